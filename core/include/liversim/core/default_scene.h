@@ -1,0 +1,33 @@
+#pragma once
+// The scene the workstation and the CLI start with when nothing else is asked for: the built-in
+// liver with the seed's tissue, held at its ligament attachment. Scenario files (issue 9) will
+// replace these defaults; until then this is the one place they are defined.
+
+#include "liversim/core/liver_geometry.h"
+#include "liversim/core/model.h"
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace liversim {
+
+struct SceneSetup {
+  TetMesh mesh;
+  ModelOptions model_options;
+  std::string description;  // e.g. "built-in liver, 5450 tetrahedra"
+};
+
+// Built-in liver at the requested element count, ligament nodes fixed.
+SceneSetup default_scene(int tet_count = kDefaultLiverTetCount);
+
+// A mesh read from disk, with the nodes of the named node set fixed. Throws MeshReadError for a bad
+// file and std::invalid_argument when the set does not exist.
+SceneSetup scene_from_file(const std::filesystem::path& file,
+                           const std::optional<std::string>& fixed_node_set);
+
+// The surface node nearest to the centre of the anterior (+z) face of the mesh's bounding box: a
+// reproducible "marked point" for loads when none is given.
+NodeIndex anterior_marked_node(const TetMesh& mesh);
+
+}  // namespace liversim

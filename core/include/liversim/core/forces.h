@@ -1,0 +1,55 @@
+#pragma once
+// Nodal forces and energies of the elastic liver, and the external inputs of a step.
+
+#include "liversim/core/model.h"
+#include "liversim/core/state.h"
+
+#include <Eigen/Core>
+
+#include <span>
+
+namespace liversim {
+
+struct PointLoad {
+  NodeIndex node;
+  Eigen::Vector3d force_n;
+};
+
+// A damped spring pulling a node toward an anchor point: how a dragged point (mouse, forceps)
+// acts. The damping is integrated implicitly, so a stiff coupling on a light node stays stable.
+struct NodeSpring {
+  NodeIndex node;
+  Eigen::Vector3d anchor_m;
+  double stiffness_n_per_m;
+  double damping_n_s_per_m = 0.0;
+};
+
+struct StepInputs {
+  std::span<const PointLoad> point_loads;
+  std::span<const NodeSpring> springs;
+};
+
+// Extremes of the element volume ratio J = det F seen in a force evaluation: compression stiffens
+// the volumetric response, which shortens the stable explicit step.
+struct VolumeRatioRange {
+  double min = 1.0;
+  double max = 1.0;
+};
+
+// Writes the elastic (internal) nodal forces at `position` into `force`, using `corner_scratch`
+// for per-element values. Allocates nothing.
+VolumeRatioRange compute_elastic_forces(const SimModel& model, const NodeArray& position,
+                                        std::array<NodeArray, 4>& corner_scratch, NodeArray& force);
+
+// Adds point loads and spring forces at `position` to `force` (spring damping is applied by the
+// integrator).
+void add_external_forces(const StepInputs& inputs, const NodeArray& position, NodeArray& force);
+
+double strain_energy_j(const SimModel& model, const NodeArray& position);
+double kinetic_energy_j(const SimModel& model, const NodeArray& velocity);
+
+// Deformation gradient F of element e at `position`.
+Eigen::Matrix3d deformation_gradient(const SimModel& model, const NodeArray& position,
+                                     std::size_t e);
+
+}  // namespace liversim

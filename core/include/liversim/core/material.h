@@ -1,0 +1,53 @@
+#pragma once
+// Tissue material parameters and the compressible Neo-Hookean stress used by the engine.
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+
+namespace liversim {
+
+// Isotropic elastic tissue. Defaults are the seed paper's liver (§4.2): E = 3500 Pa, ν = 0.49,
+// ρ = 1060 kg/m³. Here E is the small-strain Young's modulus of the elastic base.
+struct TissueMaterial {
+  double youngs_modulus_pa = 3500.0;
+  double poisson_ratio = 0.49;
+  double density_kg_per_m3 = 1060.0;
+
+  double shear_modulus_pa() const { return youngs_modulus_pa / (2.0 * (1.0 + poisson_ratio)); }
+  double lame_lambda_pa() const {
+    return youngs_modulus_pa * poisson_ratio /
+           ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
+  }
+};
+
+// Returns a message naming the first parameter that is outside its physical range (or not a
+// number), or nothing when all are valid.
+std::optional<std::string> validate(const TissueMaterial& material);
+
+// Compressible Neo-Hookean (Bonet & Wood):
+//   Ψ(F) = μ/2 (tr FᵀF − 3) − μ ln J + λ/2 (ln J)².
+// Below J = kMinVolumeRatio the volumetric part U(J) = λ/2 ln²J − μ ln J is continued by its
+// second-order Taylor polynomial, so Ψ and P stay finite for J ≤ 0 (inverted elements) and the
+// restoring pressure pushes an inverted element back out.
+namespace neo_hookean {
+
+inline constexpr double kMinVolumeRatio = 0.2;
+
+// Strain energy density Ψ in J/m³.
+double energy_density(const Eigen::Matrix3d& F, double mu, double lambda);
+
+// First Piola–Kirchhoff stress P = ∂Ψ/∂F in Pa.
+Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, double mu, double lambda);
+
+// U''(J) / U''(1): how much stiffer the volumetric response is at J than at rest (≥ 1 under
+// compression). The stable explicit step scales with its inverse square root.
+double volumetric_stiffening(double J, double mu, double lambda);
+
+}  // namespace neo_hookean
+
+// Cofactor matrix cof(F) = J F⁻ᵀ = ∂J/∂F, computed without inverting F (defined for J ≤ 0).
+Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F);
+
+}  // namespace liversim

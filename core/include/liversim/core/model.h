@@ -1,0 +1,56 @@
+#pragma once
+// The constant simulation model, built once from a mesh and a scenario's settings. Everything that
+// changes while simulating lives in SimState (state.h); stepping reads the model and never writes
+// it.
+
+#include "liversim/core/material.h"
+#include "liversim/core/tet_mesh.h"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace liversim {
+
+struct ModelOptions {
+  TissueMaterial material;
+  std::vector<NodeIndex> fixed_nodes;  // held at their rest position (e.g. ligament attachment)
+  double mass_damping_per_s = 8.0;     // Rayleigh mass-proportional damping coefficient α
+  double stable_step_safety = 0.8;     // fraction of the central-difference limit actually used
+};
+
+struct SimModel {
+  std::size_t node_count = 0;
+  std::size_t tet_count = 0;
+  std::array<std::vector<NodeIndex>, 4> corner;  // corner[c][e]
+  // Total-Lagrangian shape-function data: Dm⁻¹ per element, row-major entry k at dm_inverse[k][e],
+  // where Dm = [X1−X0, X2−X0, X3−X0] in the rest configuration.
+  std::array<std::vector<double>, 9> dm_inverse;
+  std::vector<double> rest_volume_m3;
+  std::vector<double> shear_modulus_pa;  // μ per element
+  std::vector<double> lame_lambda_pa;    // λ per element
+  NodeArray rest_position_m;
+  std::vector<double> lumped_mass_kg;
+  std::vector<double> inverse_mass_per_kg;  // 0 on fixed nodes, so they never move
+  std::vector<std::uint8_t> is_fixed;
+  // Node → element-corner incidence (CSR) for gathering element forces without atomics. A slot s
+  // names corner s / tet_count of element s % tet_count.
+  std::vector<std::int32_t> node_slot_begin;  // size node_count + 1
+  std::vector<std::int32_t> node_slots;
+  TissueMaterial material;
+  double mass_damping_per_s = 0.0;
+  // Largest eigenfrequency of M⁻¹K at rest (free nodes), from power iteration, and the explicit
+  // step used: safety · 2/ω_max (reduced for damping).
+  double max_frequency_rad_per_s = 0.0;
+  double stable_time_step_s = 0.0;
+  double stable_step_safety = 0.8;
+  // Smallest element height at rest: no node may travel more than a tenth of it in one step, which
+  // keeps fast, large distortions (a yank, an inversion) from jumping past the stiffening.
+  double min_element_height_m = 0.0;
+};
+
+// Builds the model. Throws std::invalid_argument naming the problem for an invalid material, an
+// empty mesh, an inverted or zero-volume element, or a fixed node index out of range.
+SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
+
+}  // namespace liversim

@@ -1,0 +1,26 @@
+#pragma once
+// The changing simulation state, with the scratch buffers stepping needs, sized once for a model.
+
+#include "liversim/core/model.h"
+
+#include <cstdint>
+
+namespace liversim {
+
+struct SimState {
+  NodeArray position_m;
+  // Leapfrog velocity, half a step behind the next position update (v at t − Δt/2).
+  NodeArray velocity_m_per_s;
+  NodeArray force_n;                         // total nodal force of the last evaluation
+  std::array<NodeArray, 4> corner_force_n;   // per element corner, before the gather
+  std::vector<double> spring_damping_per_s;  // c/m per node from the springs of this step
+  double max_speed_m_per_s = 0.0;            // fastest node after the last step
+  double last_step_s = 0.0;                  // length of the last step (0 before the first)
+  double time_s = 0.0;
+  std::uint64_t step_count = 0;
+};
+
+// A state at rest in the reference configuration, with all scratch allocated.
+SimState make_rest_state(const SimModel& model);
+
+}  // namespace liversim

@@ -1,0 +1,53 @@
+#include "liversim/core/default_scene.h"
+
+#include "liversim/core/mesh_io.h"
+#include "liversim/core/surface.h"
+
+#include <Eigen/Geometry>
+
+#include <limits>
+#include <stdexcept>
+
+namespace liversim {
+
+SceneSetup default_scene(int tet_count) {
+  SceneSetup setup;
+  setup.mesh = generate_liver_mesh(tet_count).mesh;
+  setup.model_options.fixed_nodes = setup.mesh.node_sets.at("ligament");
+  setup.description = "built-in liver, " + std::to_string(setup.mesh.tet_count()) + " tetrahedra";
+  return setup;
+}
+
+SceneSetup scene_from_file(const std::filesystem::path& file,
+                           const std::optional<std::string>& fixed_node_set) {
+  SceneSetup setup;
+  setup.mesh = read_tet_mesh(file);
+  if (fixed_node_set) {
+    const auto set = setup.mesh.node_sets.find(*fixed_node_set);
+    if (set == setup.mesh.node_sets.end())
+      throw std::invalid_argument("node set '" + *fixed_node_set + "' is not defined in " +
+                                  file.string());
+    setup.model_options.fixed_nodes = set->second;
+  }
+  setup.description =
+      file.filename().string() + ", " + std::to_string(setup.mesh.tet_count()) + " tetrahedra";
+  return setup;
+}
+
+NodeIndex anterior_marked_node(const TetMesh& mesh) {
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < mesh.node_count(); ++n) box.extend(mesh.rest_position_m.at(n));
+  const Eigen::Vector3d target(box.center().x(), box.center().y(), box.max().z());
+  NodeIndex best = 0;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (NodeIndex n : extract_surface(mesh).nodes) {
+    const double d = (mesh.rest_position_m.at(n) - target).squaredNorm();
+    if (d < best_distance) {
+      best_distance = d;
+      best = n;
+    }
+  }
+  return best;
+}
+
+}  // namespace liversim

@@ -1,0 +1,112 @@
+#include "liversim/core/forces.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <limits>
+
+namespace liversim {
+namespace {
+
+Eigen::Matrix3d dm_inverse_of(const SimModel& model, std::size_t e) {
+  Eigen::Matrix3d m;
+  for (int k = 0; k < 9; ++k) m(k / 3, k % 3) = model.dm_inverse[k][e];
+  return m;
+}
+
+Eigen::Matrix3d deformed_edges(const SimModel& model, const NodeArray& x, std::size_t e) {
+  const auto n0 = model.corner[0][e];
+  Eigen::Matrix3d ds;
+  for (int c = 1; c < 4; ++c) {
+    const auto n = model.corner[c][e];
+    ds.col(c - 1) = Eigen::Vector3d(x.x[n] - x.x[n0], x.y[n] - x.y[n0], x.z[n] - x.z[n0]);
+  }
+  return ds;
+}
+
+}  // namespace
+
+Eigen::Matrix3d deformation_gradient(const SimModel& model, const NodeArray& position,
+                                     std::size_t e) {
+  return deformed_edges(model, position, e) * dm_inverse_of(model, e);
+}
+
+VolumeRatioRange compute_elastic_forces(const SimModel& model, const NodeArray& position,
+                                        std::array<NodeArray, 4>& corner_scratch,
+                                        NodeArray& force) {
+  const std::size_t tets = model.tet_count;
+  VolumeRatioRange range{std::numeric_limits<double>::infinity(),
+                         -std::numeric_limits<double>::infinity()};
+  for (std::size_t e = 0; e < tets; ++e) {
+    const Eigen::Matrix3d dm_inv = dm_inverse_of(model, e);
+    const Eigen::Matrix3d F = deformed_edges(model, position, e) * dm_inv;
+    const double J = F.determinant();
+    range.min = std::min(range.min, J);
+    range.max = std::max(range.max, J);
+    const Eigen::Matrix3d P =
+        neo_hookean::first_piola_stress(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+    // Nodal forces of corners 1..3 are the columns of −V·P·Dm⁻ᵀ; corner 0 balances them.
+    const Eigen::Matrix3d h = -model.rest_volume_m3[e] * P * dm_inv.transpose();
+    const Eigen::Vector3d h0 = -(h.col(0) + h.col(1) + h.col(2));
+    corner_scratch[0].x[e] = h0.x();
+    corner_scratch[0].y[e] = h0.y();
+    corner_scratch[0].z[e] = h0.z();
+    for (int c = 1; c < 4; ++c) {
+      corner_scratch[c].x[e] = h(0, c - 1);
+      corner_scratch[c].y[e] = h(1, c - 1);
+      corner_scratch[c].z[e] = h(2, c - 1);
+    }
+  }
+  // Gather per node: each node sums its own corner slots, so no two writers share a node.
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    double fx = 0.0, fy = 0.0, fz = 0.0;
+    for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
+      const auto slot = static_cast<std::size_t>(model.node_slots[s]);
+      const auto& c = corner_scratch[slot / tets];
+      const std::size_t e = slot % tets;
+      fx += c.x[e];
+      fy += c.y[e];
+      fz += c.z[e];
+    }
+    force.x[n] = fx;
+    force.y[n] = fy;
+    force.z[n] = fz;
+  }
+  return range;
+}
+
+void add_external_forces(const StepInputs& inputs, const NodeArray& position, NodeArray& force) {
+  for (const auto& load : inputs.point_loads) {
+    force.x[load.node] += load.force_n.x();
+    force.y[load.node] += load.force_n.y();
+    force.z[load.node] += load.force_n.z();
+  }
+  for (const auto& spring : inputs.springs) {
+    const auto n = spring.node;
+    force.x[n] += spring.stiffness_n_per_m * (spring.anchor_m.x() - position.x[n]);
+    force.y[n] += spring.stiffness_n_per_m * (spring.anchor_m.y() - position.y[n]);
+    force.z[n] += spring.stiffness_n_per_m * (spring.anchor_m.z() - position.z[n]);
+  }
+}
+
+double strain_energy_j(const SimModel& model, const NodeArray& position) {
+  double energy = 0.0;
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    energy += model.rest_volume_m3[e] *
+              neo_hookean::energy_density(deformation_gradient(model, position, e),
+                                          model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+  }
+  return energy;
+}
+
+double kinetic_energy_j(const SimModel& model, const NodeArray& velocity) {
+  double energy = 0.0;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    energy += 0.5 * model.lumped_mass_kg[n] *
+              (velocity.x[n] * velocity.x[n] + velocity.y[n] * velocity.y[n] +
+               velocity.z[n] * velocity.z[n]);
+  }
+  return energy;
+}
+
+}  // namespace liversim

@@ -1,0 +1,163 @@
+#include "liversim/core/integrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace liversim {
+namespace {
+
+VolumeRatioRange evaluate_forces(const SimModel& model, SimState& state, const StepInputs& inputs) {
+  const VolumeRatioRange range =
+      compute_elastic_forces(model, state.position_m, state.corner_force_n, state.force_n);
+  add_external_forces(inputs, state.position_m, state.force_n);
+  for (const auto& spring : inputs.springs)
+    state.spring_damping_per_s[spring.node] +=
+        spring.damping_n_s_per_m * model.inverse_mass_per_kg[spring.node];
+  return range;
+}
+
+// Leapfrog kick and drift with the forces in state.force_n. Damping (mass-proportional α plus
+// the springs' c/m) taken at the mid-step velocity keeps the scheme explicit, second order and
+// stable for any damping: v⁺ = ((1 − αΔt/2) v⁻ + Δt M⁻¹ f) / (1 + αΔt/2).
+void kick_drift(const SimModel& model, SimState& state, const StepInputs& inputs, double dt_s) {
+  // With a changing step the velocity lives at the midpoints, so the kick spans half of the last
+  // step and half of this one; kicking by Δt alone would pump energy whenever the step changes.
+  const double kick_s = state.last_step_s > 0.0 ? 0.5 * (state.last_step_s + dt_s) : dt_s;
+  auto& x = state.position_m;
+  auto& v = state.velocity_m_per_s;
+  const auto& f = state.force_n;
+  double max_speed_sq = 0.0;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    const double w = model.inverse_mass_per_kg[n];
+    if (w == 0.0) continue;  // fixed node
+    const double half_damping =
+        0.5 * (model.mass_damping_per_s + state.spring_damping_per_s[n]) * kick_s;
+    const double keep = (1.0 - half_damping) / (1.0 + half_damping);
+    const double gain = kick_s * w / (1.0 + half_damping);
+    v.x[n] = keep * v.x[n] + gain * f.x[n];
+    v.y[n] = keep * v.y[n] + gain * f.y[n];
+    v.z[n] = keep * v.z[n] + gain * f.z[n];
+    x.x[n] += dt_s * v.x[n];
+    x.y[n] += dt_s * v.y[n];
+    x.z[n] += dt_s * v.z[n];
+    max_speed_sq = std::max(max_speed_sq, v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n]);
+  }
+  for (const auto& spring : inputs.springs) state.spring_damping_per_s[spring.node] = 0.0;
+  state.max_speed_m_per_s = std::sqrt(max_speed_sq);
+  state.last_step_s = dt_s;
+  state.time_s += dt_s;
+  ++state.step_count;
+}
+
+}  // namespace
+
+double stable_time_step_s(const SimModel& model, const StepInputs& inputs, double stiffening) {
+  double max_spring_omega_sq = 0.0;
+  for (const auto& spring : inputs.springs) {
+    max_spring_omega_sq = std::max(
+        max_spring_omega_sq, spring.stiffness_n_per_m * model.inverse_mass_per_kg[spring.node]);
+  }
+  const double omega = std::sqrt(model.max_frequency_rad_per_s * model.max_frequency_rad_per_s *
+                                     std::max(1.0, stiffening) +
+                                 max_spring_omega_sq);
+  if (!(omega > 0.0)) return std::numeric_limits<double>::infinity();
+  const double xi = model.mass_damping_per_s / (2.0 * omega);
+  return model.stable_step_safety * (2.0 / omega) * (std::sqrt(1.0 + xi * xi) - xi);
+}
+
+VolumeRatioRange central_difference_step(const SimModel& model, SimState& state,
+                                         const StepInputs& inputs, double dt_s) {
+  const VolumeRatioRange range = evaluate_forces(model, state, inputs);
+  kick_drift(model, state, inputs, dt_s);
+  return range;
+}
+
+StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
+                   double interval_s) {
+  StepReport report;
+  if (!(interval_s > 0.0)) return report;
+  report.smallest_substep_s = interval_s;
+  const double end_time = state.time_s + interval_s;
+  double remaining = interval_s;
+  while (remaining > 0.0) {
+    const VolumeRatioRange range = evaluate_forces(model, state, inputs);
+    const double stiffening = neo_hookean::volumetric_stiffening(
+        range.min, model.material.shear_modulus_pa(), model.material.lame_lambda_pa());
+    report.max_stiffening = std::max(report.max_stiffening, stiffening);
+    double limit = stable_time_step_s(model, inputs, stiffening);
+    if (state.max_speed_m_per_s > 0.0)
+      limit = std::min(limit, 0.1 * model.min_element_height_m / state.max_speed_m_per_s);
+    // Equal steps over what is left, so the interval ends exactly where asked.
+    const double steps_left = std::ceil(remaining / limit);
+    const double dt = steps_left <= 1.0 ? remaining : remaining / steps_left;
+    kick_drift(model, state, inputs, dt);
+    remaining = steps_left <= 1.0 ? 0.0 : remaining - dt;
+    ++report.substeps;
+    report.smallest_substep_s = std::min(report.smallest_substep_s, dt);
+    report.largest_substep_s = std::max(report.largest_substep_s, dt);
+  }
+  state.time_s = end_time;  // no drift from summing substeps
+  return report;
+}
+
+double estimate_max_frequency_rad_per_s(const SimModel& model, const NodeArray& position,
+                                        int iterations) {
+  const std::size_t n = model.node_count;
+  std::array<NodeArray, 4> scratch;
+  for (auto& c : scratch) c.resize(model.tet_count);
+  NodeArray probe = position, force_plus, force_minus;
+  force_plus.resize(n);
+  force_minus.resize(n);
+
+  // Work in mass-scaled coordinates u = M^(1/2) v, where A = M^(-1/2) K M^(-1/2) is symmetric.
+  std::vector<double> u(3 * n), au(3 * n), inv_sqrt_mass(n);
+  for (std::size_t i = 0; i < n; ++i) inv_sqrt_mass[i] = std::sqrt(model.inverse_mass_per_kg[i]);
+  std::mt19937 random(12345);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (std::size_t i = 0; i < 3 * n; ++i) u[i] = inv_sqrt_mass[i / 3] > 0 ? uniform(random) : 0;
+
+  double characteristic_length = 0.0;
+  for (double v : model.rest_volume_m3) characteristic_length = std::max(characteristic_length, v);
+  characteristic_length = std::cbrt(characteristic_length);
+
+  double eigenvalue = 0.0;
+  for (int it = 0; it < iterations; ++it) {
+    double norm = 0.0;
+    for (double value : u) norm += value * value;
+    norm = std::sqrt(norm);
+    if (norm == 0.0) return 0.0;
+    for (double& value : u) value /= norm;
+    // K·v by central differences of the elastic force along v = M^(-1/2) u.
+    double max_v = 0.0;
+    for (std::size_t i = 0; i < 3 * n; ++i)
+      max_v = std::max(max_v, std::abs(u[i] * inv_sqrt_mass[i / 3]));
+    const double h = 1e-6 * characteristic_length / max_v;
+    auto displace = [&](double sign) {
+      for (std::size_t i = 0; i < n; ++i) {
+        probe.x[i] = position.x[i] + sign * h * u[3 * i] * inv_sqrt_mass[i];
+        probe.y[i] = position.y[i] + sign * h * u[3 * i + 1] * inv_sqrt_mass[i];
+        probe.z[i] = position.z[i] + sign * h * u[3 * i + 2] * inv_sqrt_mass[i];
+      }
+    };
+    displace(+1.0);
+    compute_elastic_forces(model, probe, scratch, force_plus);
+    displace(-1.0);
+    compute_elastic_forces(model, probe, scratch, force_minus);
+    double rayleigh = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double s = inv_sqrt_mass[i] / (2.0 * h);  // K v = −(f(x+hv) − f(x−hv)) / 2h
+      au[3 * i] = -s * (force_plus.x[i] - force_minus.x[i]);
+      au[3 * i + 1] = -s * (force_plus.y[i] - force_minus.y[i]);
+      au[3 * i + 2] = -s * (force_plus.z[i] - force_minus.z[i]);
+      rayleigh +=
+          u[3 * i] * au[3 * i] + u[3 * i + 1] * au[3 * i + 1] + u[3 * i + 2] * au[3 * i + 2];
+    }
+    eigenvalue = rayleigh;
+    u.swap(au);
+  }
+  return std::sqrt(std::max(eigenvalue, 0.0));
+}
+
+}  // namespace liversim

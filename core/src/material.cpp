@@ -1,0 +1,89 @@
+#include "liversim/core/material.h"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <sstream>
+
+namespace liversim {
+
+std::optional<std::string> validate(const TissueMaterial& material) {
+  auto out_of_range = [](const char* name, double value, const char* expected) {
+    std::ostringstream message;
+    message << name << " = " << value << " is invalid: expected " << expected;
+    return message.str();
+  };
+  if (!std::isfinite(material.youngs_modulus_pa) || material.youngs_modulus_pa <= 0.0)
+    return out_of_range("Young's modulus (Pa)", material.youngs_modulus_pa, "a finite value > 0");
+  if (!std::isfinite(material.poisson_ratio) || material.poisson_ratio <= -1.0 ||
+      material.poisson_ratio >= 0.5)
+    return out_of_range("Poisson's ratio", material.poisson_ratio, "a value in (-1, 0.5)");
+  if (!std::isfinite(material.density_kg_per_m3) || material.density_kg_per_m3 <= 0.0)
+    return out_of_range("density (kg/m³)", material.density_kg_per_m3, "a finite value > 0");
+  return std::nullopt;
+}
+
+Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F) {
+  Eigen::Matrix3d c;
+  c.col(0) = F.col(1).cross(F.col(2));
+  c.col(1) = F.col(2).cross(F.col(0));
+  c.col(2) = F.col(0).cross(F.col(1));
+  return c;  // columns of cof(F) are the cross products of the other two columns of F
+}
+
+namespace neo_hookean {
+namespace {
+
+// U(J) = λ/2 ln²J − μ ln J and its first two derivatives at J0 = kMinVolumeRatio.
+struct VolumetricTaylor {
+  double u0, du0, ddu0;
+};
+
+VolumetricTaylor taylor_at_min(double mu, double lambda) {
+  const double j0 = kMinVolumeRatio, log_j0 = std::log(j0);
+  return {0.5 * lambda * log_j0 * log_j0 - mu * log_j0, (lambda * log_j0 - mu) / j0,
+          (lambda * (1.0 - log_j0) + mu) / (j0 * j0)};
+}
+
+double volumetric_energy(double J, double mu, double lambda) {
+  if (J >= kMinVolumeRatio) {
+    const double log_j = std::log(J);
+    return 0.5 * lambda * log_j * log_j - mu * log_j;
+  }
+  const auto t = taylor_at_min(mu, lambda);
+  const double d = J - kMinVolumeRatio;
+  return t.u0 + t.du0 * d + 0.5 * t.ddu0 * d * d;
+}
+
+// dU/dJ.
+double volumetric_pressure_term(double J, double mu, double lambda) {
+  if (J >= kMinVolumeRatio) return (lambda * std::log(J) - mu) / J;
+  const auto t = taylor_at_min(mu, lambda);
+  return t.du0 + t.ddu0 * (J - kMinVolumeRatio);
+}
+
+// d²U/dJ².
+double volumetric_stiffness(double J, double mu, double lambda) {
+  if (J >= kMinVolumeRatio) return (lambda * (1.0 - std::log(J)) + mu) / (J * J);
+  return taylor_at_min(mu, lambda).ddu0;
+}
+
+}  // namespace
+
+double volumetric_stiffening(double J, double mu, double lambda) {
+  return volumetric_stiffness(J, mu, lambda) / (lambda + mu);
+}
+
+double energy_density(const Eigen::Matrix3d& F, double mu, double lambda) {
+  return 0.5 * mu * (F.squaredNorm() - 3.0) + volumetric_energy(F.determinant(), mu, lambda);
+}
+
+Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, double mu, double lambda) {
+  // P = μF + U'(J) cof(F); at J = 1, U'(1) = −μ and cof(I) = I, so P(I) = 0.
+  const Eigen::Matrix3d cof = cofactor(F);
+  const double J = F.col(0).dot(cof.col(0));
+  return mu * F + volumetric_pressure_term(J, mu, lambda) * cof;
+}
+
+}  // namespace neo_hookean
+}  // namespace liversim

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# The two commands of README for a new user on Debian 12:
+#   packaging/liversim.sh run    install what is missing, build, start the workstation
+#   packaging/liversim.sh test   install what is missing, build, run the whole test suite
+# Without a display, "run" says so and runs the headless demo instead (a short simulation and a
+# screenshot written to liversim-demo.png in the current directory).
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+command=${1:-run}
+preset=release
+xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24")
+
+case "$command" in
+  run | test) ;;
+  *)
+    echo "usage: $0 run|test" >&2
+    exit 2
+    ;;
+esac
+
+"$root/packaging/setup-debian.sh"
+cd "$root"
+cmake --preset "$preset" >/dev/null
+cmake --build --preset "$preset" --parallel "$(nproc)"
+
+if [ "$command" = test ]; then
+  # GUI and rendering tests need an X server: Xvfb provides one whether or not a display exists.
+  exec "${xvfb[@]}" ctest --preset "$preset" --parallel "$(nproc)" --timeout 300
+fi
+
+if [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; then
+  exec "$root/build/$preset/app/liversim"
+fi
+demo_png="$PWD/liversim-demo.png"
+echo "liversim: no display found (DISPLAY and WAYLAND_DISPLAY are unset), so the workstation"
+echo "cannot open a window. Running the headless demo instead; its screenshot: $demo_png"
+exec "${xvfb[@]}" "$root/build/$preset/app/liversim-cli" demo --output "$demo_png"

@@ -1,0 +1,53 @@
+#pragma once
+// Test meshes: a box of nx × ny × nz cubes, each split into six tetrahedra around its main diagonal
+// (conforming across cubes), with optional jitter of the interior nodes.
+
+#include "liversim/core/tet_mesh.h"
+
+#include <random>
+
+namespace liversim::testing {
+
+inline bool on_box_boundary(int i, int j, int k, int nx, int ny, int nz) {
+  return i == 0 || j == 0 || k == 0 || i == nx || j == ny || k == nz;
+}
+
+inline TetMesh block_mesh(int nx, int ny, int nz, const Eigen::Vector3d& size_m,
+                          double interior_jitter = 0.0, unsigned seed = 7) {
+  TetMesh mesh;
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> jitter(-interior_jitter, interior_jitter);
+  const Eigen::Vector3d h(size_m.x() / nx, size_m.y() / ny, size_m.z() / nz);
+  auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) {
+        Eigen::Vector3d p(i * h.x(), j * h.y(), k * h.z());
+        if (!on_box_boundary(i, j, k, nx, ny, nz))
+          p += Eigen::Vector3d(jitter(random), jitter(random), jitter(random)).cwiseProduct(h);
+        mesh.rest_position_m.push_back(p);
+      }
+  // Kuhn subdivision: the six paths from corner 000 to 111 along the axes.
+  static constexpr int kPaths[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                       {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        for (const auto& path : kPaths) {
+          int c[3] = {i, j, k};
+          std::array<NodeIndex, 4> tet;
+          tet[0] = id(c[0], c[1], c[2]);
+          for (int s = 0; s < 3; ++s) {
+            ++c[path[s]];
+            tet[s + 1] = id(c[0], c[1], c[2]);
+          }
+          if (signed_tet_volume(mesh.rest_position_m.at(tet[0]), mesh.rest_position_m.at(tet[1]),
+                                mesh.rest_position_m.at(tet[2]),
+                                mesh.rest_position_m.at(tet[3])) < 0)
+            std::swap(tet[2], tet[3]);
+          mesh.add_tet(tet);
+        }
+  return mesh;
+}
+
+}  // namespace liversim::testing

@@ -1,0 +1,199 @@
+#include "render/liver_scene.h"
+
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellPicker.h>
+#include <vtkFloatArray.h>
+#include <vtkLight.h>
+#include <vtkPNGWriter.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkSphereSource.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <fstream>
+#include <stdexcept>
+
+namespace liversim {
+namespace {
+
+// Liver parenchyma: a dark red-brown with a moist sheen.
+constexpr double kTissueColour[3] = {0.62, 0.22, 0.17};
+constexpr double kBackgroundTop[3] = {0.16, 0.18, 0.22};
+constexpr double kBackgroundBottom[3] = {0.05, 0.05, 0.07};
+
+}  // namespace
+
+LiverScene::LiverScene(const TetMesh& mesh, BoundarySurface surface)
+    : surface_(std::move(surface)) {
+  points_->SetDataTypeToDouble();
+  points_->SetNumberOfPoints(static_cast<vtkIdType>(surface_.nodes.size()));
+  vtkNew<vtkCellArray> triangles;
+  triangles->AllocateExact(static_cast<vtkIdType>(surface_.triangles.size()),
+                           static_cast<vtkIdType>(3 * surface_.triangles.size()));
+  for (const auto& t : surface_.triangles) {
+    const vtkIdType ids[3] = {t[0], t[1], t[2]};
+    triangles->InsertNextCell(3, ids);
+  }
+  normals_->SetNumberOfComponents(3);
+  normals_->SetNumberOfTuples(static_cast<vtkIdType>(surface_.nodes.size()));
+  normals_->SetName("Normals");
+  polydata_->SetPoints(points_);
+  polydata_->SetPolys(triangles);
+  polydata_->GetPointData()->SetNormals(normals_);
+  update_positions(mesh.rest_position_m);
+
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(polydata_);
+  liver_actor_->SetMapper(mapper);
+  vtkProperty* tissue = liver_actor_->GetProperty();
+  tissue->SetColor(kTissueColour[0], kTissueColour[1], kTissueColour[2]);
+  tissue->SetInterpolationToPhong();
+  tissue->SetAmbient(0.12);
+  tissue->SetDiffuse(0.85);
+  tissue->SetSpecular(0.35);
+  tissue->SetSpecularPower(28.0);
+  renderer_->AddActor(liver_actor_);
+
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetRadius(0.004);
+  sphere->SetThetaResolution(16);
+  sphere->SetPhiResolution(16);
+  vtkNew<vtkPolyDataMapper> marker_mapper;
+  marker_mapper->SetInputConnection(sphere->GetOutputPort());
+  grab_marker_->SetMapper(marker_mapper);
+  grab_marker_->GetProperty()->SetColor(0.75, 0.8, 0.85);
+  grab_marker_->GetProperty()->SetSpecular(0.6);
+  grab_marker_->VisibilityOff();
+  grab_marker_->PickableOff();
+  renderer_->AddActor(grab_marker_);
+
+  renderer_->GradientBackgroundOn();
+  renderer_->SetBackground(kBackgroundBottom[0], kBackgroundBottom[1], kBackgroundBottom[2]);
+  renderer_->SetBackground2(kBackgroundTop[0], kBackgroundTop[1], kBackgroundTop[2]);
+  // A headlight so the surface facing the user is always lit, plus a key light from above like
+  // an operating lamp, which gives the specular highlights of a moist surface.
+  vtkNew<vtkLight> headlight;
+  headlight->SetLightTypeToHeadlight();
+  headlight->SetIntensity(0.75);
+  renderer_->AddLight(headlight);
+  vtkNew<vtkLight> lamp;
+  lamp->SetLightTypeToSceneLight();
+  lamp->SetPosition(0.1, 0.6, 0.5);
+  lamp->SetFocalPoint(0.0, 0.0, 0.0);
+  lamp->SetIntensity(0.45);
+  renderer_->AddLight(lamp);
+
+  picker_->SetTolerance(0.0005);
+  picker_->PickFromListOn();
+  picker_->AddPickList(liver_actor_);
+  reset_camera();
+}
+
+LiverScene::~LiverScene() = default;
+
+vtkRenderer* LiverScene::renderer() const {
+  return renderer_.Get();
+}
+
+void LiverScene::update_positions(const NodeArray& position_m) {
+  for (std::size_t i = 0; i < surface_.nodes.size(); ++i) {
+    const auto n = surface_.nodes[i];
+    points_->SetPoint(static_cast<vtkIdType>(i), position_m.x[n], position_m.y[n], position_m.z[n]);
+  }
+  compute_vertex_normals(surface_, position_m, normal_scratch_);
+  std::copy(normal_scratch_.begin(), normal_scratch_.end(), normals_->GetPointer(0));
+  points_->Modified();
+  normals_->Modified();
+  polydata_->Modified();
+}
+
+void LiverScene::reset_camera() {
+  vtkCamera* camera = renderer_->GetActiveCamera();
+  camera->SetFocalPoint(0.0, 0.0, 0.0);
+  camera->SetPosition(0.05, 0.12, 0.55);  // anterior, slightly from above and the left
+  camera->SetViewUp(0.0, 1.0, 0.0);
+  camera->SetViewAngle(30.0);
+  renderer_->ResetCamera(polydata_->GetBounds());
+  renderer_->ResetCameraClippingRange();
+}
+
+void LiverScene::show_grab_marker(const std::optional<Eigen::Vector3d>& point_m) {
+  if (point_m) grab_marker_->SetPosition(point_m->x(), point_m->y(), point_m->z());
+  grab_marker_->SetVisibility(point_m.has_value());
+}
+
+std::optional<ScenePick> LiverScene::pick(int display_x, int display_y) const {
+  if (!picker_->Pick(display_x, display_y, 0.0, renderer_) || picker_->GetCellId() < 0)
+    return std::nullopt;
+  double hit[3];
+  picker_->GetPickPosition(hit);
+  const Eigen::Vector3d point(hit[0], hit[1], hit[2]);
+  const auto& triangle = surface_.triangles[static_cast<std::size_t>(picker_->GetCellId())];
+  NodeIndex nearest = surface_.nodes[triangle[0]];
+  double best = std::numeric_limits<double>::infinity();
+  for (auto local : triangle) {
+    double p[3];
+    points_->GetPoint(local, p);
+    const double d = (Eigen::Vector3d(p[0], p[1], p[2]) - point).squaredNorm();
+    if (d < best) {
+      best = d;
+      nearest = surface_.nodes[local];
+    }
+  }
+  return ScenePick{point, nearest};
+}
+
+Eigen::Vector3d LiverScene::display_to_world(int display_x, int display_y,
+                                             const Eigen::Vector3d& on_plane_m) const {
+  // The plane's depth in display coordinates, then back to world at the cursor.
+  renderer_->SetWorldPoint(on_plane_m.x(), on_plane_m.y(), on_plane_m.z(), 1.0);
+  renderer_->WorldToDisplay();
+  const double depth = renderer_->GetDisplayPoint()[2];
+  renderer_->SetDisplayPoint(display_x, display_y, depth);
+  renderer_->DisplayToWorld();
+  const double* w = renderer_->GetWorldPoint();
+  return Eigen::Vector3d(w[0], w[1], w[2]) / w[3];
+}
+
+Eigen::Vector2d LiverScene::world_to_display(const Eigen::Vector3d& point_m) const {
+  renderer_->SetWorldPoint(point_m.x(), point_m.y(), point_m.z(), 1.0);
+  renderer_->WorldToDisplay();
+  const double* d = renderer_->GetDisplayPoint();
+  return {d[0], d[1]};
+}
+
+void write_screenshot_png(LiverScene& scene, const std::filesystem::path& file, int width,
+                          int height) {
+  {
+    std::ofstream probe(file, std::ios::binary);  // fail early, with the path, if unwritable
+    if (!probe) throw std::runtime_error("cannot write the screenshot to " + file.string());
+  }
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetSize(width, height);
+  window->SetMultiSamples(0);
+  window->AddRenderer(scene.renderer());
+  scene.renderer()->ResetCameraClippingRange();
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetFileName(file.string().c_str());
+  writer->SetInputConnection(grab->GetOutputPort());
+  writer->Write();
+  window->RemoveRenderer(scene.renderer());
+  if (writer->GetErrorCode() != 0)
+    throw std::runtime_error("writing the screenshot to " + file.string() + " failed");
+}
+
+}  // namespace liversim

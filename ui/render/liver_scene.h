@@ -1,0 +1,73 @@
+#pragma once
+// The VTK scene of the liver: a smooth-shaded surface updated from simulation snapshots, picking,
+// and conversion between the screen and the scene. VTK only (no Qt): the workstation, the CLI and
+// the rendering tests share it.
+
+#include "liversim/core/surface.h"
+#include "liversim/core/tet_mesh.h"
+
+#include <vtkNew.h>
+#include <vtkSmartPointer.h>
+#include <Eigen/Core>
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+class vtkActor;
+class vtkCellPicker;
+class vtkFloatArray;
+class vtkPoints;
+class vtkPolyData;
+class vtkRenderer;
+
+namespace liversim {
+
+struct ScenePick {
+  Eigen::Vector3d point_m;  // where the ray hit the liver surface
+  NodeIndex nearest_node;   // nearest mesh node of the hit triangle
+};
+
+class LiverScene {
+ public:
+  LiverScene(const TetMesh& mesh, BoundarySurface surface);
+  ~LiverScene();
+  LiverScene(const LiverScene&) = delete;
+  LiverScene& operator=(const LiverScene&) = delete;
+
+  vtkRenderer* renderer() const;
+  const BoundarySurface& surface() const { return surface_; }
+
+  // Moves the surface to these node positions (all mesh nodes). Allocates nothing after the first.
+  void update_positions(const NodeArray& position_m);
+  // Anterior view of the whole organ.
+  void reset_camera();
+  // A small sphere at the grabbed point, or none.
+  void show_grab_marker(const std::optional<Eigen::Vector3d>& point_m);
+
+  // Display coordinates are VTK's: pixels from the bottom-left corner of the render window.
+  std::optional<ScenePick> pick(int display_x, int display_y) const;
+  // The point under the display position on the plane through `on_plane_m` facing the camera.
+  Eigen::Vector3d display_to_world(int display_x, int display_y,
+                                   const Eigen::Vector3d& on_plane_m) const;
+  Eigen::Vector2d world_to_display(const Eigen::Vector3d& point_m) const;
+
+ private:
+  BoundarySurface surface_;
+  vtkNew<vtkRenderer> renderer_;
+  vtkNew<vtkPoints> points_;
+  vtkNew<vtkFloatArray> normals_;
+  vtkNew<vtkPolyData> polydata_;
+  vtkNew<vtkActor> liver_actor_;
+  vtkNew<vtkActor> grab_marker_;
+  vtkNew<vtkCellPicker> picker_;
+  std::vector<float> normal_scratch_;
+};
+
+// Renders the scene offscreen at the given size and writes a PNG. Needs an X display (Debian's VTK
+// has no EGL or OSMesa): under no display, run it inside xvfb-run. Throws std::runtime_error when
+// the file cannot be written.
+void write_screenshot_png(LiverScene& scene, const std::filesystem::path& file, int width,
+                          int height);
+
+}  // namespace liversim
