@@ -51,6 +51,14 @@ int mesh_report(const MeshSource& mesh) {
     const SceneSetup scene = load_scene(mesh);
     std::cout << scene.description << "\n" << assess_quality(scene.mesh);
     std::cout << "fixed nodes " << scene.model_options.fixed_nodes.size() << "\n";
+    const SimModel model = build_model(scene.mesh, scene.model_options);
+    std::cout << std::fixed << std::setprecision(0) << "highest frequency at rest "
+              << model.max_frequency_rad_per_s << " rad/s; explicit central-difference step "
+              << std::setprecision(3) << model.stable_time_step_s * 1e3
+              << " ms (" << std::setprecision(2) << model.stable_step_safety << " x 2/omega, E = "
+              << std::setprecision(0) << model.material.youngs_modulus_pa
+              << " Pa, nu = " << std::setprecision(3) << model.material.poisson_ratio
+              << ")\n";
     return 0;
   });
 }

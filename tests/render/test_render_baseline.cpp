@@ -1,0 +1,240 @@
+// The default scene, rendered offscreen, against a baseline picture (tests/baselines): catches
+// changes to the liver's look (mesh, colours, lights, camera). The comparison is VTK's own
+// regression-test metric (vtkImageDifference), which forgives shifts of up to two pixels and the
+// small differences between graphics drivers; a deformed liver shows that it can fail.
+//
+// Needs an X display (Debian's VTK has no EGL or OSMesa): run it under
+//   xvfb-run -a -s "-screen 0 1280x1024x24" ctest -L render
+//
+// Updating the baseline after an intended change of the picture: run the test, look at the
+// output it names, and copy that over tests/baselines/default_scene.png.
+#include <gtest/gtest.h>
+
+#include <vtkImageData.h>
+#include <vtkImageDifference.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
+#include <vtkPNGWriter.h>
+#include <vtkSmartPointer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+
+#include "liversim/core/default_scene.h"
+#include "liversim/core/surface.h"
+#include "render/liver_scene.h"
+
+namespace liversim {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kWidth = 800;
+constexpr int kHeight = 600;
+const fs::path kBaseline = fs::path(LIVERSIM_BASELINE_DIR) / "default_scene.png";
+const fs::path kOutputDir = LIVERSIM_TEST_OUTPUT_DIR;
+
+// The comparison is vtkImageDifference's: per pixel, the smallest colour error against the other
+// picture's pixels up to 2 pixels away (also 3x3-averaged), less kPixelThreshold per channel; the
+// thresholded error sums that over the picture, each pixel's error as a fraction of 255.
+//
+// Two renders of the same scene here (Xvfb, llvmpipe) are identical, pixel for pixel, within a
+// process and between processes. The tolerance is for other drivers and Mesa versions: their
+// shading and anti-aliasing differ by a few levels, their edges by a pixel.
+//
+// kPixelThreshold: VTK's default of 105 (of 255) is meant for comparing different graphics
+// systems and is blind here: a 10 mm bump in the liver or its colour 20 % darker still give 0.
+// 16 (6 %) catches a 3 mm bump (0.58) and a 10 % darker colour (18) while forgiving a camera
+// turned by 1 degree (0.001), measured against this baseline.
+constexpr int kPixelThreshold = 16;
+// Largest accepted thresholded error: vtkRegressionTestImage's default.
+constexpr double kMaxThresholdedError = 0.15;
+
+struct ImageComparison {
+  // vtkImageDifference::GetError() is left out: past a pixel's first neighbour within the
+  // threshold it stops looking, so it is not 0 even for identical pictures.
+  double thresholded_error = 0.0;
+  vtkSmartPointer<vtkImageData> difference;  // per-pixel thresholded error (RGB)
+};
+
+vtkSmartPointer<vtkImageData> readPng(const fs::path& file) {
+  vtkNew<vtkPNGReader> reader;
+  if (!fs::exists(file) || !reader->CanReadFile(file.string().c_str())) return nullptr;
+  reader->SetFileName(file.string().c_str());
+  reader->Update();
+  return reader->GetOutput();
+}
+
+// Compares two RGB pictures of the same size. Returns nothing, and records why, when they cannot
+// be compared.
+std::optional<ImageComparison> compare(const fs::path& test, const fs::path& baseline) {
+  const auto a = readPng(test);
+  const auto b = readPng(baseline);
+  if (!a || !b) {
+    ADD_FAILURE() << "cannot read " << (a ? baseline : test) << " as a PNG";
+    return std::nullopt;
+  }
+  int da[3], db[3];
+  a->GetDimensions(da);
+  b->GetDimensions(db);
+  if (da[0] != db[0] || da[1] != db[1] || a->GetNumberOfScalarComponents() != 3 ||
+      b->GetNumberOfScalarComponents() != 3) {
+    ADD_FAILURE() << test << " is " << da[0] << "x" << da[1] << " with "
+                  << a->GetNumberOfScalarComponents() << " components, " << baseline << " is "
+                  << db[0] << "x" << db[1] << " with " << b->GetNumberOfScalarComponents()
+                  << "; both must be RGB pictures of the same size";
+    return std::nullopt;
+  }
+  vtkNew<vtkImageDifference> difference;
+  difference->SetInputData(a);
+  difference->SetImageData(b);
+  difference->SetThreshold(kPixelThreshold);
+  difference->AllowShiftOn();
+  difference->AveragingOn();
+  difference->Update();
+  ImageComparison result;
+  result.thresholded_error = difference->GetThresholdedError();
+  result.difference = difference->GetOutput();
+  return result;
+}
+
+struct PixelDifference {
+  long count = 0;   // pixels that differ in any channel
+  int largest = 0;  // largest difference of a channel, of 255
+};
+
+// Exact comparison of two pictures of the same size and type.
+PixelDifference differingPixels(vtkImageData* a, vtkImageData* b) {
+  PixelDifference result;
+  const auto* pa = static_cast<const unsigned char*>(a->GetScalarPointer());
+  const auto* pb = static_cast<const unsigned char*>(b->GetScalarPointer());
+  const int components = a->GetNumberOfScalarComponents();
+  const vtkIdType pixels = a->GetNumberOfPoints();
+  for (vtkIdType i = 0; i < pixels; ++i) {
+    bool differs = false;
+    for (int c = 0; c < components; ++c) {
+      const int d = std::abs(pa[i * components + c] - pb[i * components + c]);
+      result.largest = std::max(result.largest, d);
+      differs |= d != 0;
+    }
+    result.count += differs ? 1 : 0;
+  }
+  return result;
+}
+
+void writePng(vtkImageData* image, const fs::path& file) {
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetFileName(file.string().c_str());
+  writer->SetInputData(image);
+  writer->Write();
+}
+
+// A smooth bump: nodes near `centre` move by up to `amplitude_m`, falling off as a Gaussian of
+// width `sigma_m`.
+NodeArray bumped(const NodeArray& rest, const Eigen::Vector3d& centre,
+                 const Eigen::Vector3d& amplitude_m, double sigma_m) {
+  NodeArray moved = rest;
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    const double r2 = (rest.at(i) - centre).squaredNorm();
+    moved.set(i, rest.at(i) + std::exp(-r2 / (2 * sigma_m * sigma_m)) * amplitude_m);
+  }
+  return moved;
+}
+
+class RenderBaselineTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const char* display = std::getenv("DISPLAY");
+    ASSERT_TRUE(display != nullptr && *display != '\0')
+        << "DISPLAY is not set. This rendering test needs an X server (Debian's VTK has no EGL "
+           "or OSMesa); run it under\n  xvfb-run -a -s \"-screen 0 1280x1024x24\" ctest -L render";
+    fs::create_directories(kOutputDir);
+  }
+
+  // Renders the default scene, with the nodes at `position` (all mesh nodes) when given.
+  static fs::path render(const std::string& name,
+                         const std::optional<NodeArray>& position = std::nullopt) {
+    const SceneSetup setup = default_scene();
+    LiverScene scene(setup.mesh, extract_surface(setup.mesh));
+    if (position) scene.update_positions(*position);
+    const fs::path file = kOutputDir / (name + ".png");
+    write_screenshot_png(scene, file, kWidth, kHeight);
+    return file;
+  }
+
+  static std::string report(const ImageComparison& c) {
+    return "thresholded error " + std::to_string(c.thresholded_error) + " (limit " +
+           std::to_string(kMaxThresholdedError) + ", pixel threshold " +
+           std::to_string(kPixelThreshold) + ")";
+  }
+};
+
+TEST_F(RenderBaselineTest, DefaultSceneMatchesTheBaseline) {
+  const fs::path output = render("default_scene");
+  ASSERT_TRUE(fs::exists(kBaseline))
+      << "the baseline " << kBaseline << " is missing. The picture rendered now is\n  " << output
+      << "\nlook at it and, if it is right, copy it there:\n  cp " << output << ' ' << kBaseline;
+
+  const auto comparison = compare(output, kBaseline);
+  ASSERT_TRUE(comparison);
+  const PixelDifference pixels = differingPixels(readPng(output), readPng(kBaseline));
+  std::cout << "default scene against the baseline: " << report(*comparison) << "; " << pixels.count
+            << " pixels differ, by at most " << pixels.largest << " of 255\n";
+  if (comparison->thresholded_error > kMaxThresholdedError) {
+    const fs::path diff = kOutputDir / "default_scene_diff.png";
+    writePng(comparison->difference, diff);
+    ADD_FAILURE() << "the default scene no longer looks like the baseline: " << report(*comparison)
+                  << "\n  rendered now: " << output << "\n  baseline:     " << kBaseline
+                  << "\n  difference:   " << diff
+                  << "\nif the change is intended, copy the rendered picture over the baseline.";
+    return;
+  }
+  fs::remove(output);  // passed: nothing to inspect
+}
+
+TEST_F(RenderBaselineTest, RenderingIsRepeatable) {
+  // The threshold rests on this: two renders of the same scene are identical, pixel for pixel.
+  const fs::path first = render("repeat_first");
+  const fs::path second = render("repeat_second");
+  const auto a = readPng(first);
+  const auto b = readPng(second);
+  ASSERT_TRUE(a && b);
+  const PixelDifference pixels = differingPixels(a, b);
+  std::cout << "two renders of the default scene: " << pixels.count << " pixels differ, by at most "
+            << pixels.largest << " of 255\n";
+  EXPECT_EQ(pixels.count, 0) << "the renderer is not deterministic; see " << first << " and "
+                             << second;
+  const auto comparison = compare(first, second);
+  ASSERT_TRUE(comparison);
+  EXPECT_EQ(comparison->thresholded_error, 0.0);
+  if (!HasFailure()) {
+    fs::remove(first);
+    fs::remove(second);
+  }
+}
+
+TEST_F(RenderBaselineTest, DeformedLiverDiffersFromTheBaseline) {
+  ASSERT_TRUE(fs::exists(kBaseline)) << "the baseline " << kBaseline << " is missing";
+  // The anterior face pulled 5 mm down and toward the viewer over a few centimetres: less than a
+  // gentle grab does.
+  const SceneSetup setup = default_scene();
+  const Eigen::Vector3d centre = setup.mesh.rest_position_m.at(anterior_marked_node(setup.mesh));
+  const fs::path output =
+      render("deformed_scene", bumped(setup.mesh.rest_position_m, centre,
+                                      0.005 * Eigen::Vector3d(0.0, -3.0, 2.0).normalized(), 0.025));
+
+  const auto comparison = compare(output, kBaseline);
+  ASSERT_TRUE(comparison);
+  std::cout << "deformed scene against the baseline: " << report(*comparison) << '\n';
+  EXPECT_GT(comparison->thresholded_error, kMaxThresholdedError)
+      << "the comparison does not notice a deformed liver; see " << output;
+  if (!HasFailure()) fs::remove(output);
+}
+
+}  // namespace
+}  // namespace liversim
