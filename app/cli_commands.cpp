@@ -51,14 +51,27 @@ int mesh_report(const MeshSource& mesh) {
     const SceneSetup scene = load_scene(mesh);
     std::cout << scene.description << "\n" << assess_quality(scene.mesh);
     std::cout << "fixed nodes " << scene.model_options.fixed_nodes.size() << "\n";
+    std::vector<double> visual_xyz;
+    map_visual_positions(scene.visual, scene.mesh.rest_position_m, visual_xyz);
+    double gap_sum = 0.0, gap_max = 0.0;
+    for (std::size_t v = 0; v < scene.visual.vertex_count(); ++v) {
+      const Eigen::Vector3d vertex(visual_xyz[3 * v], visual_xyz[3 * v + 1], visual_xyz[3 * v + 2]);
+      const double gap =
+          (vertex - scene.mesh.rest_position_m.at(scene.visual.surface.nodes[v])).norm();
+      gap_sum += gap;
+      gap_max = std::max(gap_max, gap);
+    }
+    std::cout << std::fixed << std::setprecision(2)
+              << "rendered surface off the physics boundary nodes: mean "
+              << 1e3 * gap_sum / std::max<std::size_t>(scene.visual.vertex_count(), 1)
+              << " mm, max " << 1e3 * gap_max << " mm\n";
     const SimModel model = build_model(scene.mesh, scene.model_options);
     std::cout << std::fixed << std::setprecision(0) << "highest frequency at rest "
               << model.max_frequency_rad_per_s << " rad/s; explicit central-difference step "
-              << std::setprecision(3) << model.stable_time_step_s * 1e3
-              << " ms (" << std::setprecision(2) << model.stable_step_safety << " x 2/omega, E = "
-              << std::setprecision(0) << model.material.youngs_modulus_pa
-              << " Pa, nu = " << std::setprecision(3) << model.material.poisson_ratio
-              << ")\n";
+              << std::setprecision(3) << model.stable_time_step_s * 1e3 << " ms ("
+              << std::setprecision(2) << model.stable_step_safety
+              << " x 2/omega, E = " << std::setprecision(0) << model.material.youngs_modulus_pa
+              << " Pa, nu = " << std::setprecision(3) << model.material.poisson_ratio << ")\n";
     return 0;
   });
 }
@@ -130,7 +143,7 @@ int simulate(const SimulateOptions& options) {
 int screenshot(const ScreenshotOptions& options) {
   return guarded([&] {
     const SceneSetup scene = load_scene(options.mesh);
-    LiverScene view(scene.mesh, extract_surface(scene.mesh));
+    LiverScene view(scene.mesh, scene.visual);
     write_screenshot_png(view, options.output, options.width, options.height);
     std::cout << "wrote " << options.output.string() << " (" << scene.description << ")\n";
     return 0;
@@ -142,11 +155,11 @@ int demo(const ScreenshotOptions& options) {
     const SceneSetup scene = load_scene(options.mesh);
     const SimModel model = build_model(scene.mesh, scene.model_options);
     const NodeIndex node = anterior_marked_node(scene.mesh);
-    const BoundarySurface surface = extract_surface(scene.mesh);
+    const BoundarySurface& surface = scene.visual.surface;
     // Grab the anterior point and pull it 3 cm forward and down over 0.3 s, then hold.
     const Eigen::Vector3d grabbed = scene.mesh.rest_position_m.at(node);
     const Grab grab = grab_surface(surface, scene.mesh.rest_position_m, model.lumped_mass_kg,
-                                   grabbed, 0.012, 300.0);
+                                   grabbed, 0.02, 300.0);
     SimState state = make_rest_state(model);
     std::vector<NodeSpring> springs;
     const Eigen::Vector3d pull(0.0, -0.02, 0.03);
@@ -158,7 +171,7 @@ int demo(const ScreenshotOptions& options) {
     }
     const Eigen::Vector3d handle = grabbed + pull;
     const Eigen::Vector3d force = grab_reaction_force_n(grab, handle, state.position_m);
-    LiverScene view(scene.mesh, surface);
+    LiverScene view(scene.mesh, scene.visual);
     view.update_positions(state.position_m);
     view.show_grab_marker(handle);
     write_screenshot_png(view, options.output, options.width, options.height);

@@ -17,7 +17,7 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   setWindowTitle(tr("LiverSim — %1").arg(QString::fromStdString(setup_.description)));
   auto model = std::make_shared<const SimModel>(build_model(setup_.mesh, setup_.model_options));
   simulation_ = std::make_unique<RealtimeSimulation>(model, make_rest_state(*model));
-  scene_ = std::make_unique<LiverScene>(setup_.mesh, extract_surface(setup_.mesh));
+  scene_ = std::make_unique<LiverScene>(setup_.mesh, setup_.visual);
 
   viewport_ = new VtkViewport(this);
   viewport_->setObjectName("liverViewport");
@@ -57,6 +57,8 @@ MainWindow::~MainWindow() {
 }
 
 bool MainWindow::beginGrab(QPoint pos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers) {
+  // While the tissue is held, other buttons must not move the camera under the handle.
+  if (grab_) return true;
   if (button != Qt::LeftButton || modifiers != Qt::NoModifier) return false;
   const auto hit = scene_->pick(pos.x(), pos.y());
   if (!hit) return false;  // background: the camera takes the drag

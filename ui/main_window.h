@@ -34,7 +34,7 @@ class MainWindow : public QMainWindow {
 
   // Spring stiffness of a mouse grab and the radius of tissue it holds.
   static constexpr double kGrabStiffnessNPerM = 300.0;
-  static constexpr double kGrabRadiusM = 0.012;
+  static constexpr double kGrabRadiusM = 0.02;
 
  private:
   bool beginGrab(QPoint vtkDisplayPos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers);

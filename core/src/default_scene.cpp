@@ -14,6 +14,15 @@ SceneSetup default_scene(int tet_count) {
   SceneSetup setup;
   setup.mesh = generate_liver_mesh(tet_count).mesh;
   setup.model_options.fixed_nodes = setup.mesh.node_sets.at("ligament");
+  // The mesher's quality guards stop some boundary nodes short of the surface; the rendered
+  // surface sits on the smooth shape and follows the elements that hold it.
+  const LiverShape shape;
+  const BoundarySurface surface = extract_surface(setup.mesh);
+  std::vector<Eigen::Vector3d> on_shape;
+  on_shape.reserve(surface.nodes.size());
+  for (NodeIndex n : surface.nodes)
+    on_shape.push_back(shape.closest_surface_point(setup.mesh.rest_position_m.at(n)));
+  setup.visual = embed_visual_surface(setup.mesh, surface, on_shape);
   setup.description = "built-in liver, " + std::to_string(setup.mesh.tet_count()) + " tetrahedra";
   return setup;
 }
@@ -29,6 +38,7 @@ SceneSetup scene_from_file(const std::filesystem::path& file,
                                   file.string());
     setup.model_options.fixed_nodes = set->second;
   }
+  setup.visual = visual_surface_on_nodes(setup.mesh);
   setup.description =
       file.filename().string() + ", " + std::to_string(setup.mesh.tet_count()) + " tetrahedra";
   return setup;

@@ -22,6 +22,16 @@ Eigen::Vector3d ImplicitShape::gradient(const Eigen::Vector3d& p) const {
   return g;
 }
 
+Eigen::Vector3d ImplicitShape::closest_surface_point(Eigen::Vector3d p) const {
+  for (int it = 0; it < 6; ++it) {
+    const Eigen::Vector3d g = gradient(p);
+    const double g2 = g.squaredNorm();
+    if (g2 < 1e-24) break;
+    p -= value(p) * g / g2;
+  }
+  return p;
+}
+
 namespace {
 
 struct Lattice {
@@ -203,16 +213,6 @@ class GuardedMover {
   std::vector<std::vector<TetIndex>> incident_;
 };
 
-Eigen::Vector3d project_to_surface(const ImplicitShape& shape, Eigen::Vector3d p) {
-  for (int it = 0; it < 6; ++it) {
-    const Eigen::Vector3d g = shape.gradient(p);
-    const double g2 = g.squaredNorm();
-    if (g2 < 1e-24) break;
-    p -= shape.value(p) * g / g2;
-  }
-  return p;
-}
-
 std::vector<std::uint8_t> boundary_flags(const TetMesh& mesh) {
   std::vector<std::array<NodeIndex, 3>> faces;
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
@@ -276,36 +276,49 @@ ImplicitMeshResult mesh_implicit_shape(const ImplicitShape& shape,
   const auto on_boundary = boundary_flags(mesh);
   GuardedMover mover(mesh, options.min_dihedral_guard_deg,
                      options.min_height_guard * result.lattice_spacing_m);
-  for (int pass = 0; pass < options.projection_passes; ++pass)
-    for (std::size_t n = 0; n < mesh.node_count(); ++n)
-      if (on_boundary[n])
-        mover.move_toward(static_cast<NodeIndex>(n),
-                          project_to_surface(shape, mesh.rest_position_m.at(n)));
-
-  // Interior vertices: guarded Laplacian smoothing over edge neighbours.
+  // Edge neighbours: interior vertices smooth over all of them, boundary vertices over the
+  // boundary ones only (a tangential average, projected back onto the surface).
   std::vector<std::vector<NodeIndex>> neighbours(mesh.node_count());
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     const auto t = mesh.tet(e);
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b)
-        if (a != b) neighbours[t[a]].push_back(t[b]);
+        if (a != b && (!on_boundary[t[a]] || on_boundary[t[b]])) neighbours[t[a]].push_back(t[b]);
   }
   for (auto& list : neighbours) {
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
   }
-  for (int pass = 0; pass < options.smoothing_passes; ++pass)
-    for (std::size_t n = 0; n < mesh.node_count(); ++n) {
-      if (on_boundary[n]) continue;
-      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (auto m : neighbours[n]) mean += mesh.rest_position_m.at(m);
-      mover.smooth(static_cast<NodeIndex>(n), mean / static_cast<double>(neighbours[n].size()));
-    }
+  auto neighbour_mean = [&](std::size_t n) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (auto m : neighbours[n]) mean += mesh.rest_position_m.at(m);
+    return Eigen::Vector3d(mean / static_cast<double>(neighbours[n].size()));
+  };
+  // Alternate: pull the boundary onto the surface, then relax the interior so that vertices the
+  // guards held back get room on the next pass.
+  for (int pass = 0; pass < options.projection_passes; ++pass) {
+    for (std::size_t n = 0; n < mesh.node_count(); ++n)
+      if (on_boundary[n])
+        mover.move_toward(static_cast<NodeIndex>(n),
+                          shape.closest_surface_point(mesh.rest_position_m.at(n)));
+    for (std::size_t n = 0; n < mesh.node_count(); ++n)
+      if (on_boundary[n])
+        mover.move_toward(static_cast<NodeIndex>(n),
+                          shape.closest_surface_point(neighbour_mean(n)));
+    for (int smooth = 0; smooth < options.smoothing_passes; ++smooth)
+      for (std::size_t n = 0; n < mesh.node_count(); ++n)
+        if (!on_boundary[n]) mover.smooth(static_cast<NodeIndex>(n), neighbour_mean(n));
+  }
 
+  int boundary_count = 0;
   for (std::size_t n = 0; n < mesh.node_count(); ++n)
-    if (on_boundary[n])
-      result.max_surface_distance_m = std::max(result.max_surface_distance_m,
-                                               std::abs(shape.value(mesh.rest_position_m.at(n))));
+    if (on_boundary[n]) {
+      const double distance = std::abs(shape.value(mesh.rest_position_m.at(n)));
+      result.max_surface_distance_m = std::max(result.max_surface_distance_m, distance);
+      result.mean_surface_distance_m += distance;
+      ++boundary_count;
+    }
+  result.mean_surface_distance_m /= std::max(boundary_count, 1);
   return result;
 }
 

@@ -2,8 +2,12 @@
 
 #include <Eigen/Geometry>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <unordered_map>
 
 namespace liversim {
@@ -78,21 +82,86 @@ BoundarySurface extract_surface(const TetMesh& mesh) {
   return surface;
 }
 
-void compute_vertex_normals(const BoundarySurface& surface, const NodeArray& position,
-                            std::vector<float>& normals) {
-  normals.assign(3 * surface.nodes.size(), 0.0f);
-  auto at = [&](std::int32_t local) { return position.at(surface.nodes[local]); };
-  for (const auto& t : surface.triangles) {
+void compute_vertex_normals(const std::vector<std::array<std::int32_t, 3>>& triangles,
+                            const std::vector<double>& vertex_xyz, std::vector<float>& normals) {
+  normals.assign(vertex_xyz.size(), 0.0f);
+  auto at = [&](std::int32_t v) {
+    return Eigen::Vector3d(vertex_xyz[3 * v], vertex_xyz[3 * v + 1], vertex_xyz[3 * v + 2]);
+  };
+  for (const auto& t : triangles) {
     const Eigen::Vector3d p0 = at(t[0]);
     const Eigen::Vector3d n = (at(t[1]) - p0).cross(at(t[2]) - p0);  // length = 2 · area
     for (auto v : t)
       for (int k = 0; k < 3; ++k) normals[3 * v + k] += static_cast<float>(n[k]);
   }
-  for (std::size_t v = 0; v < surface.nodes.size(); ++v) {
+  for (std::size_t v = 0; v < normals.size() / 3; ++v) {
     float* n = &normals[3 * v];
     const float length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (length > 0.0f)
       for (int k = 0; k < 3; ++k) n[k] /= length;
+  }
+}
+
+VisualSurface visual_surface_on_nodes(const TetMesh& mesh) {
+  VisualSurface visual;
+  visual.surface = extract_surface(mesh);
+  for (NodeIndex n : visual.surface.nodes) {
+    visual.host_nodes.push_back({n, n, n, n});
+    visual.weights.push_back({1.0, 0.0, 0.0, 0.0});
+  }
+  return visual;
+}
+
+VisualSurface embed_visual_surface(const TetMesh& mesh, const BoundarySurface& surface,
+                                   const std::vector<Eigen::Vector3d>& vertex_rest_m) {
+  if (vertex_rest_m.size() != surface.nodes.size())
+    throw std::invalid_argument("embed_visual_surface: one rest position per surface node needed");
+  std::vector<std::vector<TetIndex>> incident(mesh.node_count());
+  for (std::size_t e = 0; e < mesh.tet_count(); ++e)
+    for (auto n : mesh.tet(e)) incident[n].push_back(static_cast<TetIndex>(e));
+
+  VisualSurface visual;
+  visual.surface = surface;
+  for (std::size_t v = 0; v < surface.nodes.size(); ++v) {
+    const Eigen::Vector3d& p = vertex_rest_m[v];
+    double best_min_weight = -std::numeric_limits<double>::infinity();
+    std::array<NodeIndex, 4> best_nodes{};
+    std::array<double, 4> best_weights{};
+    for (TetIndex e : incident[surface.nodes[v]]) {
+      const auto t = mesh.tet(e);
+      const Eigen::Vector3d x0 = mesh.rest_position_m.at(t[0]);
+      Eigen::Matrix3d edges;
+      for (int c = 1; c < 4; ++c) edges.col(c - 1) = mesh.rest_position_m.at(t[c]) - x0;
+      const Eigen::Vector3d local = edges.inverse() * (p - x0);
+      const std::array<double, 4> w{1.0 - local.sum(), local[0], local[1], local[2]};
+      const double min_weight = *std::min_element(w.begin(), w.end());
+      if (min_weight > best_min_weight) {
+        best_min_weight = min_weight;
+        best_nodes = t;
+        best_weights = w;
+      }
+    }
+    visual.host_nodes.push_back(best_nodes);
+    visual.weights.push_back(best_weights);
+  }
+  return visual;
+}
+
+void map_visual_positions(const VisualSurface& visual, const NodeArray& position,
+                          std::vector<double>& vertex_xyz) {
+  vertex_xyz.resize(3 * visual.vertex_count());
+  for (std::size_t v = 0; v < visual.vertex_count(); ++v) {
+    double x = 0.0, y = 0.0, z = 0.0;
+    for (int c = 0; c < 4; ++c) {
+      const auto n = visual.host_nodes[v][c];
+      const double w = visual.weights[v][c];
+      x += w * position.x[n];
+      y += w * position.y[n];
+      z += w * position.z[n];
+    }
+    vertex_xyz[3 * v] = x;
+    vertex_xyz[3 * v + 1] = y;
+    vertex_xyz[3 * v + 2] = z;
   }
 }
 

@@ -160,7 +160,7 @@ class RenderBaselineTest : public ::testing::Test {
   static fs::path render(const std::string& name,
                          const std::optional<NodeArray>& position = std::nullopt) {
     const SceneSetup setup = default_scene();
-    LiverScene scene(setup.mesh, extract_surface(setup.mesh));
+    LiverScene scene(setup.mesh, setup.visual);
     if (position) scene.update_positions(*position);
     const fs::path file = kOutputDir / (name + ".png");
     write_screenshot_png(scene, file, kWidth, kHeight);

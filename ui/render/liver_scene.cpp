@@ -4,6 +4,7 @@
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkCellPicker.h>
+#include <vtkErrorCode.h>
 #include <vtkFloatArray.h>
 #include <vtkLight.h>
 #include <vtkPNGWriter.h>
@@ -17,32 +18,32 @@
 #include <vtkSphereSource.h>
 #include <vtkWindowToImageFilter.h>
 
-#include <fstream>
+#include <cstdlib>
 #include <stdexcept>
 
 namespace liversim {
 namespace {
 
 // Liver parenchyma: a dark red-brown with a moist sheen.
-constexpr double kTissueColour[3] = {0.62, 0.22, 0.17};
+constexpr double kTissueColour[3] = {0.52, 0.17, 0.13};
 constexpr double kBackgroundTop[3] = {0.16, 0.18, 0.22};
 constexpr double kBackgroundBottom[3] = {0.05, 0.05, 0.07};
 
 }  // namespace
 
-LiverScene::LiverScene(const TetMesh& mesh, BoundarySurface surface)
-    : surface_(std::move(surface)) {
+LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual) : visual_(std::move(visual)) {
+  const BoundarySurface& surface = visual_.surface;
   points_->SetDataTypeToDouble();
-  points_->SetNumberOfPoints(static_cast<vtkIdType>(surface_.nodes.size()));
+  points_->SetNumberOfPoints(static_cast<vtkIdType>(surface.nodes.size()));
   vtkNew<vtkCellArray> triangles;
-  triangles->AllocateExact(static_cast<vtkIdType>(surface_.triangles.size()),
-                           static_cast<vtkIdType>(3 * surface_.triangles.size()));
-  for (const auto& t : surface_.triangles) {
+  triangles->AllocateExact(static_cast<vtkIdType>(surface.triangles.size()),
+                           static_cast<vtkIdType>(3 * surface.triangles.size()));
+  for (const auto& t : surface.triangles) {
     const vtkIdType ids[3] = {t[0], t[1], t[2]};
     triangles->InsertNextCell(3, ids);
   }
   normals_->SetNumberOfComponents(3);
-  normals_->SetNumberOfTuples(static_cast<vtkIdType>(surface_.nodes.size()));
+  normals_->SetNumberOfTuples(static_cast<vtkIdType>(surface.nodes.size()));
   normals_->SetName("Normals");
   polydata_->SetPoints(points_);
   polydata_->SetPolys(triangles);
@@ -103,11 +104,11 @@ vtkRenderer* LiverScene::renderer() const {
 }
 
 void LiverScene::update_positions(const NodeArray& position_m) {
-  for (std::size_t i = 0; i < surface_.nodes.size(); ++i) {
-    const auto n = surface_.nodes[i];
-    points_->SetPoint(static_cast<vtkIdType>(i), position_m.x[n], position_m.y[n], position_m.z[n]);
-  }
-  compute_vertex_normals(surface_, position_m, normal_scratch_);
+  map_visual_positions(visual_, position_m, vertex_xyz_);
+  for (std::size_t i = 0; i < visual_.vertex_count(); ++i)
+    points_->SetPoint(static_cast<vtkIdType>(i), vertex_xyz_[3 * i], vertex_xyz_[3 * i + 1],
+                      vertex_xyz_[3 * i + 2]);
+  compute_vertex_normals(visual_.surface.triangles, vertex_xyz_, normal_scratch_);
   std::copy(normal_scratch_.begin(), normal_scratch_.end(), normals_->GetPointer(0));
   points_->Modified();
   normals_->Modified();
@@ -135,8 +136,8 @@ std::optional<ScenePick> LiverScene::pick(int display_x, int display_y) const {
   double hit[3];
   picker_->GetPickPosition(hit);
   const Eigen::Vector3d point(hit[0], hit[1], hit[2]);
-  const auto& triangle = surface_.triangles[static_cast<std::size_t>(picker_->GetCellId())];
-  NodeIndex nearest = surface_.nodes[triangle[0]];
+  const auto& triangle = surface().triangles[static_cast<std::size_t>(picker_->GetCellId())];
+  NodeIndex nearest = surface().nodes[triangle[0]];
   double best = std::numeric_limits<double>::infinity();
   for (auto local : triangle) {
     double p[3];
@@ -144,7 +145,7 @@ std::optional<ScenePick> LiverScene::pick(int display_x, int display_y) const {
     const double d = (Eigen::Vector3d(p[0], p[1], p[2]) - point).squaredNorm();
     if (d < best) {
       best = d;
-      nearest = surface_.nodes[local];
+      nearest = surface().nodes[local];
     }
   }
   return ScenePick{point, nearest};
@@ -171,10 +172,18 @@ Eigen::Vector2d LiverScene::world_to_display(const Eigen::Vector3d& point_m) con
 
 void write_screenshot_png(LiverScene& scene, const std::filesystem::path& file, int width,
                           int height) {
-  {
-    std::ofstream probe(file, std::ios::binary);  // fail early, with the path, if unwritable
-    if (!probe) throw std::runtime_error("cannot write the screenshot to " + file.string());
-  }
+  // VTK aborts the process when it cannot open the X display, so say it first.
+  const char* display = std::getenv("DISPLAY");
+  if (display == nullptr || *display == '\0')
+    throw std::runtime_error(
+        "cannot render " + file.string() +
+        ": no X display (DISPLAY is unset); run the command inside xvfb-run -a");
+  const std::filesystem::path folder =
+      file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(folder))
+    throw std::runtime_error("cannot write " + file.string() + ": folder " + folder.string() +
+                             " does not exist");
+
   vtkNew<vtkRenderWindow> window;
   window->SetOffScreenRendering(1);
   window->SetSize(width, height);
@@ -187,13 +196,17 @@ void write_screenshot_png(LiverScene& scene, const std::filesystem::path& file, 
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
   grab->Update();
+  window->RemoveRenderer(scene.renderer());
   vtkNew<vtkPNGWriter> writer;
   writer->SetFileName(file.string().c_str());
   writer->SetInputConnection(grab->GetOutputPort());
   writer->Write();
-  window->RemoveRenderer(scene.renderer());
-  if (writer->GetErrorCode() != 0)
-    throw std::runtime_error("writing the screenshot to " + file.string() + " failed");
+  if (writer->GetErrorCode() != 0) {
+    std::error_code ignored;
+    std::filesystem::remove(file, ignored);
+    throw std::runtime_error("writing the screenshot to " + file.string() + " failed (" +
+                             vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
+  }
 }
 
 }  // namespace liversim

@@ -30,13 +30,14 @@ struct ScenePick {
 
 class LiverScene {
  public:
-  LiverScene(const TetMesh& mesh, BoundarySurface surface);
+  // Shows `visual` (its rest shape when given the mesh's rest positions).
+  LiverScene(const TetMesh& mesh, VisualSurface visual);
   ~LiverScene();
   LiverScene(const LiverScene&) = delete;
   LiverScene& operator=(const LiverScene&) = delete;
 
   vtkRenderer* renderer() const;
-  const BoundarySurface& surface() const { return surface_; }
+  const BoundarySurface& surface() const { return visual_.surface; }
 
   // Moves the surface to these node positions (all mesh nodes). Allocates nothing after the first.
   void update_positions(const NodeArray& position_m);
@@ -53,7 +54,7 @@ class LiverScene {
   Eigen::Vector2d world_to_display(const Eigen::Vector3d& point_m) const;
 
  private:
-  BoundarySurface surface_;
+  VisualSurface visual_;
   vtkNew<vtkRenderer> renderer_;
   vtkNew<vtkPoints> points_;
   vtkNew<vtkFloatArray> normals_;
@@ -61,12 +62,14 @@ class LiverScene {
   vtkNew<vtkActor> liver_actor_;
   vtkNew<vtkActor> grab_marker_;
   vtkNew<vtkCellPicker> picker_;
+  std::vector<double> vertex_xyz_;
   std::vector<float> normal_scratch_;
 };
 
 // Renders the scene offscreen at the given size and writes a PNG. Needs an X display (Debian's VTK
-// has no EGL or OSMesa): under no display, run it inside xvfb-run. Throws std::runtime_error when
-// the file cannot be written.
+// has no EGL or OSMesa): under no display, run it inside xvfb-run. Throws std::runtime_error naming
+// the problem when there is no display or the file cannot be written (no partial file is left).
+// The scene's renderer is borrowed for the render, so the scene must not be on screen elsewhere.
 void write_screenshot_png(LiverScene& scene, const std::filesystem::path& file, int width,
                           int height);
 

@@ -5,6 +5,7 @@
 
 #include "liversim/core/liver_geometry.h"
 #include "liversim/core/model.h"
+#include "liversim/core/surface.h"
 
 #include <filesystem>
 #include <optional>
@@ -15,6 +16,7 @@ namespace liversim {
 struct SceneSetup {
   TetMesh mesh;
   ModelOptions model_options;
+  VisualSurface visual;     // what is rendered: on the smooth organ surface when it is known
   std::string description;  // e.g. "built-in liver, 5450 tetrahedra"
 };
 

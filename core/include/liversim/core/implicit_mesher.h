@@ -17,6 +17,8 @@ class ImplicitShape {
   virtual double value(const Eigen::Vector3d& p) const = 0;
   virtual Eigen::AlignedBox3d bounds() const = 0;            // contains the whole solid
   Eigen::Vector3d gradient(const Eigen::Vector3d& p) const;  // central differences
+  // The surface point nearest to p, by Newton steps along the gradient.
+  Eigen::Vector3d closest_surface_point(Eigen::Vector3d p) const;
 };
 
 struct ImplicitMeshOptions {
@@ -35,7 +37,8 @@ struct ImplicitMeshResult {
   TetMesh mesh;
   double lattice_spacing_m = 0.0;
   int search_iterations = 0;
-  double max_surface_distance_m = 0.0;  // largest |value| left at a boundary vertex
+  double max_surface_distance_m = 0.0;   // largest |value| left at a boundary vertex
+  double mean_surface_distance_m = 0.0;  // mean |value| over boundary vertices
 };
 
 // Throws std::runtime_error when no lattice spacing gives a count within 3 % of the target.
