@@ -8,34 +8,70 @@
 #include <QCommandLineParser>
 #include <QMessageBox>
 
+#include <cstdlib>
 #include <exception>
+#include <iostream>
+
+namespace {
+
+struct Options {
+  int tet_count = liversim::kDefaultLiverTetCount;
+};
+
+// Parsed under a plain QCoreApplication, so --help, --version and bad options work without a
+// display. Exits the process for --help, --version and errors, as QCommandLineParser does.
+Options parse_options(int argc, char** argv) {
+  QCoreApplication app(argc, argv);
+  QCoreApplication::setApplicationName("liversim");
+  QCoreApplication::setApplicationVersion(LIVERSIM_VERSION);
+  QCommandLineParser parser;
+  parser.setApplicationDescription(
+      QCoreApplication::translate("main",
+                                  "LiverSim: real-time finite-element liver surgery "
+                                  "training workstation"));
+  parser.addHelpOption();
+  parser.addVersionOption();
+  const QCommandLineOption tets(
+      "tets", QCoreApplication::translate("main", "Element count of the liver (100 to 2000000)."),
+      "count", QString::number(liversim::kDefaultLiverTetCount));
+  parser.addOption(tets);
+  parser.process(app);
+
+  Options options;
+  bool ok = false;
+  options.tet_count = parser.value(tets).toInt(&ok);
+  if (!ok || options.tet_count < 100 || options.tet_count > 2'000'000) {
+    std::cerr << "liversim: --tets must be a whole number from 100 to 2000000, not '"
+              << parser.value(tets).toStdString() << "'\n";
+    std::exit(2);
+  }
+  return options;
+}
+
+bool has_display() {
+  for (const char* variable : {"DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM"}) {
+    const char* value = std::getenv(variable);
+    if (value != nullptr && *value != '\0') return true;
+  }
+  return false;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
+  const Options options = parse_options(argc, argv);
+  if (!has_display()) {
+    std::cerr << "liversim: no display found (DISPLAY and WAYLAND_DISPLAY are unset). Run it on a "
+                 "desktop, or try the headless demo: xvfb-run -a liversim-cli demo\n";
+    return 2;
+  }
   liversim::VtkViewport::setDefaultSurfaceFormat();  // before QApplication, for every GL context
   QApplication app(argc, argv);
   QApplication::setApplicationName("LiverSim");
   QApplication::setOrganizationName("LiverSim");
   QApplication::setApplicationVersion(LIVERSIM_VERSION);
-
-  QCommandLineParser parser;
-  parser.setApplicationDescription(
-      QApplication::translate("main", "Real-time finite-element liver surgery simulator"));
-  parser.addHelpOption();
-  parser.addVersionOption();
-  QCommandLineOption tets("tets", QApplication::translate("main", "Element count of the liver."),
-                          "count", QString::number(liversim::kDefaultLiverTetCount));
-  parser.addOption(tets);
-  parser.process(app);
-
-  bool ok = false;
-  const int tet_count = parser.value(tets).toInt(&ok);
-  if (!ok || tet_count < 100 || tet_count > 2'000'000) {
-    qCritical("liversim: --tets must be a whole number from 100 to 2000000, not '%s'",
-              qPrintable(parser.value(tets)));
-    return 2;
-  }
   try {
-    liversim::MainWindow window(liversim::default_scene(tet_count));
+    liversim::MainWindow window(liversim::default_scene(options.tet_count));
     window.show();
     return QApplication::exec();
   } catch (const std::exception& e) {

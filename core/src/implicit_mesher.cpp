@@ -1,6 +1,7 @@
 #include "liversim/core/implicit_mesher.h"
 
 #include "liversim/core/mesh_quality.h"
+#include "liversim/core/surface.h"
 
 #include <algorithm>
 #include <cmath>
@@ -214,26 +215,8 @@ class GuardedMover {
 };
 
 std::vector<std::uint8_t> boundary_flags(const TetMesh& mesh) {
-  std::vector<std::array<NodeIndex, 3>> faces;
-  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
-    const auto t = mesh.tet(e);
-    for (int skip = 0; skip < 4; ++skip) {
-      std::array<NodeIndex, 3> f;
-      for (int c = 0, m = 0; c < 4; ++c)
-        if (c != skip) f[m++] = t[c];
-      std::sort(f.begin(), f.end());
-      faces.push_back(f);
-    }
-  }
-  std::sort(faces.begin(), faces.end());
   std::vector<std::uint8_t> on_boundary(mesh.node_count(), 0);
-  for (std::size_t i = 0; i < faces.size();) {
-    std::size_t j = i;
-    while (j < faces.size() && faces[j] == faces[i]) ++j;
-    if (j - i == 1)
-      for (auto n : faces[i]) on_boundary[n] = 1;
-    i = j;
-  }
+  for (NodeIndex n : extract_surface(mesh).nodes) on_boundary[n] = 1;
   return on_boundary;
 }
 
