@@ -70,8 +70,9 @@ int mesh_report(const MeshSource& mesh) {
               << model.max_frequency_rad_per_s << " rad/s; explicit central-difference step "
               << std::setprecision(3) << model.stable_time_step_s * 1e3 << " ms ("
               << std::setprecision(2) << model.stable_step_safety
-              << " x 2/omega, E = " << std::setprecision(0) << model.material.youngs_modulus_pa
-              << " Pa, nu = " << std::setprecision(3) << model.material.poisson_ratio << ")\n";
+              << " x 2/omega, E = " << std::setprecision(0)
+              << model.regions[0].tissue.youngs_modulus_pa << " Pa, nu = " << std::setprecision(3)
+              << model.regions[0].tissue.poisson_ratio << ")\n";
     return 0;
   });
 }

@@ -31,20 +31,38 @@ Eigen::Matrix3d deformation_gradient(const SimModel& model, const NodeArray& pos
   return deformed_edges(model, position, e) * dm_inverse_of(model, e);
 }
 
-VolumeRatioRange compute_elastic_forces(const SimModel& model, const NodeArray& position,
-                                        std::array<NodeArray, 4>& corner_scratch,
-                                        NodeArray& force) {
-  const std::size_t tets = model.tet_count;
-  VolumeRatioRange range{std::numeric_limits<double>::infinity(),
-                         -std::numeric_limits<double>::infinity()};
-  for (std::size_t e = 0; e < tets; ++e) {
+namespace {
+
+template <bool kFibres>
+Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F,
+                          ElasticEvaluation& seen) {
+  Eigen::Matrix3d P =
+      neo_hookean::first_piola_stress(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+  if constexpr (kFibres) {
+    const FibreParameters& fibres = model.fibre_parameters[e];
+    for (const auto& family : model.fibre_direction) {
+      const Eigen::Vector3d& a = family[e];
+      P += hgo::first_piola_stress(F, a, fibres);
+      seen.max_fibre_modulus_pa =
+          std::max(seen.max_fibre_modulus_pa, hgo::tangent_modulus_pa(F, a, fibres));
+    }
+  }
+  return P;
+}
+
+// One element loop per effect set, chosen once per evaluation rather than tested per element.
+template <bool kFibres>
+ElasticEvaluation element_forces(const SimModel& model, const NodeArray& position,
+                                 std::array<NodeArray, 4>& corner_scratch) {
+  ElasticEvaluation seen{std::numeric_limits<double>::infinity(),
+                         -std::numeric_limits<double>::infinity(), 0.0};
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
     const Eigen::Matrix3d dm_inv = dm_inverse_of(model, e);
     const Eigen::Matrix3d F = deformed_edges(model, position, e) * dm_inv;
     const double J = F.determinant();
-    range.min = std::min(range.min, J);
-    range.max = std::max(range.max, J);
-    const Eigen::Matrix3d P =
-        neo_hookean::first_piola_stress(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+    seen.min_volume_ratio = std::min(seen.min_volume_ratio, J);
+    seen.max_volume_ratio = std::max(seen.max_volume_ratio, J);
+    const Eigen::Matrix3d P = stress_of<kFibres>(model, e, F, seen);
     // Nodal forces of corners 1..3 are the columns of −V·P·Dm⁻ᵀ; corner 0 balances them.
     const Eigen::Matrix3d h = -model.rest_volume_m3[e] * P * dm_inv.transpose();
     const Eigen::Vector3d h0 = -(h.col(0) + h.col(1) + h.col(2));
@@ -57,6 +75,33 @@ VolumeRatioRange compute_elastic_forces(const SimModel& model, const NodeArray& 
       corner_scratch[c].z[e] = h(2, c - 1);
     }
   }
+  return seen;
+}
+
+}  // namespace
+
+double element_energy_density(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F) {
+  double psi = neo_hookean::energy_density(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+  if (model.effects.fibres)
+    for (const auto& family : model.fibre_direction)
+      psi += hgo::energy_density(F, family[e], model.fibre_parameters[e]);
+  return psi;
+}
+
+Eigen::Matrix3d element_first_piola_stress(const SimModel& model, std::size_t e,
+                                           const Eigen::Matrix3d& F) {
+  ElasticEvaluation ignored;
+  return model.effects.fibres ? stress_of<true>(model, e, F, ignored)
+                              : stress_of<false>(model, e, F, ignored);
+}
+
+ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray& position,
+                                         std::array<NodeArray, 4>& corner_scratch,
+                                         NodeArray& force) {
+  const std::size_t tets = model.tet_count;
+  const ElasticEvaluation seen = model.effects.fibres
+                                     ? element_forces<true>(model, position, corner_scratch)
+                                     : element_forces<false>(model, position, corner_scratch);
   // Gather per node: each node sums its own corner slots, so no two writers share a node.
   for (std::size_t n = 0; n < model.node_count; ++n) {
     double fx = 0.0, fy = 0.0, fz = 0.0;
@@ -72,7 +117,7 @@ VolumeRatioRange compute_elastic_forces(const SimModel& model, const NodeArray& 
     force.y[n] = fy;
     force.z[n] = fz;
   }
-  return range;
+  return seen;
 }
 
 void add_external_forces(const StepInputs& inputs, const NodeArray& position, NodeArray& force) {
@@ -91,11 +136,9 @@ void add_external_forces(const StepInputs& inputs, const NodeArray& position, No
 
 double strain_energy_j(const SimModel& model, const NodeArray& position) {
   double energy = 0.0;
-  for (std::size_t e = 0; e < model.tet_count; ++e) {
+  for (std::size_t e = 0; e < model.tet_count; ++e)
     energy += model.rest_volume_m3[e] *
-              neo_hookean::energy_density(deformation_gradient(model, position, e),
-                                          model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
-  }
+              element_energy_density(model, e, deformation_gradient(model, position, e));
   return energy;
 }
 

@@ -8,14 +8,15 @@
 namespace liversim {
 namespace {
 
-VolumeRatioRange evaluate_forces(const SimModel& model, SimState& state, const StepInputs& inputs) {
-  const VolumeRatioRange range =
+ElasticEvaluation evaluate_forces(const SimModel& model, SimState& state,
+                                  const StepInputs& inputs) {
+  const ElasticEvaluation seen =
       compute_elastic_forces(model, state.position_m, state.corner_force_n, state.force_n);
   add_external_forces(inputs, state.position_m, state.force_n);
   for (const auto& spring : inputs.springs)
     state.spring_damping_per_s[spring.node] +=
         spring.damping_n_s_per_m * model.inverse_mass_per_kg[spring.node];
-  return range;
+  return seen;
 }
 
 // Leapfrog kick and drift with the forces in state.force_n. Damping (mass-proportional α plus
@@ -67,11 +68,22 @@ double stable_time_step_s(const SimModel& model, const StepInputs& inputs, doubl
   return model.stable_step_safety * (2.0 / omega) * (std::sqrt(1.0 + xi * xi) - xi);
 }
 
-VolumeRatioRange central_difference_step(const SimModel& model, SimState& state,
-                                         const StepInputs& inputs, double dt_s) {
-  const VolumeRatioRange range = evaluate_forces(model, state, inputs);
+ElasticEvaluation central_difference_step(const SimModel& model, SimState& state,
+                                          const StepInputs& inputs, double dt_s) {
+  const ElasticEvaluation seen = evaluate_forces(model, state, inputs);
   kick_drift(model, state, inputs, dt_s);
-  return range;
+  return seen;
+}
+
+double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& seen) {
+  double stiffening = 1.0;
+  for (const RegionMaterial& region : model.regions) {
+    const double mu = region.tissue.shear_modulus_pa(), lambda = region.tissue.lame_lambda_pa();
+    stiffening =
+        std::max(stiffening, neo_hookean::volumetric_stiffening(seen.min_volume_ratio, mu, lambda));
+    stiffening = std::max(stiffening, 1.0 + seen.max_fibre_modulus_pa / (lambda + 2.0 * mu));
+  }
+  return stiffening;
 }
 
 StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
@@ -82,9 +94,7 @@ StepReport advance(const SimModel& model, SimState& state, const StepInputs& inp
   const double end_time = state.time_s + interval_s;
   double remaining = interval_s;
   while (remaining > 0.0) {
-    const VolumeRatioRange range = evaluate_forces(model, state, inputs);
-    const double stiffening = neo_hookean::volumetric_stiffening(
-        range.min, model.material.shear_modulus_pa(), model.material.lame_lambda_pa());
+    const double stiffening = stiffening_since_rest(model, evaluate_forces(model, state, inputs));
     report.max_stiffening = std::max(report.max_stiffening, stiffening);
     double limit = stable_time_step_s(model, inputs, stiffening);
     if (state.max_speed_m_per_s > 0.0)

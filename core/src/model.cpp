@@ -28,8 +28,47 @@ void build_incidence(SimModel& model) {
 
 }  // namespace
 
+namespace {
+
+std::string region_name(std::size_t r) {
+  return r == 0 ? "region 0 (parenchyma)" : "region " + std::to_string(r);
+}
+
+void validate_regions(const std::vector<RegionMaterial>& regions) {
+  if (regions.empty()) throw std::invalid_argument("no region materials given");
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    if (auto problem = validate(regions[r].tissue))
+      throw std::invalid_argument(region_name(r) + ": " + *problem);
+    if (regions[r].fibres)
+      if (auto problem = validate(*regions[r].fibres))
+        throw std::invalid_argument(region_name(r) + ": " + *problem);
+  }
+}
+
+// Per-element unit directions of one family from a field that is empty, uniform or per element.
+std::vector<Eigen::Vector3d> fibre_directions(const std::vector<Eigen::Vector3d>& field,
+                                              std::size_t tets, const char* family) {
+  if (field.empty()) return std::vector<Eigen::Vector3d>(tets, Eigen::Vector3d::Zero());
+  if (field.size() != 1 && field.size() != tets)
+    throw std::invalid_argument(std::string(family) + " fibre field has " +
+                                std::to_string(field.size()) + " directions; expected 1 or " +
+                                std::to_string(tets) + " (one per element)");
+  std::vector<Eigen::Vector3d> directions(tets);
+  for (std::size_t e = 0; e < tets; ++e) {
+    const Eigen::Vector3d& a = field[field.size() == 1 ? 0 : e];
+    if (!a.allFinite() || a.norm() < 1e-12)
+      throw std::invalid_argument(std::string(family) + " fibre direction of element " +
+                                  std::to_string(field.size() == 1 ? 0 : e) +
+                                  " is zero or not a number");
+    directions[e] = a.normalized();
+  }
+  return directions;
+}
+
+}  // namespace
+
 SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
-  if (auto problem = validate(options.material)) throw std::invalid_argument(*problem);
+  validate_regions(options.regions);
   if (mesh.tet_count() == 0) throw std::invalid_argument("the mesh has no tetrahedra");
   if (!(options.mass_damping_per_s >= 0.0) || !std::isfinite(options.mass_damping_per_s))
     throw std::invalid_argument("mass damping must be a finite value >= 0 (1/s)");
@@ -41,18 +80,29 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   model.tet_count = mesh.tet_count();
   model.corner = mesh.corner;
   model.rest_position_m = mesh.rest_position_m;
-  model.material = options.material;
+  model.regions = options.regions;
   model.mass_damping_per_s = options.mass_damping_per_s;
   model.stable_step_safety = options.stable_step_safety;
 
   const std::size_t tets = model.tet_count;
   for (auto& entry : model.dm_inverse) entry.resize(tets);
   model.rest_volume_m3.resize(tets);
-  model.shear_modulus_pa.assign(tets, options.material.shear_modulus_pa());
-  model.lame_lambda_pa.assign(tets, options.material.lame_lambda_pa());
+  model.shear_modulus_pa.resize(tets);
+  model.lame_lambda_pa.resize(tets);
+  model.region.assign(tets, 0);
   model.lumped_mass_kg.assign(model.node_count, 0.0);
 
   for (std::size_t e = 0; e < tets; ++e) {
+    const auto region = e < mesh.region.size() ? mesh.region[e] : 0;
+    if (region < 0 || static_cast<std::size_t>(region) >= options.regions.size())
+      throw std::invalid_argument("element " + std::to_string(e) + " is in region " +
+                                  std::to_string(region) + ", which has no material (" +
+                                  std::to_string(options.regions.size()) + " regions given)");
+    model.region[e] = region;
+    const TissueMaterial& tissue = options.regions[region].tissue;
+    model.shear_modulus_pa[e] = tissue.shear_modulus_pa();
+    model.lame_lambda_pa[e] = tissue.lame_lambda_pa();
+
     const auto nodes = mesh.tet(e);
     for (auto n : nodes) {
       if (n < 0 || static_cast<std::size_t>(n) >= model.node_count)
@@ -71,8 +121,21 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
     const Eigen::Matrix3d inv = dm.inverse();
     for (int k = 0; k < 9; ++k) model.dm_inverse[k][e] = inv(k / 3, k % 3);
     model.rest_volume_m3[e] = volume;
-    const double corner_mass = options.material.density_kg_per_m3 * volume / 4.0;
+    const double corner_mass = tissue.density_kg_per_m3 * volume / 4.0;
     for (auto n : nodes) model.lumped_mass_kg[n] += corner_mass;
+  }
+
+  for (const auto& region : options.regions)
+    model.effects.fibres |= region.fibres.has_value() && region.fibres->k1_pa > 0.0;
+  if (model.effects.fibres) {
+    if (options.fibre_field.first_family.empty())
+      throw std::invalid_argument("a region has fibres but the fibre field gives no direction");
+    model.fibre_direction[0] = fibre_directions(options.fibre_field.first_family, tets, "first");
+    model.fibre_direction[1] = fibre_directions(options.fibre_field.second_family, tets, "second");
+    model.fibre_parameters.resize(tets);
+    for (std::size_t e = 0; e < tets; ++e)
+      model.fibre_parameters[e] =
+          options.regions[model.region[e]].fibres.value_or(FibreParameters{});
   }
 
   model.is_fixed.assign(model.node_count, 0);

@@ -2,6 +2,8 @@
 // Test meshes: a box of nx × ny × nz cubes, each split into six tetrahedra around its main diagonal
 // (conforming across cubes), with optional jitter of the interior nodes.
 
+#include "liversim/core/forces.h"
+#include "liversim/core/surface.h"
 #include "liversim/core/tet_mesh.h"
 
 #include <random>
@@ -48,6 +50,23 @@ inline TetMesh block_mesh(int nx, int ny, int nz, const Eigen::Vector3d& size_m,
           mesh.add_tet(tet);
         }
   return mesh;
+}
+
+// Consistent nodal loads of a uniform normal traction σ (Pa, positive pulling outward) on the
+// faces of a box mesh that are perpendicular to the x axis: each boundary triangle hands a third of
+// σ·area to each of its corners.
+inline std::vector<PointLoad> end_face_tension(const TetMesh& mesh, double sigma_pa) {
+  std::vector<PointLoad> loads;
+  const BoundarySurface surface = extract_surface(mesh);
+  for (const auto& t : surface.triangles) {
+    const Eigen::Vector3d a = mesh.rest_position_m.at(surface.nodes[t[0]]);
+    const Eigen::Vector3d b = mesh.rest_position_m.at(surface.nodes[t[1]]);
+    const Eigen::Vector3d c = mesh.rest_position_m.at(surface.nodes[t[2]]);
+    const Eigen::Vector3d area_normal = 0.5 * (b - a).cross(c - a);
+    if (std::abs(std::abs(area_normal.normalized().x()) - 1.0) > 1e-12) continue;  // not an end
+    for (auto v : t) loads.push_back({surface.nodes[v], sigma_pa * area_normal / 3.0});
+  }
+  return loads;
 }
 
 }  // namespace liversim::testing

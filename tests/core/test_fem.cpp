@@ -75,9 +75,14 @@ TEST(NeoHookean, InvalidMaterialIsNamed) {
   ASSERT_TRUE(message.has_value());
   EXPECT_NE(message->find("Young"), std::string::npos);
   EXPECT_FALSE(validate(TissueMaterial{}).has_value());
-  EXPECT_THROW(build_model(block_mesh(1, 1, 1, {0.01, 0.01, 0.01}),
-                           ModelOptions{TissueMaterial{-1.0, 0.3, 1000.0}}),
-               std::invalid_argument);
+  ModelOptions bad;
+  bad.regions[0].tissue.youngs_modulus_pa = -1.0;
+  try {
+    build_model(block_mesh(1, 1, 1, {0.01, 0.01, 0.01}), bad);
+    ADD_FAILURE() << "a negative modulus was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("region 0"), std::string::npos) << e.what();
+  }
 }
 
 // ---------------------------------------------------------------- patch tests
@@ -112,7 +117,7 @@ TEST(PatchTest, InteriorRelaxesToTheAffineFieldWhenTheBoundaryIsPrescribed) {
   Eigen::Matrix3d A;
   A << 1.05, 0.02, 0.0, 0.0, 0.97, 0.03, 0.01, 0.0, 1.02;
   ModelOptions options;
-  options.material.poisson_ratio = 0.3;
+  options.regions[0].tissue.poisson_ratio = 0.3;
   options.mass_damping_per_s = 60.0;
   std::vector<Eigen::Vector3d> expected(mesh.node_count());
   std::mt19937 random(11);
@@ -148,20 +153,11 @@ TEST(StaticBlock, UniaxialTensionMatchesSmallStrainElasticity) {
   const double length = 0.1, width = 0.02, sigma = 1.0;
   const TetMesh mesh = block_mesh(10, 2, 2, {length, width, width}, 0.15);
   ModelOptions options;
-  options.material = TissueMaterial{3500.0, 0.45, 1060.0};
+  options.regions[0].tissue = TissueMaterial{3500.0, 0.45, 1060.0};
   options.mass_damping_per_s = 120.0;
   const SimModel model = build_model(mesh, options);
 
-  std::vector<PointLoad> loads;
-  const BoundarySurface surface = extract_surface(mesh);
-  for (const auto& t : surface.triangles) {
-    const Eigen::Vector3d a = mesh.rest_position_m.at(surface.nodes[t[0]]);
-    const Eigen::Vector3d b = mesh.rest_position_m.at(surface.nodes[t[1]]);
-    const Eigen::Vector3d c = mesh.rest_position_m.at(surface.nodes[t[2]]);
-    const Eigen::Vector3d area_normal = 0.5 * (b - a).cross(c - a);
-    if (std::abs(std::abs(area_normal.normalized().x()) - 1.0) > 1e-12) continue;  // not an end
-    for (auto v : t) loads.push_back({surface.nodes[v], sigma * area_normal / 3.0});
-  }
+  const std::vector<PointLoad> loads = testing::end_face_tension(mesh, sigma);
   SimState state = make_rest_state(model);
   const StepInputs inputs{loads, {}};
   // The free bar under dead loads keeps one soft mode, a slow rigid rotation that the loads
@@ -176,7 +172,7 @@ TEST(StaticBlock, UniaxialTensionMatchesSmallStrainElasticity) {
   }
   ASSERT_LT(residual, 1e-6);
 
-  const double strain = sigma / options.material.youngs_modulus_pa;
+  const double strain = sigma / options.regions[0].tissue.youngs_modulus_pa;
   auto mean_coordinate = [&](int axis, double rest_value) {
     double sum = 0;
     int count = 0;
@@ -190,7 +186,7 @@ TEST(StaticBlock, UniaxialTensionMatchesSmallStrainElasticity) {
   const double elongation = mean_coordinate(0, length) - mean_coordinate(0, 0.0);
   const double thinning = mean_coordinate(1, width) - mean_coordinate(1, 0.0);
   EXPECT_NEAR(elongation / length - 1.0, strain, 5 * strain * strain);
-  EXPECT_NEAR(thinning / width - 1.0, -options.material.poisson_ratio * strain,
+  EXPECT_NEAR(thinning / width - 1.0, -options.regions[0].tissue.poisson_ratio * strain,
               5 * strain * strain);
 }
 

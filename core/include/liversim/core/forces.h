@@ -29,17 +29,26 @@ struct StepInputs {
   std::span<const NodeSpring> springs;
 };
 
-// Extremes of the element volume ratio J = det F seen in a force evaluation: compression stiffens
-// the volumetric response, which shortens the stable explicit step.
-struct VolumeRatioRange {
-  double min = 1.0;
-  double max = 1.0;
+// What a force evaluation saw that bears on the stable explicit step: the extremes of the element
+// volume ratio J = det F (compression stiffens the volumetric response) and the largest fibre
+// tangent stiffness (stretched fibres stiffen exponentially).
+struct ElasticEvaluation {
+  double min_volume_ratio = 1.0;
+  double max_volume_ratio = 1.0;
+  double max_fibre_modulus_pa = 0.0;
 };
 
 // Writes the elastic (internal) nodal forces at `position` into `force`, using `corner_scratch`
-// for per-element values. Allocates nothing.
-VolumeRatioRange compute_elastic_forces(const SimModel& model, const NodeArray& position,
-                                        std::array<NodeArray, 4>& corner_scratch, NodeArray& force);
+// for per-element values. The element kernel is the one for the model's effect set. Allocates
+// nothing.
+ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray& position,
+                                         std::array<NodeArray, 4>& corner_scratch,
+                                         NodeArray& force);
+
+// Strain energy density and first Piola–Kirchhoff stress of element e at deformation F.
+double element_energy_density(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F);
+Eigen::Matrix3d element_first_piola_stress(const SimModel& model, std::size_t e,
+                                           const Eigen::Matrix3d& F);
 
 // Adds point loads and spring forces at `position` to `force` (spring damping is applied by the
 // integrator).

@@ -14,7 +14,8 @@ struct StepReport {
 };
 
 // Stable explicit step for the model with these inputs: springs raise the highest frequency
-// (Weyl: ω² ≤ ω²_max·s + max k/m, with s the volumetric stiffening of compressed elements),
+// (Weyl: ω² ≤ ω²_max·s + max k/m, with s the stiffening of compressed elements and stretched
+// fibres relative to rest, see stiffening_since_rest),
 // damping lowers the limit to (2/ω)(√(1+ξ²) − ξ), ξ = α/(2ω).
 double stable_time_step_s(const SimModel& model, const StepInputs& inputs, double stiffening = 1.0);
 
@@ -23,10 +24,10 @@ double stable_time_step_s(const SimModel& model, const StepInputs& inputs, doubl
 StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
                    double interval_s);
 
-// One central-difference step of length dt_s (the caller guarantees stability). Returns the
-// volume ratio range of the configuration the step started from.
-VolumeRatioRange central_difference_step(const SimModel& model, SimState& state,
-                                         const StepInputs& inputs, double dt_s);
+// One central-difference step of length dt_s (the caller guarantees stability). Returns what the
+// force evaluation of the configuration the step started from saw.
+ElasticEvaluation central_difference_step(const SimModel& model, SimState& state,
+                                          const StepInputs& inputs, double dt_s);
 
 // Largest eigenvalue of M⁻¹K (free nodes) at `position`, as an angular frequency, by power
 // iteration on M^(-1/2) K M^(-1/2) with K·v from central differences of the elastic force.

@@ -3,17 +3,42 @@
 // changes while simulating lives in SimState (state.h); stepping reads the model and never writes
 // it.
 
+#include "liversim/core/fibres.h"
 #include "liversim/core/material.h"
 #include "liversim/core/tet_mesh.h"
 
+#include <Eigen/Core>
+
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace liversim {
 
+// What one region of the organ is made of: the parenchyma (region 0) or a lesion.
+struct RegionMaterial {
+  TissueMaterial tissue;
+  std::optional<FibreParameters> fibres;  // none: isotropic
+};
+
+// Reference fibre directions (normalised when the model is built): empty for no family, one vector
+// for a uniform direction, or one per element.
+struct FibreField {
+  std::vector<Eigen::Vector3d> first_family;
+  std::vector<Eigen::Vector3d> second_family;
+};
+
+// Effects the model computes; the element kernel is chosen from these once, and an effect that is
+// off costs nothing in the step.
+struct EffectSet {
+  bool fibres = false;
+};
+
 struct ModelOptions {
-  TissueMaterial material;
+  // Region r of the mesh (TetMesh::region) is made of regions[r]; region 0 is the parenchyma.
+  std::vector<RegionMaterial> regions{RegionMaterial{}};
+  FibreField fibre_field;
   std::vector<NodeIndex> fixed_nodes;  // held at their rest position (e.g. ligament attachment)
   double mass_damping_per_s = 8.0;     // Rayleigh mass-proportional damping coefficient α
   double stable_step_safety = 0.8;     // fraction of the central-difference limit actually used
@@ -29,6 +54,13 @@ struct SimModel {
   std::vector<double> rest_volume_m3;
   std::vector<double> shear_modulus_pa;  // μ per element
   std::vector<double> lame_lambda_pa;    // λ per element
+  std::vector<std::int32_t> region;      // region per element
+  std::vector<RegionMaterial> regions;
+  EffectSet effects;
+  // Fibre data per element, allocated only when effects.fibres: HGO parameters (k1 = 0 where the
+  // region has none) and the unit reference direction of each family (zero vector: no family).
+  std::vector<FibreParameters> fibre_parameters;
+  std::array<std::vector<Eigen::Vector3d>, 2> fibre_direction;
   NodeArray rest_position_m;
   std::vector<double> lumped_mass_kg;
   std::vector<double> inverse_mass_per_kg;  // 0 on fixed nodes, so they never move
@@ -37,7 +69,6 @@ struct SimModel {
   // names corner s / tet_count of element s % tet_count.
   std::vector<std::int32_t> node_slot_begin;  // size node_count + 1
   std::vector<std::int32_t> node_slots;
-  TissueMaterial material;
   double mass_damping_per_s = 0.0;
   // Largest eigenfrequency of M⁻¹K at rest (free nodes), from power iteration, and the explicit
   // step used: safety · 2/ω_max (reduced for damping).
@@ -49,8 +80,9 @@ struct SimModel {
   double min_element_height_m = 0.0;
 };
 
-// Builds the model. Throws std::invalid_argument naming the problem for an invalid material, an
-// empty mesh, an inverted or zero-volume element, or a fixed node index out of range.
+// Builds the model. Throws std::invalid_argument naming the problem for an invalid material, a
+// region without a material, a fibre field of the wrong size or with a zero vector, an empty mesh,
+// an inverted or zero-volume element, or a fixed node index out of range.
 SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
 
 }  // namespace liversim
