@@ -54,6 +54,26 @@ Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, const Eigen::Vector
   return 2.0 * psi4 * fa * a.transpose();
 }
 
+Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, const Eigen::Vector3d& a,
+                                           const FibreParameters& p) {
+  Eigen::Matrix<double, 9, 9> tangent = Eigen::Matrix<double, 9, 9>::Zero();
+  const Eigen::Vector3d fa = F * a;
+  const double stretch = fa.squaredNorm() - 1.0;
+  if (stretch <= 0.0 || p.k1_pa == 0.0) return tangent;
+  const double x = p.k2 * stretch * stretch;
+  const double e = guarded_exp_slope(x);
+  const double psi4 = p.k1_pa * stretch * e;
+  const double psi44 = p.k1_pa * e * (1.0 + (x <= kMaxExponent ? 2.0 * x : 0.0));
+  Eigen::Matrix<double, 9, 1> g;  // ∂I4/∂F / 2 = (Fa) ⊗ a, flattened
+  for (int i = 0; i < 3; ++i)
+    for (int J = 0; J < 3; ++J) {
+      g[3 * i + J] = fa[i] * a[J];
+      for (int L = 0; L < 3; ++L) tangent(3 * i + J, 3 * i + L) += 2.0 * psi4 * a[J] * a[L];
+    }
+  tangent += 4.0 * psi44 * g * g.transpose();
+  return tangent;
+}
+
 double tangent_modulus_pa(const Eigen::Matrix3d& F, const Eigen::Vector3d& a,
                           const FibreParameters& p) {
   const double i4 = fibre_invariant(F, a);

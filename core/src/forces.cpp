@@ -95,6 +95,16 @@ Eigen::Matrix3d element_first_piola_stress(const SimModel& model, std::size_t e,
                               : stress_of<false>(model, e, F, ignored);
 }
 
+Eigen::Matrix<double, 9, 9> element_stress_tangent(const SimModel& model, std::size_t e,
+                                                   const Eigen::Matrix3d& F) {
+  Eigen::Matrix<double, 9, 9> tangent =
+      neo_hookean::stress_tangent(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+  if (model.effects.fibres)
+    for (const auto& family : model.fibre_direction)
+      tangent += hgo::stress_tangent(F, family[e], model.fibre_parameters[e]);
+  return tangent;
+}
+
 ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray& position,
                                          std::array<NodeArray, 4>& corner_scratch,
                                          NodeArray& force) {

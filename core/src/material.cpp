@@ -31,6 +31,23 @@ Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F) {
   return c;  // columns of cof(F) are the cross products of the other two columns of F
 }
 
+void add_cofactor_derivative(const Eigen::Matrix3d& F, double scale,
+                             Eigen::Matrix<double, 9, 9>& tangent) {
+  // ε_ikm is non-zero only for i ≠ k, with m the third index and sign +1 for cyclic (i, k, m).
+  auto third = [](int a, int b) { return 3 - a - b; };
+  auto sign = [](int a, int b) { return (b - a + 3) % 3 == 1 ? 1.0 : -1.0; };
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) {
+      if (i == k) continue;
+      for (int J = 0; J < 3; ++J)
+        for (int L = 0; L < 3; ++L) {
+          if (J == L) continue;
+          tangent(3 * i + J, 3 * k + L) +=
+              scale * sign(i, k) * sign(J, L) * F(third(i, k), third(J, L));
+        }
+    }
+}
+
 namespace neo_hookean {
 namespace {
 
@@ -69,6 +86,17 @@ double volumetric_stiffness(double J, double mu, double lambda) {
 }
 
 }  // namespace
+
+Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, double mu, double lambda) {
+  const Eigen::Matrix3d cof = cofactor(F);
+  const double J = F.col(0).dot(cof.col(0));
+  Eigen::Matrix<double, 9, 9> tangent = mu * Eigen::Matrix<double, 9, 9>::Identity();
+  Eigen::Matrix<double, 9, 1> c;
+  for (int k = 0; k < 9; ++k) c[k] = cof(k / 3, k % 3);
+  tangent += volumetric_stiffness(J, mu, lambda) * c * c.transpose();
+  add_cofactor_derivative(F, volumetric_pressure_term(J, mu, lambda), tangent);
+  return tangent;
+}
 
 double volumetric_stiffening(double J, double mu, double lambda) {
   return volumetric_stiffness(J, mu, lambda) / (lambda + mu);

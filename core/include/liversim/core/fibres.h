@@ -33,6 +33,11 @@ double energy_density(const Eigen::Matrix3d& F, const Eigen::Vector3d& a, const 
 Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, const Eigen::Vector3d& a,
                                    const FibreParameters& p);
 
+// ∂P/∂F of one family as a 9×9 matrix (row 3i+J, column 3k+L):
+// 2ψ4 δik a_J a_L + 4ψ44 (Fa)_i a_J (Fa)_k a_L in tension, zero otherwise.
+Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, const Eigen::Vector3d& a,
+                                           const FibreParameters& p);
+
 // An upper bound of the fibre's tangent stiffness ∂²Ψ_f/∂(Fa)² in Pa at this stretch, for the
 // stable-step estimate: 2ψ4 + 4 I4 ψ44.
 double tangent_modulus_pa(const Eigen::Matrix3d& F, const Eigen::Vector3d& a,

@@ -49,6 +49,9 @@ ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray&
 double element_energy_density(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F);
 Eigen::Matrix3d element_first_piola_stress(const SimModel& model, std::size_t e,
                                            const Eigen::Matrix3d& F);
+// ∂P/∂F of element e at F, 9×9 over row-major flattened indices.
+Eigen::Matrix<double, 9, 9> element_stress_tangent(const SimModel& model, std::size_t e,
+                                                   const Eigen::Matrix3d& F);
 
 // Adds point loads and spring forces at `position` to `force` (spring damping is applied by the
 // integrator).

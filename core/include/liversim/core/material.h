@@ -41,6 +41,10 @@ double energy_density(const Eigen::Matrix3d& F, double mu, double lambda);
 // First Piola–Kirchhoff stress P = ∂Ψ/∂F in Pa.
 Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, double mu, double lambda);
 
+// ∂P/∂F as a 9×9 matrix over row-major flattened indices (row 3i+J for P_iJ, column 3k+L for
+// F_kL): μ δik δJL + U''(J) cof_iJ cof_kL + U'(J) ∂cof_iJ/∂F_kL. Needed by implicit integrators.
+Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, double mu, double lambda);
+
 // U''(J) / U''(1): how much stiffer the volumetric response is at J than at rest (≥ 1 under
 // compression). The stable explicit step scales with its inverse square root.
 double volumetric_stiffening(double J, double mu, double lambda);
@@ -49,5 +53,9 @@ double volumetric_stiffening(double J, double mu, double lambda);
 
 // Cofactor matrix cof(F) = J F⁻ᵀ = ∂J/∂F, computed without inverting F (defined for J ≤ 0).
 Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F);
+
+// ∂cof(F)_iJ/∂F_kL = ε_ikm ε_JLM F_mM, scaled by `scale` and added to a 9×9 tangent.
+void add_cofactor_derivative(const Eigen::Matrix3d& F, double scale,
+                             Eigen::Matrix<double, 9, 9>& tangent);
 
 }  // namespace liversim

@@ -1,0 +1,128 @@
+#pragma once
+// Finite-strain viscoelasticity and viscoplasticity at one material point: the seed's
+// three-element model (standard linear solid, Eq. 1–3) with a nonlinear viscoplastic element in
+// series above a yield limit (Eq. 4). See docs/viscous-tissue.md for the formulation and its
+// verification.
+//
+// Moduli: the seed quotes a single E = 3500 Pa. We take it as the INSTANTANEOUS small-strain
+// modulus E1 + E2 (before the dashpot moves both springs carry load): the instantaneous response
+// is the stiffest, so it is the one the explicit stable step must be computed with. The relaxed
+// (long-term) modulus is E2. Shear and bulk response relax by the same factor, so Poisson's ratio
+// is the same at every instant and the 3-D uniaxial response is exactly the 1-D model.
+
+#include <Eigen/Core>
+
+#include <array>
+#include <optional>
+#include <string>
+
+namespace liversim {
+
+// Seed Eq. 1–3: spring E2 in parallel with a Maxwell arm (spring E1 in series with dashpot η1).
+struct ViscoelasticParameters {
+  double e1_pa;      // spring of the Maxwell arm
+  double e2_pa;      // parallel spring: the relaxed modulus
+  double eta1_pa_s;  // dashpot of the Maxwell arm
+
+  double instantaneous_modulus_pa() const { return e1_pa + e2_pa; }
+  // τ = η1/E1: the decay time of the stress at held strain (Eq. 2).
+  double relaxation_time_s() const { return eta1_pa_s / e1_pa; }
+  // τc = (E1 + E2)·τ/E2: the decay time of the strain at held stress (Eq. 3).
+  double retardation_time_s() const {
+    return instantaneous_modulus_pa() * relaxation_time_s() / e2_pa;
+  }
+};
+
+// Seed Eq. 4: above the yield limit σs a viscoplastic element in series creeps by
+// (σ − σs)·tⁿ/η2, σ being the von Mises equivalent of the Kirchhoff stress in 3-D.
+struct ViscoplasticParameters {
+  double yield_limit_pa;   // σs (0: creep under any deviatoric stress)
+  double eta2_pa_s_pow_n;  // η2 in Pa·sⁿ
+  double creep_index_n;    // n in (0, 1]: primary (n < 1) or steady (n = 1) creep
+};
+
+struct ViscousTissueParameters {
+  ViscoelasticParameters viscoelastic;
+  double poisson_ratio;  // of the compressible Neo-Hookean base, at every instant
+  std::optional<ViscoplasticParameters> viscoplastic;  // none: the viscoelastic model alone
+};
+
+// Each returns a message naming the first parameter that is outside its range (or not a number),
+// or nothing when all are valid.
+std::optional<std::string> validate(const ViscoelasticParameters& parameters);
+std::optional<std::string> validate(const ViscoplasticParameters& parameters);
+std::optional<std::string> validate(const ViscousTissueParameters& parameters);
+
+// Constants of one step length, shared by every element of a material: build one per step length
+// (per distinct stage length of a Runge–Kutta step), not one per element (it costs an exp).
+struct ViscousTissueStep {
+  // `parameters` must be valid (see validate). Throws std::invalid_argument unless dt_s ≥ 0
+  // (dt_s = 0: an instantaneous, purely elastic change of deformation).
+  ViscousTissueStep(const ViscousTissueParameters& parameters, double dt_s);
+
+  double dt_s;
+  double mu_instant_pa;  // Lamé parameters of the instantaneous modulus E1 + E2
+  double lambda_instant_pa;
+  double relaxed_fraction;       // g0 = E2/(E1 + E2)
+  double arm_fraction;           // g1 = E1/(E1 + E2)
+  double arm_decay;              // g = exp(−Δt/τ)
+  double arm_loading;            // h = (1 − g)/(Δt/τ): weight of this step's elastic increment
+  double step_shear_modulus_pa;  // (g0 + g1·h)·μ: shear stiffness of the response within the step
+  std::optional<ViscoplasticParameters> viscoplastic;
+};
+
+// History of one element, committed once per step. Its tensors live in the intermediate
+// configuration of F = Fe·Fp (unloaded, plastically deformed), so a rigid rotation of the
+// current configuration leaves the state unchanged. 23 doubles.
+struct ViscousTissueState {
+  // Symmetric tensors in Voigt order (xx, yy, zz, yz, xz, xy), 2nd Piola–Kirchhoff-like, Pa.
+  std::array<double, 6> maxwell_stress_pa{};  // H: the Maxwell arm carries g1·H
+  std::array<double, 6> elastic_stress_pa{};  // S_e(Fe) of the committed step
+  Eigen::Matrix3d inverse_plastic_deformation = Eigen::Matrix3d::Identity();  // Fp⁻¹, det = 1
+  double equivalent_plastic_strain = 0.0;
+  // Time spent above the yield limit (time hardening); it holds, not resets, below the limit.
+  double yield_clock_s = 0.0;
+};
+
+// First Piola–Kirchhoff stress P (Pa) at deformation gradient F, `step.dt_s` after the state
+// `committed`. Writes the state that committing F would keep to `trial` (which may be `committed`
+// itself); reads nothing else, so the stages of a Runge–Kutta step can evaluate trial
+// deformations from the same committed state. Allocates nothing. Finite for every finite F,
+// including det F ≤ 0: below J = neo_hookean::kMinVolumeRatio the Maxwell arm is not fed (its
+// 2nd Piola–Kirchhoff elastic stress grows like C⁻¹ without bound as J → 0), it only relaxes, and
+// there is no plastic flow.
+Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
+                                      const ViscousTissueState& committed,
+                                      ViscousTissueState& trial);
+
+// viscous_tissue_stress, committing the step into `state`.
+Eigen::Matrix3d viscous_tissue_update(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
+                                      ViscousTissueState& state);
+
+// A homogeneous material point under uniaxial stress: F = diag(λ_axial, λ_lateral, λ_lateral),
+// the lateral stretch solved by Newton's method so that the lateral stresses vanish. For
+// verification against the seed's 1-D formulas and for material curves.
+class UniaxialDriver {
+ public:
+  // Throws std::invalid_argument with validate's message for invalid parameters. The step
+  // functions throw std::runtime_error if Newton's method does not converge in 50 iterations.
+  explicit UniaxialDriver(const ViscousTissueParameters& parameters);
+
+  // Holds the axial stretch over a step of dt_s (0: an instantaneous jump) and commits it.
+  // Returns the nominal axial stress P_xx (force per reference area) in Pa.
+  double step_to_stretch(double axial_stretch, double dt_s);
+  // Holds the nominal axial stress over a step of dt_s and commits it. Returns the axial stretch.
+  double step_to_nominal_stress(double nominal_stress_pa, double dt_s);
+
+  double axial_stretch() const { return axial_stretch_; }
+  double lateral_stretch() const { return lateral_stretch_; }
+  const ViscousTissueState& state() const { return state_; }
+
+ private:
+  ViscousTissueParameters parameters_;
+  ViscousTissueState state_;
+  double axial_stretch_ = 1.0;
+  double lateral_stretch_ = 1.0;
+};
+
+}  // namespace liversim

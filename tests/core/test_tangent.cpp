@@ -1,0 +1,92 @@
+// The tangent ∂P/∂F of every energy equals the finite-difference derivative of its stress.
+#include "block_mesh.h"
+
+#include "liversim/core/fibres.h"
+#include "liversim/core/forces.h"
+#include "liversim/core/material.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <random>
+
+namespace liversim {
+namespace {
+
+using Tangent = Eigen::Matrix<double, 9, 9>;
+
+// Central differences of P along each F_kL; error O(h² P''') + O(ε P / h).
+Tangent numeric_tangent(const std::function<Eigen::Matrix3d(const Eigen::Matrix3d&)>& stress,
+                        const Eigen::Matrix3d& F) {
+  Tangent t;
+  const double h = 1e-6;
+  for (int c = 0; c < 9; ++c) {
+    Eigen::Matrix3d Fp = F, Fm = F;
+    Fp(c / 3, c % 3) += h;
+    Fm(c / 3, c % 3) -= h;
+    const Eigen::Matrix3d dP = (stress(Fp) - stress(Fm)) / (2 * h);
+    for (int r = 0; r < 9; ++r) t(r, c) = dP(r / 3, r % 3);
+  }
+  return t;
+}
+
+Eigen::Matrix3d random_deformation(std::mt19937& random, double volume_ratio) {
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  for (int i = 0; i < 9; ++i) F(i / 3, i % 3) += u(random);
+  F.col(2) *= volume_ratio / F.determinant();  // J = volume_ratio exactly
+  return F;
+}
+
+TEST(Tangent, NeoHookeanIncludingCompressedAndInverted) {
+  const TissueMaterial tissue;
+  const double mu = tissue.shear_modulus_pa(), lambda = tissue.lame_lambda_pa();
+  std::mt19937 random(23);
+  for (double J : {1.0, 1.3, 0.6, 0.1, -0.4}) {
+    const Eigen::Matrix3d F = random_deformation(random, J);
+    const Tangent analytic = neo_hookean::stress_tangent(F, mu, lambda);
+    const Tangent numeric = numeric_tangent(
+        [&](const Eigen::Matrix3d& G) { return neo_hookean::first_piola_stress(G, mu, lambda); },
+        F);
+    EXPECT_LT((analytic - numeric).norm(), 1e-6 * analytic.norm()) << "J = " << J;
+    EXPECT_LT((analytic - analytic.transpose()).norm(), 1e-9 * analytic.norm());  // hyperelastic
+  }
+}
+
+TEST(Tangent, HgoFibreIncludingPastTheGuard) {
+  std::mt19937 random(29);
+  for (const FibreParameters p : {FibreParameters{800.0, 3.0}, FibreParameters{800.0, 300.0}}) {
+    for (int trial = 0; trial < 10; ++trial) {
+      const Eigen::Matrix3d F = random_deformation(random, 1.0) *
+                                Eigen::Vector3d(1.4, 1.0, 1.0).asDiagonal();  // fibre in tension
+      const Eigen::Vector3d a = Eigen::Vector3d(1.0, 0.2, -0.1).normalized();
+      const Tangent analytic = hgo::stress_tangent(F, a, p);
+      const Tangent numeric = numeric_tangent(
+          [&](const Eigen::Matrix3d& G) { return hgo::first_piola_stress(G, a, p); }, F);
+      EXPECT_LT((analytic - numeric).norm(), 1e-6 * (analytic.norm() + p.k1_pa));
+    }
+  }
+}
+
+TEST(Tangent, ElementWithTwoFibreFamiliesAndALesionRegion) {
+  TetMesh mesh = testing::block_mesh(1, 1, 1, {0.01, 0.01, 0.01});
+  mesh.region[3] = 1;
+  ModelOptions options;
+  options.regions[0].fibres = FibreParameters{600.0, 2.0};
+  options.regions.push_back({TissueMaterial{35000.0, 0.45, 1100.0}, std::nullopt});
+  options.fibre_field.first_family = {Eigen::Vector3d(1, 1, 0)};
+  options.fibre_field.second_family = {Eigen::Vector3d(1, -1, 0.3)};
+  const SimModel model = build_model(mesh, options);
+  std::mt19937 random(31);
+  for (std::size_t e : {0u, 3u}) {
+    const Eigen::Matrix3d F =
+        random_deformation(random, 0.95) * Eigen::Vector3d(1.3, 1.1, 0.8).asDiagonal();
+    const Tangent analytic = element_stress_tangent(model, e, F);
+    const Tangent numeric = numeric_tangent(
+        [&](const Eigen::Matrix3d& G) { return element_first_piola_stress(model, e, G); }, F);
+    EXPECT_LT((analytic - numeric).norm(), 1e-6 * analytic.norm()) << "element " << e;
+  }
+}
+
+}  // namespace
+}  // namespace liversim
