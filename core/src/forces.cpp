@@ -33,11 +33,22 @@ Eigen::Matrix3d deformation_gradient(const SimModel& model, const NodeArray& pos
 
 namespace {
 
-template <bool kFibres>
+// History-dependent materials of one evaluation: the state to advance and commit, and the step
+// constants per region; null when the model has no viscous region.
+struct ViscousContext {
+  std::vector<ViscousTissueState>* state;
+  const std::vector<std::optional<ViscousTissueStep>>* step_by_region;
+};
+
+template <bool kFibres, bool kViscous>
 Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F,
-                          ElasticEvaluation& seen) {
-  Eigen::Matrix3d P =
-      neo_hookean::first_piola_stress(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+                          ElasticEvaluation& seen, const ViscousContext& viscous) {
+  Eigen::Matrix3d P;
+  const auto* step = kViscous ? &(*viscous.step_by_region)[model.region[e]] : nullptr;
+  if (kViscous && step->has_value())
+    P = viscous_tissue_update(F, **step, (*viscous.state)[e]);
+  else
+    P = neo_hookean::first_piola_stress(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
   if constexpr (kFibres) {
     const FibreParameters& fibres = model.fibre_parameters[e];
     for (const auto& family : model.fibre_direction) {
@@ -51,9 +62,10 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
 }
 
 // One element loop per effect set, chosen once per evaluation rather than tested per element.
-template <bool kFibres>
+template <bool kFibres, bool kViscous>
 ElasticEvaluation element_forces(const SimModel& model, const NodeArray& position,
-                                 std::array<NodeArray, 4>& corner_scratch) {
+                                 std::array<NodeArray, 4>& corner_scratch,
+                                 const ViscousContext& viscous) {
   ElasticEvaluation seen{std::numeric_limits<double>::infinity(),
                          -std::numeric_limits<double>::infinity(), 0.0};
   for (std::size_t e = 0; e < model.tet_count; ++e) {
@@ -62,7 +74,7 @@ ElasticEvaluation element_forces(const SimModel& model, const NodeArray& positio
     const double J = F.determinant();
     seen.min_volume_ratio = std::min(seen.min_volume_ratio, J);
     seen.max_volume_ratio = std::max(seen.max_volume_ratio, J);
-    const Eigen::Matrix3d P = stress_of<kFibres>(model, e, F, seen);
+    const Eigen::Matrix3d P = stress_of<kFibres, kViscous>(model, e, F, seen, viscous);
     // Nodal forces of corners 1..3 are the columns of −V·P·Dm⁻ᵀ; corner 0 balances them.
     const Eigen::Matrix3d h = -model.rest_volume_m3[e] * P * dm_inv.transpose();
     const Eigen::Vector3d h0 = -(h.col(0) + h.col(1) + h.col(2));
@@ -78,6 +90,35 @@ ElasticEvaluation element_forces(const SimModel& model, const NodeArray& positio
   return seen;
 }
 
+// Each node sums its own corner slots, so no two writers share a node (no atomics when threaded).
+void gather_corner_forces(const SimModel& model, const std::array<NodeArray, 4>& corner_scratch,
+                          NodeArray& force) {
+  const std::size_t tets = model.tet_count;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    double fx = 0.0, fy = 0.0, fz = 0.0;
+    for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
+      const auto slot = static_cast<std::size_t>(model.node_slots[s]);
+      const auto& c = corner_scratch[slot / tets];
+      const std::size_t e = slot % tets;
+      fx += c.x[e];
+      fy += c.y[e];
+      fz += c.z[e];
+    }
+    force.x[n] = fx;
+    force.y[n] = fy;
+    force.z[n] = fz;
+  }
+}
+
+template <bool kViscous>
+ElasticEvaluation element_forces_for_effects(const SimModel& model, const NodeArray& position,
+                                             std::array<NodeArray, 4>& corner_scratch,
+                                             const ViscousContext& viscous) {
+  return model.effects.fibres
+             ? element_forces<true, kViscous>(model, position, corner_scratch, viscous)
+             : element_forces<false, kViscous>(model, position, corner_scratch, viscous);
+}
+
 }  // namespace
 
 double element_energy_density(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F) {
@@ -91,8 +132,8 @@ double element_energy_density(const SimModel& model, std::size_t e, const Eigen:
 Eigen::Matrix3d element_first_piola_stress(const SimModel& model, std::size_t e,
                                            const Eigen::Matrix3d& F) {
   ElasticEvaluation ignored;
-  return model.effects.fibres ? stress_of<true>(model, e, F, ignored)
-                              : stress_of<false>(model, e, F, ignored);
+  return model.effects.fibres ? stress_of<true, false>(model, e, F, ignored, {})
+                              : stress_of<false, false>(model, e, F, ignored, {});
 }
 
 Eigen::Matrix<double, 9, 9> element_stress_tangent(const SimModel& model, std::size_t e,
@@ -108,25 +149,22 @@ Eigen::Matrix<double, 9, 9> element_stress_tangent(const SimModel& model, std::s
 ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray& position,
                                          std::array<NodeArray, 4>& corner_scratch,
                                          NodeArray& force) {
-  const std::size_t tets = model.tet_count;
-  const ElasticEvaluation seen = model.effects.fibres
-                                     ? element_forces<true>(model, position, corner_scratch)
-                                     : element_forces<false>(model, position, corner_scratch);
-  // Gather per node: each node sums its own corner slots, so no two writers share a node.
-  for (std::size_t n = 0; n < model.node_count; ++n) {
-    double fx = 0.0, fy = 0.0, fz = 0.0;
-    for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
-      const auto slot = static_cast<std::size_t>(model.node_slots[s]);
-      const auto& c = corner_scratch[slot / tets];
-      const std::size_t e = slot % tets;
-      fx += c.x[e];
-      fy += c.y[e];
-      fz += c.z[e];
-    }
-    force.x[n] = fx;
-    force.y[n] = fy;
-    force.z[n] = fz;
-  }
+  const ElasticEvaluation seen =
+      element_forces_for_effects<false>(model, position, corner_scratch, {});
+  gather_corner_forces(model, corner_scratch, force);
+  return seen;
+}
+
+ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state,
+                                          double dt_since_last_s) {
+  if (!model.effects.viscous)
+    return compute_elastic_forces(model, state.position_m, state.corner_force_n, state.force_n);
+  for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
+    if (model.viscous_parameters[r])
+      state.viscous_step[r].emplace(*model.viscous_parameters[r], dt_since_last_s);
+  const ElasticEvaluation seen = element_forces_for_effects<true>(
+      model, state.position_m, state.corner_force_n, {&state.viscous_state, &state.viscous_step});
+  gather_corner_forces(model, state.corner_force_n, state.force_n);
   return seen;
 }
 

@@ -10,8 +10,8 @@ namespace {
 
 ElasticEvaluation evaluate_forces(const SimModel& model, SimState& state,
                                   const StepInputs& inputs) {
-  const ElasticEvaluation seen =
-      compute_elastic_forces(model, state.position_m, state.corner_force_n, state.force_n);
+  // The configuration was reached by the last step, so history-dependent materials advance by it.
+  const ElasticEvaluation seen = compute_internal_forces(model, state, state.last_step_s);
   add_external_forces(inputs, state.position_m, state.force_n);
   for (const auto& spring : inputs.springs)
     state.spring_damping_per_s[spring.node] +=

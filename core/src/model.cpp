@@ -42,6 +42,22 @@ void validate_regions(const std::vector<RegionMaterial>& regions) {
     if (regions[r].fibres)
       if (auto problem = validate(*regions[r].fibres))
         throw std::invalid_argument(region_name(r) + ": " + *problem);
+    if (regions[r].viscoplastic && !regions[r].viscoelastic)
+      throw std::invalid_argument(region_name(r) +
+                                  ": viscoplasticity needs the viscoelastic parameters (E1, E2, "
+                                  "eta1) it acts in series with");
+    if (const auto& visco = regions[r].viscoelastic) {
+      if (auto problem = validate(ViscousTissueParameters{*visco, regions[r].tissue.poisson_ratio,
+                                                          regions[r].viscoplastic}))
+        throw std::invalid_argument(region_name(r) + ": " + *problem);
+      const double instantaneous = visco->instantaneous_modulus_pa();
+      if (std::abs(instantaneous - regions[r].tissue.youngs_modulus_pa) > 1e-9 * instantaneous)
+        throw std::invalid_argument(
+            region_name(r) + ": Young's modulus " +
+            std::to_string(regions[r].tissue.youngs_modulus_pa) +
+            " Pa must equal the instantaneous modulus E1 + E2 = " + std::to_string(instantaneous) +
+            " Pa of its viscoelastic parameters");
+    }
   }
 }
 
@@ -137,6 +153,16 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
       model.fibre_parameters[e] =
           options.regions[model.region[e]].fibres.value_or(FibreParameters{});
   }
+
+  for (const auto& region : options.regions)
+    model.effects.viscous |= region.viscoelastic.has_value();
+  if (model.effects.viscous)
+    for (const auto& region : options.regions)
+      model.viscous_parameters.push_back(
+          region.viscoelastic
+              ? std::optional<ViscousTissueParameters>(ViscousTissueParameters{
+                    *region.viscoelastic, region.tissue.poisson_ratio, region.viscoplastic})
+              : std::nullopt);
 
   model.is_fixed.assign(model.node_count, 0);
   for (auto n : options.fixed_nodes) {

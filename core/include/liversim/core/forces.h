@@ -45,7 +45,14 @@ ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray&
                                          std::array<NodeArray, 4>& corner_scratch,
                                          NodeArray& force);
 
-// Strain energy density and first Piola–Kirchhoff stress of element e at deformation F.
+// The internal forces of a step at the state's positions, into state.force_n. History-dependent
+// (viscous) elements advance their state by dt_since_last_s, the time since the last evaluation,
+// and commit it; without viscous regions this is compute_elastic_forces. Allocates nothing.
+ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state,
+                                          double dt_since_last_s);
+
+// Strain energy density and first Piola–Kirchhoff stress of element e at deformation F (the
+// instantaneous elastic response for viscous regions, whose E is E1 + E2).
 double element_energy_density(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F);
 Eigen::Matrix3d element_first_piola_stress(const SimModel& model, std::size_t e,
                                            const Eigen::Matrix3d& F);

@@ -6,6 +6,7 @@
 #include "liversim/core/fibres.h"
 #include "liversim/core/material.h"
 #include "liversim/core/tet_mesh.h"
+#include "liversim/core/viscous_tissue.h"
 
 #include <Eigen/Core>
 
@@ -20,6 +21,10 @@ namespace liversim {
 struct RegionMaterial {
   TissueMaterial tissue;
   std::optional<FibreParameters> fibres;  // none: isotropic
+  // Seed Eq. 1–3. When given, tissue.youngs_modulus_pa must be the instantaneous modulus E1 + E2.
+  std::optional<ViscoelasticParameters> viscoelastic;
+  // Seed Eq. 4, in series; needs `viscoelastic`.
+  std::optional<ViscoplasticParameters> viscoplastic;
 };
 
 // Reference fibre directions (normalised when the model is built): empty for no family, one vector
@@ -33,6 +38,7 @@ struct FibreField {
 // off costs nothing in the step.
 struct EffectSet {
   bool fibres = false;
+  bool viscous = false;  // viscoelasticity (and viscoplasticity) in some region
 };
 
 struct ModelOptions {
@@ -61,6 +67,8 @@ struct SimModel {
   // region has none) and the unit reference direction of each family (zero vector: no family).
   std::vector<FibreParameters> fibre_parameters;
   std::array<std::vector<Eigen::Vector3d>, 2> fibre_direction;
+  // Per region, the viscous law of regions that have one (allocated only when effects.viscous).
+  std::vector<std::optional<ViscousTissueParameters>> viscous_parameters;
   NodeArray rest_position_m;
   std::vector<double> lumped_mass_kg;
   std::vector<double> inverse_mass_per_kg;  // 0 on fixed nodes, so they never move

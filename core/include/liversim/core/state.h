@@ -2,6 +2,9 @@
 // The changing simulation state, with the scratch buffers stepping needs, sized once for a model.
 
 #include "liversim/core/model.h"
+#include "liversim/core/viscous_tissue.h"
+
+#include <optional>
 
 #include <cstdint>
 
@@ -16,6 +19,10 @@ struct SimState {
   std::vector<double> spring_damping_per_s;  // c/m per node from the springs of this step
   double max_speed_m_per_s = 0.0;            // fastest node after the last step
   double last_step_s = 0.0;                  // length of the last step (0 before the first)
+  // History of viscous elements, committed at every force evaluation of a step (allocated only
+  // when the model's effects.viscous), and the per-region step constants (scratch).
+  std::vector<ViscousTissueState> viscous_state;
+  std::vector<std::optional<ViscousTissueStep>> viscous_step;
   double time_s = 0.0;
   std::uint64_t step_count = 0;
 };
