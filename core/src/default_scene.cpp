@@ -14,6 +14,8 @@ SceneSetup default_scene(int tet_count) {
   SceneSetup setup;
   setup.mesh = generate_liver_mesh(tet_count).mesh;
   setup.model_options.fixed_nodes = setup.mesh.node_sets.at("ligament");
+  // ν = 0.49 locks linear tetrahedra; average nodal pressure removes it (docs/tissue-model.md).
+  setup.model_options.average_nodal_pressure = true;
   // The mesher's quality guards stop some boundary nodes short of the surface; the rendered
   // surface sits on the smooth shape and follows the elements that hold it.
   const LiverShape shape;

@@ -40,13 +40,18 @@ struct ViscousContext {
   const std::vector<std::optional<ViscousTissueStep>>* step_by_region;
 };
 
-template <bool kFibres, bool kViscous>
+// `averaged_volume_ratio` is used only with average nodal pressure (kAveragedPressure).
+template <bool kFibres, bool kViscous, bool kAveragedPressure>
 Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F,
-                          ElasticEvaluation& seen, const ViscousContext& viscous) {
+                          double averaged_volume_ratio, ElasticEvaluation& seen,
+                          const ViscousContext& viscous) {
   Eigen::Matrix3d P;
   const auto* step = kViscous ? &(*viscous.step_by_region)[model.region[e]] : nullptr;
   if (kViscous && step->has_value())
     P = viscous_tissue_update(F, **step, (*viscous.state)[e]);
+  else if (kAveragedPressure)
+    P = neo_hookean::first_piola_stress_averaged_pressure(
+        F, model.shear_modulus_pa[e], model.lame_lambda_pa[e], averaged_volume_ratio);
   else
     P = neo_hookean::first_piola_stress(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
   if constexpr (kFibres) {
@@ -61,20 +66,44 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
   return P;
 }
 
+// Average nodal pressure, first pass: each node's volume-weighted mean of its elements' J.
+void average_nodal_volume_ratios(const SimModel& model, const NodeArray& position,
+                                 ForceScratch& scratch) {
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    scratch.element_volume_ratio[e] = deformation_gradient(model, position, e).determinant();
+  const std::size_t tets = model.tet_count;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    double weighted = 0.0, volume = 0.0;
+    for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
+      const std::size_t e = static_cast<std::size_t>(model.node_slots[s]) % tets;
+      weighted += model.rest_volume_m3[e] * scratch.element_volume_ratio[e];
+      volume += model.rest_volume_m3[e];
+    }
+    scratch.nodal_volume_ratio[n] = volume > 0.0 ? weighted / volume : 1.0;
+  }
+}
+
 // One element loop per effect set, chosen once per evaluation rather than tested per element.
-template <bool kFibres, bool kViscous>
+template <bool kFibres, bool kViscous, bool kAveragedPressure>
 ElasticEvaluation element_forces(const SimModel& model, const NodeArray& position,
-                                 std::array<NodeArray, 4>& corner_scratch,
-                                 const ViscousContext& viscous) {
+                                 ForceScratch& scratch, const ViscousContext& viscous) {
+  if constexpr (kAveragedPressure) average_nodal_volume_ratios(model, position, scratch);
   ElasticEvaluation seen{std::numeric_limits<double>::infinity(),
                          -std::numeric_limits<double>::infinity(), 0.0};
+  auto& corner_scratch = scratch.corner_force_n;
   for (std::size_t e = 0; e < model.tet_count; ++e) {
     const Eigen::Matrix3d dm_inv = dm_inverse_of(model, e);
     const Eigen::Matrix3d F = deformed_edges(model, position, e) * dm_inv;
     const double J = F.determinant();
     seen.min_volume_ratio = std::min(seen.min_volume_ratio, J);
     seen.max_volume_ratio = std::max(seen.max_volume_ratio, J);
-    const Eigen::Matrix3d P = stress_of<kFibres, kViscous>(model, e, F, seen, viscous);
+    double averaged = J;
+    if constexpr (kAveragedPressure) {
+      averaged = 0.0;
+      for (int c = 0; c < 4; ++c) averaged += 0.25 * scratch.nodal_volume_ratio[model.corner[c][e]];
+    }
+    const Eigen::Matrix3d P =
+        stress_of<kFibres, kViscous, kAveragedPressure>(model, e, F, averaged, seen, viscous);
     // Nodal forces of corners 1..3 are the columns of −V·P·Dm⁻ᵀ; corner 0 balances them.
     const Eigen::Matrix3d h = -model.rest_volume_m3[e] * P * dm_inv.transpose();
     const Eigen::Vector3d h0 = -(h.col(0) + h.col(1) + h.col(2));
@@ -91,8 +120,8 @@ ElasticEvaluation element_forces(const SimModel& model, const NodeArray& positio
 }
 
 // Each node sums its own corner slots, so no two writers share a node (no atomics when threaded).
-void gather_corner_forces(const SimModel& model, const std::array<NodeArray, 4>& corner_scratch,
-                          NodeArray& force) {
+void gather_corner_forces(const SimModel& model, const ForceScratch& scratch, NodeArray& force) {
+  const auto& corner_scratch = scratch.corner_force_n;
   const std::size_t tets = model.tet_count;
   for (std::size_t n = 0; n < model.node_count; ++n) {
     double fx = 0.0, fy = 0.0, fz = 0.0;
@@ -112,11 +141,13 @@ void gather_corner_forces(const SimModel& model, const std::array<NodeArray, 4>&
 
 template <bool kViscous>
 ElasticEvaluation element_forces_for_effects(const SimModel& model, const NodeArray& position,
-                                             std::array<NodeArray, 4>& corner_scratch,
-                                             const ViscousContext& viscous) {
-  return model.effects.fibres
-             ? element_forces<true, kViscous>(model, position, corner_scratch, viscous)
-             : element_forces<false, kViscous>(model, position, corner_scratch, viscous);
+                                             ForceScratch& scratch, const ViscousContext& viscous) {
+  const EffectSet& on = model.effects;
+  if (on.average_nodal_pressure)
+    return on.fibres ? element_forces<true, kViscous, true>(model, position, scratch, viscous)
+                     : element_forces<false, kViscous, true>(model, position, scratch, viscous);
+  return on.fibres ? element_forces<true, kViscous, false>(model, position, scratch, viscous)
+                   : element_forces<false, kViscous, false>(model, position, scratch, viscous);
 }
 
 }  // namespace
@@ -132,8 +163,9 @@ double element_energy_density(const SimModel& model, std::size_t e, const Eigen:
 Eigen::Matrix3d element_first_piola_stress(const SimModel& model, std::size_t e,
                                            const Eigen::Matrix3d& F) {
   ElasticEvaluation ignored;
-  return model.effects.fibres ? stress_of<true, false>(model, e, F, ignored, {})
-                              : stress_of<false, false>(model, e, F, ignored, {});
+  const double J = F.determinant();  // a single element: its own J is the average
+  return model.effects.fibres ? stress_of<true, false, false>(model, e, F, J, ignored, {})
+                              : stress_of<false, false, false>(model, e, F, J, ignored, {});
 }
 
 Eigen::Matrix<double, 9, 9> element_stress_tangent(const SimModel& model, std::size_t e,
@@ -147,24 +179,22 @@ Eigen::Matrix<double, 9, 9> element_stress_tangent(const SimModel& model, std::s
 }
 
 ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray& position,
-                                         std::array<NodeArray, 4>& corner_scratch,
-                                         NodeArray& force) {
-  const ElasticEvaluation seen =
-      element_forces_for_effects<false>(model, position, corner_scratch, {});
-  gather_corner_forces(model, corner_scratch, force);
+                                         ForceScratch& scratch, NodeArray& force) {
+  const ElasticEvaluation seen = element_forces_for_effects<false>(model, position, scratch, {});
+  gather_corner_forces(model, scratch, force);
   return seen;
 }
 
 ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state,
                                           double dt_since_last_s) {
   if (!model.effects.viscous)
-    return compute_elastic_forces(model, state.position_m, state.corner_force_n, state.force_n);
+    return compute_elastic_forces(model, state.position_m, state.force_scratch, state.force_n);
   for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
     if (model.viscous_parameters[r])
       state.viscous_step[r].emplace(*model.viscous_parameters[r], dt_since_last_s);
   const ElasticEvaluation seen = element_forces_for_effects<true>(
-      model, state.position_m, state.corner_force_n, {&state.viscous_state, &state.viscous_step});
-  gather_corner_forces(model, state.corner_force_n, state.force_n);
+      model, state.position_m, state.force_scratch, {&state.viscous_state, &state.viscous_step});
+  gather_corner_forces(model, state.force_scratch, state.force_n);
   return seen;
 }
 

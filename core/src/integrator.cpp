@@ -115,8 +115,7 @@ StepReport advance(const SimModel& model, SimState& state, const StepInputs& inp
 double estimate_max_frequency_rad_per_s(const SimModel& model, const NodeArray& position,
                                         int iterations) {
   const std::size_t n = model.node_count;
-  std::array<NodeArray, 4> scratch;
-  for (auto& c : scratch) c.resize(model.tet_count);
+  ForceScratch scratch = make_force_scratch(model);
   NodeArray probe = position, force_plus, force_minus;
   force_plus.resize(n);
   force_minus.resize(n);

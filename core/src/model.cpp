@@ -154,6 +154,7 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
           options.regions[model.region[e]].fibres.value_or(FibreParameters{});
   }
 
+  model.effects.average_nodal_pressure = options.average_nodal_pressure;
   for (const auto& region : options.regions)
     model.effects.viscous |= region.viscoelastic.has_value();
   if (model.effects.viscous)

@@ -2,12 +2,22 @@
 
 namespace liversim {
 
+ForceScratch make_force_scratch(const SimModel& model) {
+  ForceScratch scratch;
+  for (auto& corner : scratch.corner_force_n) corner.resize(model.tet_count);
+  if (model.effects.average_nodal_pressure) {
+    scratch.element_volume_ratio.resize(model.tet_count);
+    scratch.nodal_volume_ratio.resize(model.node_count);
+  }
+  return scratch;
+}
+
 SimState make_rest_state(const SimModel& model) {
   SimState state;
   state.position_m = model.rest_position_m;
   state.velocity_m_per_s.resize(model.node_count);
   state.force_n.resize(model.node_count);
-  for (auto& corner : state.corner_force_n) corner.resize(model.tet_count);
+  state.force_scratch = make_force_scratch(model);
   state.spring_damping_per_s.assign(model.node_count, 0.0);
   if (model.effects.viscous) {
     state.viscous_state.resize(model.tet_count);

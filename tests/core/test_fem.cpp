@@ -102,8 +102,7 @@ TEST(PatchTest, AffineDeformationLeavesInteriorNodesInEquilibrium) {
     boundary[n] = on_box;
     interior[n] = !on_box;
   }
-  std::array<NodeArray, 4> scratch;
-  for (auto& c : scratch) c.resize(model.tet_count);
+  ForceScratch scratch = make_force_scratch(model);
   NodeArray force;
   force.resize(model.node_count);
   compute_elastic_forces(model, x, scratch, force);
@@ -196,8 +195,7 @@ TEST(StaticBlock, UniaxialTensionMatchesSmallStrainElasticity) {
 double exact_max_frequency(const SimModel& model) {
   const int n = static_cast<int>(model.node_count);
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  std::array<NodeArray, 4> scratch;
-  for (auto& c : scratch) c.resize(model.tet_count);
+  ForceScratch scratch = make_force_scratch(model);
   NodeArray fp, fm;
   fp.resize(n);
   fm.resize(n);

@@ -114,8 +114,7 @@ TEST(Fibres, UniaxialTensionAlongTheFibreMatchesTheAnalyticAnswer) {
     NodeArray x = mesh.rest_position_m;
     const Eigen::Vector3d scale(stretch, answer.lateral_stretch, answer.lateral_stretch);
     for (std::size_t n = 0; n < x.size(); ++n) x.set(n, scale.cwiseProduct(x.at(n)));
-    std::array<NodeArray, 4> scratch;
-    for (auto& c : scratch) c.resize(model.tet_count);
+    ForceScratch scratch = make_force_scratch(model);
     NodeArray force;
     force.resize(model.node_count);
     compute_elastic_forces(model, x, scratch, force);

@@ -42,8 +42,7 @@ struct ElasticEvaluation {
 // for per-element values. The element kernel is the one for the model's effect set. Allocates
 // nothing.
 ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray& position,
-                                         std::array<NodeArray, 4>& corner_scratch,
-                                         NodeArray& force);
+                                         ForceScratch& scratch, NodeArray& force);
 
 // The internal forces of a step at the state's positions, into state.force_n. History-dependent
 // (viscous) elements advance their state by dt_since_last_s, the time since the last evaluation,

@@ -41,6 +41,12 @@ double energy_density(const Eigen::Matrix3d& F, double mu, double lambda);
 // First Piola–Kirchhoff stress P = ∂Ψ/∂F in Pa.
 Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, double mu, double lambda);
 
+// The same stress with the λ part of the pressure, λ ln J / J, taken at an averaged volume ratio
+// (average nodal pressure) instead of the element's J: P = μF + (U'(J) − p_λ(J) + p_λ(J_avg)) cof
+// F. Equal to first_piola_stress when J_avg = J; p_λ is Taylor-continued below kMinVolumeRatio too.
+Eigen::Matrix3d first_piola_stress_averaged_pressure(const Eigen::Matrix3d& F, double mu,
+                                                     double lambda, double averaged_volume_ratio);
+
 // ∂P/∂F as a 9×9 matrix over row-major flattened indices (row 3i+J for P_iJ, column 3k+L for
 // F_kL): μ δik δJL + U''(J) cof_iJ cof_kL + U'(J) ∂cof_iJ/∂F_kL. Needed by implicit integrators.
 Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, double mu, double lambda);

@@ -39,15 +39,19 @@ struct FibreField {
 struct EffectSet {
   bool fibres = false;
   bool viscous = false;  // viscoelasticity (and viscoplasticity) in some region
+  // Near-incompressibility on linear tetrahedra: the λ part of the pressure is taken from the
+  // average nodal volume ratio (Joldes, Wittek & Miller 2009; NiftySim's T4ANP), not the element's.
+  bool average_nodal_pressure = false;
 };
 
 struct ModelOptions {
   // Region r of the mesh (TetMesh::region) is made of regions[r]; region 0 is the parenchyma.
   std::vector<RegionMaterial> regions{RegionMaterial{}};
   FibreField fibre_field;
-  std::vector<NodeIndex> fixed_nodes;  // held at their rest position (e.g. ligament attachment)
-  double mass_damping_per_s = 8.0;     // Rayleigh mass-proportional damping coefficient α
-  double stable_step_safety = 0.8;     // fraction of the central-difference limit actually used
+  bool average_nodal_pressure = false;  // see EffectSet
+  std::vector<NodeIndex> fixed_nodes;   // held at their rest position (e.g. ligament attachment)
+  double mass_damping_per_s = 8.0;      // Rayleigh mass-proportional damping coefficient α
+  double stable_step_safety = 0.8;      // fraction of the central-difference limit actually used
 };
 
 struct SimModel {
