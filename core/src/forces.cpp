@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <type_traits>
 
 namespace liversim {
 namespace {
@@ -41,7 +42,7 @@ struct ViscousContext {
 };
 
 // `averaged_volume_ratio` is used only with average nodal pressure (kAveragedPressure).
-template <bool kFibres, bool kViscous, bool kAveragedPressure>
+template <bool kFibres, bool kViscous, bool kAveragedPressure, bool kMooneyRivlin>
 Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F,
                           double averaged_volume_ratio, ElasticEvaluation& seen,
                           const ViscousContext& viscous) {
@@ -54,6 +55,9 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
         F, model.shear_modulus_pa[e], model.lame_lambda_pa[e], averaged_volume_ratio);
   else
     P = neo_hookean::first_piola_stress(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+  if constexpr (kMooneyRivlin)
+    if (!(kViscous && step->has_value()))
+      P += mooney_rivlin::extra_first_piola_stress(F, model.mooney_rivlin_c2_pa[e]);
   if constexpr (kFibres) {
     const FibreParameters& fibres = model.fibre_parameters[e];
     for (const auto& family : model.fibre_direction) {
@@ -84,7 +88,7 @@ void average_nodal_volume_ratios(const SimModel& model, const NodeArray& positio
 }
 
 // One element loop per effect set, chosen once per evaluation rather than tested per element.
-template <bool kFibres, bool kViscous, bool kAveragedPressure>
+template <bool kFibres, bool kViscous, bool kAveragedPressure, bool kMooneyRivlin>
 ElasticEvaluation element_forces(const SimModel& model, const NodeArray& position,
                                  ForceScratch& scratch, const ViscousContext& viscous) {
   if constexpr (kAveragedPressure) average_nodal_volume_ratios(model, position, scratch);
@@ -102,8 +106,8 @@ ElasticEvaluation element_forces(const SimModel& model, const NodeArray& positio
       averaged = 0.0;
       for (int c = 0; c < 4; ++c) averaged += 0.25 * scratch.nodal_volume_ratio[model.corner[c][e]];
     }
-    const Eigen::Matrix3d P =
-        stress_of<kFibres, kViscous, kAveragedPressure>(model, e, F, averaged, seen, viscous);
+    const Eigen::Matrix3d P = stress_of<kFibres, kViscous, kAveragedPressure, kMooneyRivlin>(
+        model, e, F, averaged, seen, viscous);
     // Nodal forces of corners 1..3 are the columns of −V·P·Dm⁻ᵀ; corner 0 balances them.
     const Eigen::Matrix3d h = -model.rest_volume_m3[e] * P * dm_inv.transpose();
     const Eigen::Vector3d h0 = -(h.col(0) + h.col(1) + h.col(2));
@@ -139,21 +143,32 @@ void gather_corner_forces(const SimModel& model, const ForceScratch& scratch, No
   }
 }
 
+// Picks the element loop compiled for the model's effect set.
 template <bool kViscous>
 ElasticEvaluation element_forces_for_effects(const SimModel& model, const NodeArray& position,
                                              ForceScratch& scratch, const ViscousContext& viscous) {
   const EffectSet& on = model.effects;
-  if (on.average_nodal_pressure)
-    return on.fibres ? element_forces<true, kViscous, true>(model, position, scratch, viscous)
-                     : element_forces<false, kViscous, true>(model, position, scratch, viscous);
-  return on.fibres ? element_forces<true, kViscous, false>(model, position, scratch, viscous)
-                   : element_forces<false, kViscous, false>(model, position, scratch, viscous);
+  auto run = [&](auto fibres, auto pressure, auto mooney) {
+    return element_forces<decltype(fibres)::value, kViscous, decltype(pressure)::value,
+                          decltype(mooney)::value>(model, position, scratch, viscous);
+  };
+  auto with_mooney = [&](auto fibres, auto pressure) {
+    return on.mooney_rivlin ? run(fibres, pressure, std::true_type{})
+                            : run(fibres, pressure, std::false_type{});
+  };
+  auto with_pressure = [&](auto fibres) {
+    return on.average_nodal_pressure ? with_mooney(fibres, std::true_type{})
+                                     : with_mooney(fibres, std::false_type{});
+  };
+  return on.fibres ? with_pressure(std::true_type{}) : with_pressure(std::false_type{});
 }
 
 }  // namespace
 
 double element_energy_density(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F) {
   double psi = neo_hookean::energy_density(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+  if (model.effects.mooney_rivlin)
+    psi += mooney_rivlin::extra_energy_density(F, model.mooney_rivlin_c2_pa[e]);
   if (model.effects.fibres)
     for (const auto& family : model.fibre_direction)
       psi += hgo::energy_density(F, family[e], model.fibre_parameters[e]);
@@ -164,14 +179,20 @@ Eigen::Matrix3d element_first_piola_stress(const SimModel& model, std::size_t e,
                                            const Eigen::Matrix3d& F) {
   ElasticEvaluation ignored;
   const double J = F.determinant();  // a single element: its own J is the average
-  return model.effects.fibres ? stress_of<true, false, false>(model, e, F, J, ignored, {})
-                              : stress_of<false, false, false>(model, e, F, J, ignored, {});
+  Eigen::Matrix3d P = model.effects.fibres
+                          ? stress_of<true, false, false, false>(model, e, F, J, ignored, {})
+                          : stress_of<false, false, false, false>(model, e, F, J, ignored, {});
+  if (model.effects.mooney_rivlin)
+    P += mooney_rivlin::extra_first_piola_stress(F, model.mooney_rivlin_c2_pa[e]);
+  return P;
 }
 
 Eigen::Matrix<double, 9, 9> element_stress_tangent(const SimModel& model, std::size_t e,
                                                    const Eigen::Matrix3d& F) {
   Eigen::Matrix<double, 9, 9> tangent =
       neo_hookean::stress_tangent(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+  if (model.effects.mooney_rivlin)
+    tangent += mooney_rivlin::extra_stress_tangent(F, model.mooney_rivlin_c2_pa[e]);
   if (model.effects.fibres)
     for (const auto& family : model.fibre_direction)
       tangent += hgo::stress_tangent(F, family[e], model.fibre_parameters[e]);

@@ -20,6 +20,16 @@ std::optional<std::string> validate(const TissueMaterial& material) {
     return out_of_range("Poisson's ratio", material.poisson_ratio, "a value in (-1, 0.5)");
   if (!std::isfinite(material.density_kg_per_m3) || material.density_kg_per_m3 <= 0.0)
     return out_of_range("density (kg/m³)", material.density_kg_per_m3, "a finite value > 0");
+  if (!std::isfinite(material.mooney_rivlin_fraction) || material.mooney_rivlin_fraction < 0.0 ||
+      material.mooney_rivlin_fraction >= 1.0)
+    return out_of_range("Mooney-Rivlin fraction c2/(c1+c2)", material.mooney_rivlin_fraction,
+                        "a value in [0, 1)");
+  // The I2 term's share of λ (4 c2 = 2 f μ) must leave the volumetric λ positive.
+  if (material.lame_lambda_pa() -
+          2.0 * material.mooney_rivlin_fraction * material.shear_modulus_pa() <=
+      0.0)
+    return out_of_range("Mooney-Rivlin fraction c2/(c1+c2)", material.mooney_rivlin_fraction,
+                        "a value below λ/(2μ) = ν/(1 − 2ν) for this Poisson's ratio");
   return std::nullopt;
 }
 
@@ -135,4 +145,62 @@ Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, double mu, double l
 }
 
 }  // namespace neo_hookean
+
+namespace mooney_rivlin {
+namespace {
+
+// g(J) = −4 c2 ln J and its first two derivatives, continued quadratically below J0.
+struct LogTerm {
+  double value, slope, curvature;
+};
+
+LogTerm log_term(double J, double c2) {
+  const double j0 = neo_hookean::kMinVolumeRatio;
+  if (J >= j0) return {-4.0 * c2 * std::log(J), -4.0 * c2 / J, 4.0 * c2 / (J * J)};
+  const double d = J - j0;
+  const double value = -4.0 * c2 * std::log(j0), slope = -4.0 * c2 / j0;
+  const double curvature = 4.0 * c2 / (j0 * j0);
+  return {value + slope * d + 0.5 * curvature * d * d, slope + curvature * d, curvature};
+}
+
+}  // namespace
+
+double extra_energy_density(const Eigen::Matrix3d& F, double c2) {
+  const Eigen::Matrix3d C = F.transpose() * F;
+  const double i1 = C.trace(), i2 = 0.5 * (i1 * i1 - (C * C).trace());
+  return c2 * (i2 - 3.0) + log_term(F.determinant(), c2).value;
+}
+
+Eigen::Matrix3d extra_first_piola_stress(const Eigen::Matrix3d& F, double c2) {
+  // ∂I2/∂F = 2 (I1 F − F C); ∂(ln J)/∂F = cof F / J, with the continued slope for J < J0.
+  const Eigen::Matrix3d C = F.transpose() * F;
+  const Eigen::Matrix3d cof = cofactor(F);
+  const double J = F.col(0).dot(cof.col(0));
+  return 2.0 * c2 * (C.trace() * F - F * C) + log_term(J, c2).slope * cof;
+}
+
+Eigen::Matrix<double, 9, 9> extra_stress_tangent(const Eigen::Matrix3d& F, double c2) {
+  // ∂[I1 F − F Fᵀ F]_iJ/∂F_kL = 2 F_kL F_iJ + I1 δik δJL − δik C_LJ − F_iL F_kJ − B_ik δJL.
+  const Eigen::Matrix3d C = F.transpose() * F, B = F * F.transpose();
+  const double i1 = C.trace();
+  Eigen::Matrix<double, 9, 9> tangent;
+  for (int i = 0; i < 3; ++i)
+    for (int J = 0; J < 3; ++J)
+      for (int k = 0; k < 3; ++k)
+        for (int L = 0; L < 3; ++L) {
+          const double dik = i == k, dJL = J == L;
+          tangent(3 * i + J, 3 * k + L) = 2.0 * c2 *
+                                          (2.0 * F(k, L) * F(i, J) + i1 * dik * dJL -
+                                           dik * C(L, J) - F(i, L) * F(k, J) - B(i, k) * dJL);
+        }
+  const Eigen::Matrix3d cof = cofactor(F);
+  const LogTerm g = log_term(F.col(0).dot(cof.col(0)), c2);
+  Eigen::Matrix<double, 9, 1> c;
+  for (int k = 0; k < 9; ++k) c[k] = cof(k / 3, k % 3);
+  tangent += g.curvature * c * c.transpose();
+  add_cofactor_derivative(F, g.slope, tangent);
+  return tangent;
+}
+
+}  // namespace mooney_rivlin
 }  // namespace liversim

@@ -116,7 +116,7 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
                                   std::to_string(options.regions.size()) + " regions given)");
     model.region[e] = region;
     const TissueMaterial& tissue = options.regions[region].tissue;
-    model.shear_modulus_pa[e] = tissue.shear_modulus_pa();
+    model.shear_modulus_pa[e] = (1.0 - tissue.mooney_rivlin_fraction) * tissue.shear_modulus_pa();
     model.lame_lambda_pa[e] = tissue.lame_lambda_pa();
 
     const auto nodes = mesh.tet(e);
@@ -155,6 +155,18 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   }
 
   model.effects.average_nodal_pressure = options.average_nodal_pressure;
+  for (const auto& region : options.regions)
+    model.effects.mooney_rivlin |= region.tissue.mooney_rivlin_fraction > 0.0;
+  if (model.effects.mooney_rivlin) {
+    model.mooney_rivlin_c2_pa.resize(tets);
+    for (std::size_t e = 0; e < tets; ++e) {
+      const TissueMaterial& tissue = options.regions[model.region[e]].tissue;
+      model.mooney_rivlin_c2_pa[e] =
+          0.5 * tissue.mooney_rivlin_fraction * tissue.shear_modulus_pa();
+      // The I2 term adds 4 c2 to the small-strain λ; take it off so E and ν mean what they say.
+      model.lame_lambda_pa[e] -= 4.0 * model.mooney_rivlin_c2_pa[e];
+    }
+  }
   for (const auto& region : options.regions)
     model.effects.viscous |= region.viscoelastic.has_value();
   if (model.effects.viscous)

@@ -14,6 +14,10 @@ struct TissueMaterial {
   double youngs_modulus_pa = 3500.0;
   double poisson_ratio = 0.49;
   double density_kg_per_m3 = 1060.0;
+  // Mooney–Rivlin option: the share f = c2/(c1 + c2) of the shear modulus carried by the I2 term
+  // (0: Neo-Hookean). The small-strain moduli stay those of E and ν: μ = 2(c1 + c2), and the
+  // volumetric λ is reduced by the 4 c2 the I2 term contributes.
+  double mooney_rivlin_fraction = 0.0;
 
   double shear_modulus_pa() const { return youngs_modulus_pa / (2.0 * (1.0 + poisson_ratio)); }
   double lame_lambda_pa() const {
@@ -56,6 +60,15 @@ Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, double mu, 
 double volumetric_stiffening(double J, double mu, double lambda);
 
 }  // namespace neo_hookean
+
+// The I2 part of compressible Mooney–Rivlin, Ψ = c1 (I1 − 3) + c2 (I2 − 3) − (2c1 + 4c2) ln J
+// + λ/2 ln²J: the Neo-Hookean functions above with μ = 2c1 give all but c2 (I2 − 3) − 4c2 ln J,
+// which these add (the ln J term Taylor-continued below kMinVolumeRatio, as for Neo-Hookean).
+namespace mooney_rivlin {
+double extra_energy_density(const Eigen::Matrix3d& F, double c2);
+Eigen::Matrix3d extra_first_piola_stress(const Eigen::Matrix3d& F, double c2);
+Eigen::Matrix<double, 9, 9> extra_stress_tangent(const Eigen::Matrix3d& F, double c2);
+}  // namespace mooney_rivlin
 
 // Cofactor matrix cof(F) = J F⁻ᵀ = ∂J/∂F, computed without inverting F (defined for J ≤ 0).
 Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F);

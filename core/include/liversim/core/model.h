@@ -42,6 +42,7 @@ struct EffectSet {
   // Near-incompressibility on linear tetrahedra: the λ part of the pressure is taken from the
   // average nodal volume ratio (Joldes, Wittek & Miller 2009; NiftySim's T4ANP), not the element's.
   bool average_nodal_pressure = false;
+  bool mooney_rivlin = false;  // some region has a Mooney–Rivlin I2 term
 };
 
 struct ModelOptions {
@@ -64,7 +65,10 @@ struct SimModel {
   std::vector<double> rest_volume_m3;
   std::vector<double> shear_modulus_pa;  // μ per element
   std::vector<double> lame_lambda_pa;    // λ per element
-  std::vector<std::int32_t> region;      // region per element
+  // Mooney–Rivlin c2 per element (allocated only when effects.mooney_rivlin); shear_modulus_pa
+  // then holds the Neo-Hookean part 2c1 = (1 − f) μ.
+  std::vector<double> mooney_rivlin_c2_pa;
+  std::vector<std::int32_t> region;  // region per element
   std::vector<RegionMaterial> regions;
   EffectSet effects;
   // Fibre data per element, allocated only when effects.fibres: HGO parameters (k1 = 0 where the
