@@ -25,9 +25,10 @@ std::optional<std::string> validate(const TissueMaterial& material) {
     return out_of_range("Mooney-Rivlin fraction c2/(c1+c2)", material.mooney_rivlin_fraction,
                         "a value in [0, 1)");
   // The I2 term's share of λ (4 c2 = 2 f μ) must leave the volumetric λ positive.
-  if (material.lame_lambda_pa() -
-          2.0 * material.mooney_rivlin_fraction * material.shear_modulus_pa() <=
-      0.0)
+  if (material.mooney_rivlin_fraction > 0.0 &&
+      material.lame_lambda_pa() -
+              2.0 * material.mooney_rivlin_fraction * material.shear_modulus_pa() <=
+          0.0)
     return out_of_range("Mooney-Rivlin fraction c2/(c1+c2)", material.mooney_rivlin_fraction,
                         "a value below λ/(2μ) = ν/(1 − 2ν) for this Poisson's ratio");
   return std::nullopt;
