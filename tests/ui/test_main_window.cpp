@@ -297,26 +297,3 @@ TEST_F(MainWindowTest, TheStatusBarReportsFrameRateAndSimulationSpeed) {
 
 }  // namespace
 }  // namespace liversim
-
-#if defined(__SANITIZE_ADDRESS__)
-// As in test_vtk_viewport.cpp: D-Bus and Mesa leak at exit, after the driver is unloaded.
-extern "C" const char* __asan_default_options() {
-  return "detect_leaks=0";
-}
-#endif
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  // Listing the tests (ctest discovery at build time) needs no display.
-  if (GTEST_FLAG_GET(list_tests)) {
-    return RUN_ALL_TESTS();
-  }
-  if (qEnvironmentVariableIsEmpty("DISPLAY")) {
-    std::cerr << "FAIL: DISPLAY is not set. This GUI test needs an X server; run it under\n"
-                 "  xvfb-run -a -s \"-screen 0 1280x1024x24\" ctest -L gui\n";
-    return 1;
-  }
-  liversim::VtkViewport::setDefaultSurfaceFormat();
-  QApplication app(argc, argv);
-  return RUN_ALL_TESTS();
-}
