@@ -7,8 +7,10 @@
 #include "liversim/core/mesh_quality.h"
 #include "liversim/core/state.h"
 #include "liversim/core/surface.h"
+#include "liversim/core/viscous_tissue.h"
 
 #ifdef LIVERSIM_HAVE_RENDER
+#include "render/curve_plot.h"
 #include "render/liver_scene.h"
 #endif
 
@@ -17,16 +19,18 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
 namespace liversim::cli {
-namespace {
 
 int fail(const std::string& message) {
   std::cerr << "liversim-cli: error: " << message << "\n";
   return 2;
 }
+
+namespace {
 
 SceneSetup load_scene(const MeshSource& source) {
   if (source.file) return scene_from_file(*source.file, source.fixed_set);
@@ -43,6 +47,42 @@ int guarded(Body&& body) {
     return fail(e.what());
   }
 }
+
+std::string number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+// What a material test records and the closed form it is compared with.
+struct MaterialQuantity {
+  const char* name;      // in the summary and on the plot's y axis
+  const char* unit;      // "" for a strain
+  const char* column;    // CSV column of the simulated value; "analytic_" + column beside it
+  const char* equation;  // of the seed, in docs/viscous-tissue.md
+};
+
+MaterialQuantity material_quantity(MaterialTest test) {
+  switch (test) {
+    case MaterialTest::relaxation:
+      return {"nominal axial stress", "Pa", "stress_pa", "Eq. 2"};
+    case MaterialTest::creep:
+      return {"axial strain", "", "strain", "Eq. 3"};
+    case MaterialTest::yield_creep:
+      return {"axial strain", "", "strain", "Eq. 4"};
+  }
+  throw std::logic_error("unknown material test");
+}
+
+// The curve of a held load: samples at t = 0 (the instantaneous jump) and after every step.
+struct MaterialCurve {
+  std::vector<double> time_s, simulated, analytic;
+  double largest_relative_error = 0.0;
+  double time_of_largest_error_s = 0.0;
+};
+
+// Bounds the run time and memory (three doubles per step) of a mistyped --dt.
+constexpr double kMaxMaterialSteps = 1e7;
 
 }  // namespace
 
@@ -136,6 +176,143 @@ int simulate(const SimulateOptions& options) {
               << "displacement of node " << node << " after " << state.time_s
               << " s (mm): " << (u * 1e3).transpose() << "  |u| = " << u.norm() * 1e3 << "\n";
     if (csv) std::cout << "wrote " << options.csv_output->string() << "\n";
+    return 0;
+  });
+}
+
+int material_test(const MaterialTestOptions& o) {
+  return guarded([&]() -> int {
+    if (!std::isfinite(o.dt_s) || o.dt_s <= 0.0)
+      return fail("--dt " + number(o.dt_s) + " s is invalid: expected a finite value > 0");
+    if (!std::isfinite(o.duration_s) || o.duration_s < o.dt_s)
+      return fail("--duration " + number(o.duration_s) +
+                  " s is invalid: expected a finite value of at least --dt (" + number(o.dt_s) +
+                  " s)");
+    if (o.duration_s / o.dt_s > kMaxMaterialSteps)
+      return fail("--duration / --dt gives " + number(o.duration_s / o.dt_s) + " steps; at most " +
+                  number(kMaxMaterialSteps) + " are allowed");
+    const bool holds_strain = o.test == MaterialTest::relaxation;
+    if (holds_strain && (!std::isfinite(o.strain) || o.strain <= 0.0))
+      return fail("--strain " + number(o.strain) + " is invalid: expected a finite value > 0");
+    if (!holds_strain && (!std::isfinite(o.stress_pa) || o.stress_pa <= 0.0))
+      return fail("--stress " + number(o.stress_pa) +
+                  " Pa is invalid: expected a finite value > 0");
+
+    ViscousTissueParameters parameters{{o.e1_pa, o.e2_pa, o.eta1_pa_s}, o.poisson_ratio, {}};
+    if (o.test == MaterialTest::yield_creep)
+      parameters.viscoplastic =
+          ViscoplasticParameters{o.yield_limit_pa, o.eta2_pa_s_pow_n, o.creep_index_n};
+    if (auto message = validate(parameters)) return fail(*message);
+    if (o.test == MaterialTest::yield_creep && o.stress_pa <= o.yield_limit_pa)
+      return fail("--stress " + number(o.stress_pa) + " Pa must exceed the yield limit --yield " +
+                  number(o.yield_limit_pa) + " Pa: below it yield-creep is plain creep");
+
+    const ViscoelasticParameters& ve = parameters.viscoelastic;
+    const double tau_s = ve.relaxation_time_s();
+    const double tau_c_s = ve.retardation_time_s();
+    const double e_instant_pa = ve.instantaneous_modulus_pa();
+    auto analytic = [&](double t_s) {
+      switch (o.test) {
+        case MaterialTest::relaxation:  // Eq. 2
+          return ve.e2_pa * o.strain +
+                 (e_instant_pa * o.strain - ve.e2_pa * o.strain) * std::exp(-t_s / tau_s);
+        case MaterialTest::creep:  // Eq. 3
+          return o.stress_pa / ve.e2_pa +
+                 o.stress_pa * (1.0 / e_instant_pa - 1.0 / ve.e2_pa) * std::exp(-t_s / tau_c_s);
+        case MaterialTest::yield_creep:  // Eq. 4 = Eq. 3 + the viscoplastic creep
+          return o.stress_pa / ve.e2_pa +
+                 o.stress_pa * (1.0 / e_instant_pa - 1.0 / ve.e2_pa) * std::exp(-t_s / tau_c_s) +
+                 (o.stress_pa - o.yield_limit_pa) * std::pow(t_s, o.creep_index_n) /
+                     o.eta2_pa_s_pow_n;
+      }
+      throw std::logic_error("unknown material test");
+    };
+
+    UniaxialDriver driver(parameters);
+    auto simulate_step = [&](double dt_s) {
+      return holds_strain ? driver.step_to_stretch(1.0 + o.strain, dt_s)
+                          : driver.step_to_nominal_stress(o.stress_pa, dt_s) - 1.0;
+    };
+    MaterialCurve curve;
+    auto record = [&](double t_s, double simulated) {
+      const double exact = analytic(t_s);
+      const double relative_error = std::abs(simulated - exact) / std::abs(exact);
+      curve.time_s.push_back(t_s);
+      curve.simulated.push_back(simulated);
+      curve.analytic.push_back(exact);
+      if (relative_error > curve.largest_relative_error) {
+        curve.largest_relative_error = relative_error;
+        curve.time_of_largest_error_s = t_s;
+      }
+    };
+    record(0.0, simulate_step(0.0));  // the load is applied as a step at t = 0
+    // The tolerance keeps round-off in duration/dt from adding a last step of ~1e-13 s; a
+    // duration that is not a multiple of dt ends with one shorter step.
+    const auto steps = static_cast<long>(std::ceil(o.duration_s / o.dt_s * (1.0 - 1e-12)));
+    double t_s = 0.0;
+    for (long k = 1; k <= steps; ++k) {
+      const double t_next_s = std::min(static_cast<double>(k) * o.dt_s, o.duration_s);
+      const double simulated = simulate_step(t_next_s - t_s);
+      t_s = t_next_s;
+      record(t_s, simulated);
+    }
+
+    const MaterialQuantity quantity = material_quantity(o.test);
+    const std::string unit = *quantity.unit ? std::string(" ") + quantity.unit : "";
+    const char* test_names[] = {"relaxation", "creep", "yield-creep"};
+    std::cout << std::setprecision(6) << "material-test " << test_names[static_cast<int>(o.test)]
+              << ": E1 = " << ve.e1_pa << " Pa, E2 = " << ve.e2_pa << " Pa, eta1 = " << ve.eta1_pa_s
+              << " Pa s (tau = " << tau_s << " s, tau_c = " << tau_c_s
+              << " s), nu = " << o.poisson_ratio;
+    if (parameters.viscoplastic)
+      std::cout << ", yield limit = " << o.yield_limit_pa << " Pa, eta2 = " << o.eta2_pa_s_pow_n
+                << " Pa s^n, n = " << o.creep_index_n;
+    if (holds_strain)
+      std::cout << "; axial strain " << o.strain << " held from t = 0\n";
+    else
+      std::cout << "; nominal axial stress " << o.stress_pa << " Pa held from t = 0\n";
+    std::cout << "time step " << o.dt_s << " s: " << steps << " steps to " << t_s << " s\n"
+              << quantity.name << " at t = " << t_s << " s: simulated " << curve.simulated.back()
+              << unit << ", analytic (seed " << quantity.equation << ") " << curve.analytic.back()
+              << unit << "\n"
+              << std::scientific << std::setprecision(3)
+              << "largest relative error over the curve: " << curve.largest_relative_error
+              << std::defaultfloat << std::setprecision(6)
+              << " (at t = " << curve.time_of_largest_error_s << " s)\n";
+
+    // The CSV first: a plot that cannot be drawn (no display) must not lose the computed curve.
+    if (o.csv_output) {
+      std::ofstream csv(*o.csv_output);
+      if (!csv) return fail("cannot write " + o.csv_output->string());
+      csv << "time_s," << quantity.column << ",analytic_" << quantity.column << ",relative_error\n"
+          << std::setprecision(10);
+      for (std::size_t i = 0; i < curve.time_s.size(); ++i)
+        csv << curve.time_s[i] << "," << curve.simulated[i] << "," << curve.analytic[i] << ","
+            << std::abs(curve.simulated[i] - curve.analytic[i]) / std::abs(curve.analytic[i])
+            << "\n";
+      if (!csv) return fail("writing " + o.csv_output->string() + " failed");
+      std::cout << "wrote " << o.csv_output->string() << "\n";
+    }
+    if (o.plot_output) {
+#ifdef LIVERSIM_HAVE_RENDER
+      const std::string title = std::string(holds_strain ? "Relaxation" : "Creep") + " under " +
+                                (holds_strain ? "axial strain " + number(o.strain)
+                                              : "nominal stress " + number(o.stress_pa) + " Pa") +
+                                ": simulated vs seed " + quantity.equation;
+      write_curve_plot_png(
+          *o.plot_output, title, "time (s)",
+          std::string(quantity.name) +
+              (*quantity.unit ? std::string(" (") + quantity.unit + ")" : std::string()),
+          curve.time_s,
+          {{"simulated (dt = " + number(o.dt_s) + " s)", curve.simulated, false},
+           {std::string("analytic, ") + quantity.equation, curve.analytic, true}},
+          800, 500);
+      std::cout << "wrote " << o.plot_output->string() << "\n";
+#else
+      return fail("cannot write " + o.plot_output->string() +
+                  ": this liversim-cli was built without the renderer (LIVERSIM_BUILD_UI=OFF)");
+#endif
+    }
     return 0;
   });
 }

@@ -26,6 +26,33 @@ struct SimulateOptions {
   double sample_interval_s = 0.01;
 };
 
+// A homogeneous material point of the viscous tissue law (core/viscous_tissue.h) under uniaxial
+// stress, compared with the seed's 1-D closed forms (docs/viscous-tissue.md, Eq. 2–4).
+enum class MaterialTest {
+  relaxation,   // axial strain held from t = 0; nominal stress vs Eq. 2
+  creep,        // nominal stress held from t = 0; axial strain vs Eq. 3
+  yield_creep,  // creep above the yield limit; axial strain vs Eq. 4
+};
+
+// The defaults are ASSUMPTIONS, not data: the seed quotes only E = 3500 Pa, taken as the
+// instantaneous modulus E1 + E2, and gives no split nor viscosities, yield limit or creep index.
+struct MaterialTestOptions {
+  MaterialTest test = MaterialTest::relaxation;
+  double e1_pa = 2000.0;
+  double e2_pa = 1500.0;
+  double eta1_pa_s = 2000.0;  // τ = η1/E1 = 1 s
+  double poisson_ratio = 0.49;
+  double yield_limit_pa = 0.5;
+  double eta2_pa_s_pow_n = 500.0;
+  double creep_index_n = 0.5;
+  double strain = 1e-3;    // held axial strain (relaxation)
+  double stress_pa = 1.0;  // held nominal axial stress (creep, yield-creep)
+  double duration_s = 10.0;
+  double dt_s = 0.01;
+  std::optional<std::filesystem::path> csv_output;
+  std::optional<std::filesystem::path> plot_output;
+};
+
 struct ScreenshotOptions {
   MeshSource mesh;
   std::filesystem::path output;
@@ -36,6 +63,9 @@ struct ScreenshotOptions {
 int mesh_report(const MeshSource& mesh);
 int simulate(const SimulateOptions& options);
 int screenshot(const ScreenshotOptions& options);
+int material_test(const MaterialTestOptions& options);
+// Reports a problem on stderr as "liversim-cli: error: <message>" and returns exit code 2.
+int fail(const std::string& message);
 // A short pull on the liver, released, with a screenshot of the deformed organ while pulled.
 int demo(const ScreenshotOptions& options);
 

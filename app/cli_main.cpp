@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <map>
 
 namespace {
 
@@ -20,7 +21,9 @@ void add_mesh_options(CLI::App& command, liversim::cli::MeshSource& mesh) {
 
 int main(int argc, char** argv) {
   using namespace liversim::cli;
-  CLI::App app{"LiverSim headless tools: simulate the liver, report mesh quality, render images"};
+  CLI::App app{
+      "LiverSim headless tools: simulate the liver, report mesh quality, render images, "
+      "test the tissue law"};
   app.set_version_flag("--version", std::string("liversim-cli ") + LIVERSIM_VERSION);
   app.require_subcommand(1);
 
@@ -64,6 +67,58 @@ int main(int argc, char** argv) {
       "demo", "Pull the liver for a short simulation, then write a screenshot of it");
   demo_cmd->add_option("--output,-o", demo_shot.output, "PNG file to write")->capture_default_str();
 
+  MaterialTestOptions material;
+  auto* material_cmd = app.add_subcommand(
+      "material-test",
+      "Hold a strain (relaxation) or a stress (creep, yield-creep) on one material point of the "
+      "viscous tissue law and compare the curve with the seed's closed form (Eq. 2, 3, 4). The "
+      "default parameters are ASSUMED, not measured: the seed's E = 3500 Pa taken as the "
+      "instantaneous modulus E1 + E2 and split 2000 + 1500 Pa, eta1 = 2000 Pa s (tau = 1 s), and "
+      "for yield-creep a stress of 1 Pa over a yield limit of 0.5 Pa, eta2 = 500 Pa s^n, n = 0.5");
+  material_cmd
+      ->add_option("test", material.test,
+                   "relaxation (Eq. 2), creep (Eq. 3) or yield-creep (Eq. 4)")
+      ->required()
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, MaterialTest>{{"relaxation", MaterialTest::relaxation},
+                                              {"creep", MaterialTest::creep},
+                                              {"yield-creep", MaterialTest::yield_creep}}));
+  material_cmd->add_option("--e1", material.e1_pa, "Maxwell-arm spring E1 (Pa; assumed)")
+      ->capture_default_str();
+  material_cmd
+      ->add_option("--e2", material.e2_pa, "Parallel spring E2, the relaxed modulus (Pa; assumed)")
+      ->capture_default_str();
+  material_cmd->add_option("--eta1", material.eta1_pa_s, "Maxwell-arm dashpot eta1 (Pa s; assumed)")
+      ->capture_default_str();
+  material_cmd->add_option("--poisson", material.poisson_ratio, "Poisson's ratio")
+      ->capture_default_str();
+  auto* yield_option =
+      material_cmd
+          ->add_option("--yield", material.yield_limit_pa, "Yield limit (Pa; yield-creep; assumed)")
+          ->capture_default_str();
+  auto* eta2_option = material_cmd
+                          ->add_option("--eta2", material.eta2_pa_s_pow_n,
+                                       "Viscoplastic viscosity eta2 (Pa s^n; yield-creep; assumed)")
+                          ->capture_default_str();
+  auto* n_option = material_cmd
+                       ->add_option("--n", material.creep_index_n,
+                                    "Creep index n in (0, 1] (yield-creep; assumed)")
+                       ->capture_default_str();
+  auto* strain_option =
+      material_cmd->add_option("--strain", material.strain, "Held axial strain (relaxation)")
+          ->capture_default_str();
+  auto* stress_option = material_cmd
+                            ->add_option("--stress", material.stress_pa,
+                                         "Held nominal axial stress (Pa; creep, yield-creep)")
+                            ->capture_default_str();
+  material_cmd->add_option("--duration", material.duration_s, "Simulated time (s)")
+      ->capture_default_str();
+  material_cmd->add_option("--dt", material.dt_s, "Time step (s)")->capture_default_str();
+  material_cmd->add_option("--csv", material.csv_output,
+                           "Write time_s, simulated, analytic, relative_error as CSV");
+  material_cmd->add_option("--plot", material.plot_output,
+                           "Write a PNG plot of both curves (needs X or xvfb-run)");
+
   try {
     app.parse(argc, argv);
     if (force.size() == 3) sim.force_n = {force[0], force[1], force[2]};
@@ -74,6 +129,18 @@ int main(int argc, char** argv) {
   if (report->parsed()) return mesh_report(report_mesh);
   if (simulate_cmd->parsed()) return simulate(sim);
   if (screenshot_cmd->parsed()) return screenshot(shot);
+  if (material_cmd->parsed()) {
+    // An option of another test would be silently ignored: say so instead.
+    const bool yield_creep = material.test == MaterialTest::yield_creep;
+    for (const CLI::Option* option : {yield_option, eta2_option, n_option})
+      if (option->count() > 0 && !yield_creep)
+        return fail(option->get_name() + " applies to yield-creep only");
+    if (strain_option->count() > 0 && material.test != MaterialTest::relaxation)
+      return fail("--strain applies to relaxation only (creep holds --stress)");
+    if (stress_option->count() > 0 && material.test == MaterialTest::relaxation)
+      return fail("--stress applies to creep and yield-creep only (relaxation holds --strain)");
+    return material_test(material);
+  }
   if (demo_cmd->parsed()) return demo(demo_shot);
   return 1;
 }

@@ -1,0 +1,120 @@
+#include "render/curve_plot.h"
+
+#include <vtkAxis.h>
+#include <vtkChartLegend.h>
+#include <vtkChartXY.h>
+#include <vtkContextScene.h>
+#include <vtkContextView.h>
+#include <vtkDoubleArray.h>
+#include <vtkErrorCode.h>
+#include <vtkNew.h>
+#include <vtkPNGWriter.h>
+#include <vtkPen.h>
+#include <vtkPlot.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkTable.h>
+#include <vtkTextProperty.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <cstdlib>
+#include <stdexcept>
+
+namespace liversim {
+
+std::array<unsigned char, 3> curve_series_colour(std::size_t index) {
+  // Saturated and far apart, so that overlapping curves stay distinguishable (and testable).
+  static constexpr std::array<std::array<unsigned char, 3>, 4> kPalette{{
+      {31, 119, 180},  // blue
+      {214, 39, 40},   // red
+      {44, 160, 44},   // green
+      {148, 103, 189}  // purple
+  }};
+  return kPalette[index % kPalette.size()];
+}
+
+void write_curve_plot_png(const std::filesystem::path& file, const std::string& title,
+                          const std::string& x_label, const std::string& y_label,
+                          const std::vector<double>& x, const std::vector<CurveSeries>& series,
+                          int width, int height) {
+  if (series.empty()) throw std::invalid_argument("a curve plot needs at least one series");
+  for (const CurveSeries& s : series)
+    if (s.y.size() != x.size())
+      throw std::invalid_argument("series '" + s.name + "' has " + std::to_string(s.y.size()) +
+                                  " values for " + std::to_string(x.size()) + " abscissae");
+  // VTK aborts the process when it cannot open the X display, so say it first.
+  const char* display = std::getenv("DISPLAY");
+  if (display == nullptr || *display == '\0')
+    throw std::runtime_error("cannot plot " + file.string() +
+                             ": no X display (DISPLAY is unset); run the command inside "
+                             "xvfb-run -a");
+  const std::filesystem::path folder =
+      file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(folder))
+    throw std::runtime_error("cannot write " + file.string() + ": folder " + folder.string() +
+                             " does not exist");
+
+  vtkNew<vtkTable> table;
+  vtkNew<vtkDoubleArray> x_column;
+  x_column->SetName(x_label.c_str());
+  table->AddColumn(x_column);
+  for (const CurveSeries& s : series) {
+    vtkNew<vtkDoubleArray> column;
+    column->SetName(s.name.c_str());
+    table->AddColumn(column);
+  }
+  table->SetNumberOfRows(static_cast<vtkIdType>(x.size()));
+  for (std::size_t row = 0; row < x.size(); ++row) {
+    table->SetValue(static_cast<vtkIdType>(row), 0, x[row]);
+    for (std::size_t i = 0; i < series.size(); ++i)
+      table->SetValue(static_cast<vtkIdType>(row), static_cast<vtkIdType>(i + 1), series[i].y[row]);
+  }
+
+  vtkNew<vtkContextView> view;
+  view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
+  vtkRenderWindow* window = view->GetRenderWindow();
+  window->SetOffScreenRendering(1);
+  window->SetSize(width, height);
+  window->SetMultiSamples(0);
+
+  vtkNew<vtkChartXY> chart;
+  view->GetScene()->AddItem(chart);
+  chart->SetTitle(title);
+  chart->GetTitleProperties()->SetFontSize(16);
+  chart->SetShowLegend(true);
+  chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
+  chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::CENTER);
+  chart->GetAxis(vtkAxis::BOTTOM)->SetTitle(x_label);
+  vtkAxis* y_axis = chart->GetAxis(vtkAxis::LEFT);
+  y_axis->SetTitle(y_label);
+  // The default fixed notation prints small strains (1e-4) as 0.00.
+  y_axis->SetNotation(vtkAxis::PRINTF_NOTATION);
+  y_axis->SetLabelFormat("%g");
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    vtkPlot* line = chart->AddPlot(vtkChart::LINE);
+    line->SetInputData(table, 0, static_cast<vtkIdType>(i + 1));
+    const auto rgb = curve_series_colour(i);
+    line->SetColor(rgb[0], rgb[1], rgb[2], 255);
+    line->SetWidth(series[i].dashed ? 2.0f : 3.0f);
+    if (series[i].dashed) line->GetPen()->SetLineType(vtkPen::DASH_LINE);
+  }
+
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetFileName(file.string().c_str());
+  writer->SetInputConnection(grab->GetOutputPort());
+  writer->Write();
+  if (writer->GetErrorCode() != 0) {
+    std::error_code ignored;
+    std::filesystem::remove(file, ignored);
+    throw std::runtime_error("writing the plot to " + file.string() + " failed (" +
+                             vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
+  }
+}
+
+}  // namespace liversim
