@@ -1,23 +1,21 @@
 #include "render/curve_plot.h"
 
+#include "render/offscreen_png.h"
+
 #include <vtkAxis.h>
 #include <vtkChartLegend.h>
 #include <vtkChartXY.h>
 #include <vtkContextScene.h>
 #include <vtkContextView.h>
 #include <vtkDoubleArray.h>
-#include <vtkErrorCode.h>
 #include <vtkNew.h>
-#include <vtkPNGWriter.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
-#include <vtkWindowToImageFilter.h>
 
-#include <cstdlib>
 #include <stdexcept>
 
 namespace liversim {
@@ -42,17 +40,7 @@ void write_curve_plot_png(const std::filesystem::path& file, const std::string& 
     if (s.y.size() != x.size())
       throw std::invalid_argument("series '" + s.name + "' has " + std::to_string(s.y.size()) +
                                   " values for " + std::to_string(x.size()) + " abscissae");
-  // VTK aborts the process when it cannot open the X display, so say it first.
-  const char* display = std::getenv("DISPLAY");
-  if (display == nullptr || *display == '\0')
-    throw std::runtime_error("cannot plot " + file.string() +
-                             ": no X display (DISPLAY is unset); run the command inside "
-                             "xvfb-run -a");
-  const std::filesystem::path folder =
-      file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-  if (!std::filesystem::is_directory(folder))
-    throw std::runtime_error("cannot write " + file.string() + ": folder " + folder.string() +
-                             " does not exist");
+  check_offscreen_png_target(file, "plot");
 
   vtkNew<vtkTable> table;
   vtkNew<vtkDoubleArray> x_column;
@@ -99,22 +87,7 @@ void write_curve_plot_png(const std::filesystem::path& file, const std::string& 
     if (series[i].dashed) line->GetPen()->SetLineType(vtkPen::DASH_LINE);
   }
 
-  window->Render();
-  vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(window);
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->Update();
-  vtkNew<vtkPNGWriter> writer;
-  writer->SetFileName(file.string().c_str());
-  writer->SetInputConnection(grab->GetOutputPort());
-  writer->Write();
-  if (writer->GetErrorCode() != 0) {
-    std::error_code ignored;
-    std::filesystem::remove(file, ignored);
-    throw std::runtime_error("writing the plot to " + file.string() + " failed (" +
-                             vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
-  }
+  write_window_png(window, file);
 }
 
 }  // namespace liversim

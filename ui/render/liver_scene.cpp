@@ -1,13 +1,13 @@
 #include "render/liver_scene.h"
 
+#include "render/offscreen_png.h"
+
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkCellPicker.h>
-#include <vtkErrorCode.h>
 #include <vtkFloatArray.h>
 #include <vtkLight.h>
-#include <vtkPNGWriter.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -16,9 +16,7 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkSphereSource.h>
-#include <vtkWindowToImageFilter.h>
 
-#include <cstdlib>
 #include <stdexcept>
 
 namespace liversim {
@@ -172,41 +170,21 @@ Eigen::Vector2d LiverScene::world_to_display(const Eigen::Vector3d& point_m) con
 
 void write_screenshot_png(LiverScene& scene, const std::filesystem::path& file, int width,
                           int height) {
-  // VTK aborts the process when it cannot open the X display, so say it first.
-  const char* display = std::getenv("DISPLAY");
-  if (display == nullptr || *display == '\0')
-    throw std::runtime_error(
-        "cannot render " + file.string() +
-        ": no X display (DISPLAY is unset); run the command inside xvfb-run -a");
-  const std::filesystem::path folder =
-      file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-  if (!std::filesystem::is_directory(folder))
-    throw std::runtime_error("cannot write " + file.string() + ": folder " + folder.string() +
-                             " does not exist");
-
+  check_offscreen_png_target(file, "render");
   vtkNew<vtkRenderWindow> window;
   window->SetOffScreenRendering(1);
   window->SetSize(width, height);
   window->SetMultiSamples(0);
   window->AddRenderer(scene.renderer());
   scene.renderer()->ResetCameraClippingRange();
-  window->Render();
-  vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(window);
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->Update();
-  window->RemoveRenderer(scene.renderer());
-  vtkNew<vtkPNGWriter> writer;
-  writer->SetFileName(file.string().c_str());
-  writer->SetInputConnection(grab->GetOutputPort());
-  writer->Write();
-  if (writer->GetErrorCode() != 0) {
-    std::error_code ignored;
-    std::filesystem::remove(file, ignored);
-    throw std::runtime_error("writing the screenshot to " + file.string() + " failed (" +
-                             vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
+  // Give the renderer back whatever happens: it may be shown elsewhere afterwards.
+  try {
+    write_window_png(window, file);
+  } catch (...) {
+    window->RemoveRenderer(scene.renderer());
+    throw;
   }
+  window->RemoveRenderer(scene.renderer());
 }
 
 }  // namespace liversim

@@ -1,0 +1,20 @@
+#pragma once
+// Writing what an offscreen VTK render window shows to a PNG file, for screenshots and plots.
+
+#include <filesystem>
+#include <string>
+
+class vtkRenderWindow;
+
+namespace liversim {
+
+// Throws std::runtime_error naming `file` unless an X display is available (VTK aborts the process
+// when it cannot open one; Debian's VTK has no EGL or OSMesa) and the file's folder exists.
+// `action` says what was asked, e.g. "render" or "plot".
+void check_offscreen_png_target(const std::filesystem::path& file, const std::string& action);
+
+// Renders `window` and writes its picture to `file`; on failure removes any partial file and
+// throws std::runtime_error naming it.
+void write_window_png(vtkRenderWindow* window, const std::filesystem::path& file);
+
+}  // namespace liversim
