@@ -295,10 +295,11 @@ int material_test(const MaterialTestOptions& o) {
     }
     if (o.plot_output) {
 #ifdef LIVERSIM_HAVE_RENDER
-      const std::string title = std::string(holds_strain ? "Relaxation" : "Creep") + " under " +
-                                (holds_strain ? "axial strain " + number(o.strain)
-                                              : "nominal stress " + number(o.stress_pa) + " Pa") +
-                                ": simulated vs seed " + quantity.equation;
+      std::string title = holds_strain
+                              ? "Relaxation under axial strain " + number(o.strain)
+                              : "Creep under nominal stress " + number(o.stress_pa) + " Pa";
+      if (parameters.viscoplastic) title += " (yield limit " + number(o.yield_limit_pa) + " Pa)";
+      title += std::string(": simulated vs seed ") + quantity.equation;
       write_curve_plot_png(
           *o.plot_output, title, "time (s)",
           std::string(quantity.name) +

@@ -75,14 +75,16 @@ int main(int argc, char** argv) {
       "default parameters are ASSUMED, not measured: the seed's E = 3500 Pa taken as the "
       "instantaneous modulus E1 + E2 and split 2000 + 1500 Pa, eta1 = 2000 Pa s (tau = 1 s), and "
       "for yield-creep a stress of 1 Pa over a yield limit of 0.5 Pa, eta2 = 500 Pa s^n, n = 0.5");
+  const std::map<std::string, MaterialTest> material_tests{
+      {"relaxation", MaterialTest::relaxation},
+      {"creep", MaterialTest::creep},
+      {"yield-creep", MaterialTest::yield_creep}};
+  std::string material_test_name;
   material_cmd
-      ->add_option("test", material.test,
+      ->add_option("test", material_test_name,
                    "relaxation (Eq. 2), creep (Eq. 3) or yield-creep (Eq. 4)")
       ->required()
-      ->transform(CLI::CheckedTransformer(
-          std::map<std::string, MaterialTest>{{"relaxation", MaterialTest::relaxation},
-                                              {"creep", MaterialTest::creep},
-                                              {"yield-creep", MaterialTest::yield_creep}}));
+      ->check(CLI::IsMember(material_tests));
   material_cmd->add_option("--e1", material.e1_pa, "Maxwell-arm spring E1 (Pa; assumed)")
       ->capture_default_str();
   material_cmd
@@ -130,6 +132,7 @@ int main(int argc, char** argv) {
   if (simulate_cmd->parsed()) return simulate(sim);
   if (screenshot_cmd->parsed()) return screenshot(shot);
   if (material_cmd->parsed()) {
+    material.test = material_tests.at(material_test_name);
     // An option of another test would be silently ignored: say so instead.
     const bool yield_creep = material.test == MaterialTest::yield_creep;
     for (const CLI::Option* option : {yield_option, eta2_option, n_option})
