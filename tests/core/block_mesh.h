@@ -69,4 +69,18 @@ inline std::vector<PointLoad> end_face_tension(const TetMesh& mesh, double sigma
   return loads;
 }
 
+// Mean current coordinate `axis` of the nodes whose rest coordinate `axis` is `rest_value` (a face
+// or cross-section of a box mesh): how the block tests measure elongation and thinning.
+inline double mean_coordinate_on_plane(const TetMesh& mesh, const NodeArray& position, int axis,
+                                       double rest_value) {
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t n = 0; n < mesh.node_count(); ++n)
+    if (std::abs(mesh.rest_position_m.at(n)[axis] - rest_value) < 1e-12) {
+      sum += position.at(n)[axis];
+      ++count;
+    }
+  return sum / count;
+}
+
 }  // namespace liversim::testing

@@ -172,18 +172,10 @@ TEST(StaticBlock, UniaxialTensionMatchesSmallStrainElasticity) {
   ASSERT_LT(residual, 1e-6);
 
   const double strain = sigma / options.regions[0].tissue.youngs_modulus_pa;
-  auto mean_coordinate = [&](int axis, double rest_value) {
-    double sum = 0;
-    int count = 0;
-    for (std::size_t n = 0; n < mesh.node_count(); ++n)
-      if (std::abs(mesh.rest_position_m.at(n)[axis] - rest_value) < 1e-12) {
-        sum += state.position_m.at(n)[axis];
-        ++count;
-      }
-    return sum / count;
-  };
-  const double elongation = mean_coordinate(0, length) - mean_coordinate(0, 0.0);
-  const double thinning = mean_coordinate(1, width) - mean_coordinate(1, 0.0);
+  const double elongation = testing::mean_coordinate_on_plane(mesh, state.position_m, 0, length) -
+                            testing::mean_coordinate_on_plane(mesh, state.position_m, 0, 0.0);
+  const double thinning = testing::mean_coordinate_on_plane(mesh, state.position_m, 1, width) -
+                          testing::mean_coordinate_on_plane(mesh, state.position_m, 1, 0.0);
   EXPECT_NEAR(elongation / length - 1.0, strain, 5 * strain * strain);
   EXPECT_NEAR(thinning / width - 1.0, -options.regions[0].tissue.poisson_ratio * strain,
               5 * strain * strain);

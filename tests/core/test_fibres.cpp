@@ -235,14 +235,7 @@ TEST(Regions, AStiffLesionDeformsTenTimesLessUnderTheSameStress) {
   SimState state = make_rest_state(model);
   for (int i = 0; i < 400; ++i) advance(model, state, StepInputs{loads, {}}, 0.01);
   auto mean_x_at = [&](double rest_x) {
-    double sum = 0.0;
-    int count = 0;
-    for (std::size_t n = 0; n < mesh.node_count(); ++n)
-      if (std::abs(mesh.rest_position_m.x[n] - rest_x) < 1e-12) {
-        sum += state.position_m.x[n];
-        ++count;
-      }
-    return sum / count;
+    return testing::mean_coordinate_on_plane(mesh, state.position_m, 0, rest_x);
   };
   const double soft = mean_x_at(0.5 * length) - mean_x_at(0.0) - 0.5 * length;
   const double stiff = mean_x_at(length) - mean_x_at(0.5 * length) - 0.5 * length;

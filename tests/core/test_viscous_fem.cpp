@@ -76,14 +76,7 @@ double residual_strain_after_pull(const RegionMaterial& material, double sigma_p
   }
   for (int i = 0; i < 4700; ++i) advance(model, state, {}, 0.01);  // 47 s = 20 τc free
   auto mean_x = [&](double rest_x) {
-    double sum = 0.0;
-    int count = 0;
-    for (std::size_t n = 0; n < mesh.node_count(); ++n)
-      if (std::abs(mesh.rest_position_m.x[n] - rest_x) < 1e-12) {
-        sum += state.position_m.x[n];
-        ++count;
-      }
-    return sum / count;
+    return testing::mean_coordinate_on_plane(mesh, state.position_m, 0, rest_x);
   };
   if (mean_plastic_strain) {
     *mean_plastic_strain = 0.0;
