@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -81,6 +82,26 @@ std::vector<Eigen::Vector3d> fibre_directions(const std::vector<Eigen::Vector3d>
   return directions;
 }
 
+void validate_integrator(const IntegratorSettings& settings) {
+  auto fail = [](const std::string& what, double value, const char* expected) {
+    std::ostringstream message;
+    message << "integrator " << what << " = " << value << " is invalid: expected " << expected;
+    throw std::invalid_argument(message.str());
+  };
+  if (!std::isfinite(settings.step_s) || settings.step_s < 0.0)
+    fail("step (s)", settings.step_s, "a finite value >= 0");
+  const bool implicit =
+      settings.kind == IntegratorKind::backward_euler || settings.kind == IntegratorKind::bdf2;
+  if (implicit && settings.step_s == 0.0)
+    fail("step (s)", settings.step_s, "a step > 0 for an implicit scheme");
+  if (!std::isfinite(settings.tolerance_m) || settings.tolerance_m <= 0.0)
+    fail("tolerance (m)", settings.tolerance_m, "a finite value > 0");
+  if (!std::isfinite(settings.newton_tolerance_m) || settings.newton_tolerance_m <= 0.0)
+    fail("Newton tolerance (m)", settings.newton_tolerance_m, "a finite value > 0");
+  if (settings.max_newton_iterations < 1)
+    fail("Newton iteration limit", settings.max_newton_iterations, "at least 1");
+}
+
 }  // namespace
 
 SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
@@ -90,6 +111,7 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
     throw std::invalid_argument("mass damping must be a finite value >= 0 (1/s)");
   if (!(options.stable_step_safety > 0.0 && options.stable_step_safety <= 1.0))
     throw std::invalid_argument("stable step safety factor must be in (0, 1]");
+  validate_integrator(options.integrator);
 
   SimModel model;
   model.node_count = mesh.node_count();
@@ -99,6 +121,7 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   model.regions = options.regions;
   model.mass_damping_per_s = options.mass_damping_per_s;
   model.stable_step_safety = options.stable_step_safety;
+  model.integrator = options.integrator;
 
   const std::size_t tets = model.tet_count;
   for (auto& entry : model.dm_inverse) entry.resize(tets);

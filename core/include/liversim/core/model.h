@@ -45,6 +45,28 @@ struct EffectSet {
   bool mooney_rivlin = false;  // some region has a Mooney–Rivlin I2 term
 };
 
+// Time integrators (facts about each in integrator.h).
+enum class IntegratorKind {
+  central_difference,  // explicit, 2nd order, TLED style (the default)
+  rk4,                 // classical Runge–Kutta, explicit, 4th order (the seed's)
+  dopri5,              // Dormand–Prince 5(4), explicit, adaptive step with error control
+  backward_euler,      // implicit, 1st order, Newton + sparse Cholesky
+  bdf2,                // implicit, 2nd order (BE for its first step and after a step change)
+};
+
+struct IntegratorSettings {
+  IntegratorKind kind = IntegratorKind::central_difference;
+  // Requested step. Explicit schemes take the largest stable step when 0, and shorten a requested
+  // step that is not stable (and report it). Implicit schemes need a step > 0. dopri5 starts from
+  // it and adapts.
+  double step_s = 0.0;
+  // dopri5: tolerated local error per step (m; positions, and velocities times the step).
+  double tolerance_m = 1e-6;
+  // Implicit schemes: Newton stops when no node moves more than this in an iteration.
+  double newton_tolerance_m = 1e-9;
+  int max_newton_iterations = 25;
+};
+
 struct ModelOptions {
   // Region r of the mesh (TetMesh::region) is made of regions[r]; region 0 is the parenchyma.
   std::vector<RegionMaterial> regions{RegionMaterial{}};
@@ -53,6 +75,7 @@ struct ModelOptions {
   std::vector<NodeIndex> fixed_nodes;   // held at their rest position (e.g. ligament attachment)
   double mass_damping_per_s = 8.0;      // Rayleigh mass-proportional damping coefficient α
   double stable_step_safety = 0.8;      // fraction of the central-difference limit actually used
+  IntegratorSettings integrator;
 };
 
 struct SimModel {
@@ -91,6 +114,7 @@ struct SimModel {
   double max_frequency_rad_per_s = 0.0;
   double stable_time_step_s = 0.0;
   double stable_step_safety = 0.8;
+  IntegratorSettings integrator;
   // Smallest element height at rest: no node may travel more than a tenth of it in one step, which
   // keeps fast, large distortions (a yank, an inversion) from jumping past the stiffening.
   double min_element_height_m = 0.0;
@@ -98,7 +122,8 @@ struct SimModel {
 
 // Builds the model. Throws std::invalid_argument naming the problem for an invalid material, a
 // region without a material, a fibre field of the wrong size or with a zero vector, an empty mesh,
-// an inverted or zero-volume element, or a fixed node index out of range.
+// an inverted or zero-volume element, a fixed node index out of range, or integrator settings out
+// of range.
 SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
 
 }  // namespace liversim
