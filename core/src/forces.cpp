@@ -7,13 +7,14 @@
 #include <type_traits>
 
 namespace liversim {
-namespace {
 
-Eigen::Matrix3d dm_inverse_of(const SimModel& model, std::size_t e) {
+Eigen::Matrix3d element_dm_inverse(const SimModel& model, std::size_t e) {
   Eigen::Matrix3d m;
   for (int k = 0; k < 9; ++k) m(k / 3, k % 3) = model.dm_inverse[k][e];
   return m;
 }
+
+namespace {
 
 Eigen::Matrix3d deformed_edges(const SimModel& model, const NodeArray& x, std::size_t e) {
   const auto n0 = model.corner[0][e];
@@ -29,7 +30,7 @@ Eigen::Matrix3d deformed_edges(const SimModel& model, const NodeArray& x, std::s
 
 Eigen::Matrix3d deformation_gradient(const SimModel& model, const NodeArray& position,
                                      std::size_t e) {
-  return deformed_edges(model, position, e) * dm_inverse_of(model, e);
+  return deformed_edges(model, position, e) * element_dm_inverse(model, e);
 }
 
 namespace {
@@ -39,6 +40,7 @@ namespace {
 struct ViscousContext {
   std::vector<ViscousTissueState>* state;
   const std::vector<std::optional<ViscousTissueStep>>* step_by_region;
+  const ViscousArmInputs* arm = nullptr;  // set: the arm is carried by the integrator
 };
 
 // `averaged_volume_ratio` is used only with average nodal pressure (kAveragedPressure).
@@ -48,9 +50,17 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
                           const ViscousContext& viscous) {
   Eigen::Matrix3d P;
   const auto* step = kViscous ? &(*viscous.step_by_region)[model.region[e]] : nullptr;
-  if (kViscous && step->has_value())
-    P = viscous_tissue_update(F, **step, (*viscous.state)[e]);
-  else if (kAveragedPressure)
+  if (kViscous && step->has_value()) {
+    if (viscous.arm) {
+      const ViscousArmInputs& arm = *viscous.arm;
+      const auto r = static_cast<std::size_t>(model.region[e]);
+      P = viscoelastic_stress_rate_form(F, **step, (*viscous.state)[e].inverse_plastic_deformation,
+                                        arm.q_known[e], arm.keep_by_region[r],
+                                        arm.elastic_weight_by_region[r], arm.elastic_stress[e]);
+    } else {
+      P = viscous_tissue_update(F, **step, (*viscous.state)[e]);
+    }
+  } else if (kAveragedPressure)
     P = neo_hookean::first_piola_stress_averaged_pressure(
         F, model.shear_modulus_pa[e], model.lame_lambda_pa[e], averaged_volume_ratio);
   else
@@ -96,7 +106,7 @@ ElasticEvaluation element_forces(const SimModel& model, const NodeArray& positio
                          -std::numeric_limits<double>::infinity(), 0.0};
   auto& corner_scratch = scratch.corner_force_n;
   for (std::size_t e = 0; e < model.tet_count; ++e) {
-    const Eigen::Matrix3d dm_inv = dm_inverse_of(model, e);
+    const Eigen::Matrix3d dm_inv = element_dm_inverse(model, e);
     const Eigen::Matrix3d F = deformed_edges(model, position, e) * dm_inv;
     const double J = F.determinant();
     seen.min_volume_ratio = std::min(seen.min_volume_ratio, J);
@@ -217,6 +227,37 @@ ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state
       model, state.position_m, state.force_scratch, {&state.viscous_state, &state.viscous_step});
   gather_corner_forces(model, state.force_scratch, state.force_n);
   return seen;
+}
+
+ElasticEvaluation compute_internal_forces_rate_form(const SimModel& model, SimState& state,
+                                                    const NodeArray& position,
+                                                    const ViscousArmInputs& arm, NodeArray& force) {
+  if (!model.effects.viscous)
+    return compute_elastic_forces(model, position, state.force_scratch, force);
+  // The rate form needs only the step's moduli, not its length.
+  for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
+    if (model.viscous_parameters[r] && !state.viscous_step[r])
+      state.viscous_step[r].emplace(*model.viscous_parameters[r], 0.0);
+  const ElasticEvaluation seen = element_forces_for_effects<true>(
+      model, position, state.force_scratch, {&state.viscous_state, &state.viscous_step, &arm});
+  gather_corner_forces(model, state.force_scratch, force);
+  return seen;
+}
+
+Eigen::Matrix<double, 9, 9> element_step_tangent(const SimModel& model, const SimState& state,
+                                                 const ViscousArmInputs& arm, std::size_t e,
+                                                 const Eigen::Matrix3d& F) {
+  const auto r = static_cast<std::size_t>(model.region[e]);
+  if (model.effects.viscous && model.viscous_parameters[r] && state.viscous_step[r]) {
+    Eigen::Matrix<double, 9, 9> tangent = viscoelastic_stress_tangent_rate_form(
+        F, *state.viscous_step[r], state.viscous_state[e].inverse_plastic_deformation,
+        arm.q_known[e], arm.keep_by_region[r], arm.elastic_weight_by_region[r]);
+    if (model.effects.fibres)
+      for (const auto& family : model.fibre_direction)
+        tangent += hgo::stress_tangent(F, family[e], model.fibre_parameters[e]);
+    return tangent;
+  }
+  return element_stress_tangent(model, e, F);
 }
 
 void add_external_forces(const StepInputs& inputs, const NodeArray& position, NodeArray& force) {

@@ -1,5 +1,7 @@
 #include "liversim/core/integrator.h"
 
+#include "integrator_internal.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -25,7 +27,8 @@ ElasticEvaluation evaluate_forces(const SimModel& model, SimState& state,
 void kick_drift(const SimModel& model, SimState& state, const StepInputs& inputs, double dt_s) {
   // With a changing step the velocity lives at the midpoints, so the kick spans half of the last
   // step and half of this one; kicking by Δt alone would pump energy whenever the step changes.
-  const double kick_s = state.last_step_s > 0.0 ? 0.5 * (state.last_step_s + dt_s) : dt_s;
+  // The first step starts from v(t₀) (what a user sets), so it kicks by half a step only.
+  const double kick_s = 0.5 * (state.last_step_s + dt_s);
   auto& x = state.position_m;
   auto& v = state.velocity_m_per_s;
   const auto& f = state.force_n;
@@ -142,15 +145,19 @@ void accumulate(StepReport& total, const StepReport& part) {
         std::isnan(part.error_estimate_m) ? total.error_estimate_m : part.error_estimate_m;
 }
 
-double stable_time_step_s(const SimModel& model, const StepInputs& inputs, double stiffening) {
+double max_frequency_rad_per_s(const SimModel& model, const StepInputs& inputs, double stiffening) {
   double max_spring_omega_sq = 0.0;
   for (const auto& spring : inputs.springs) {
     max_spring_omega_sq = std::max(
         max_spring_omega_sq, spring.stiffness_n_per_m * model.inverse_mass_per_kg[spring.node]);
   }
-  const double omega = std::sqrt(model.max_frequency_rad_per_s * model.max_frequency_rad_per_s *
-                                     std::max(1.0, stiffening) +
-                                 max_spring_omega_sq);
+  return std::sqrt(model.max_frequency_rad_per_s * model.max_frequency_rad_per_s *
+                       std::max(1.0, stiffening) +
+                   max_spring_omega_sq);
+}
+
+double stable_time_step_s(const SimModel& model, const StepInputs& inputs, double stiffening) {
+  const double omega = max_frequency_rad_per_s(model, inputs, stiffening);
   if (!(omega > 0.0)) return std::numeric_limits<double>::infinity();
   const double xi = model.mass_damping_per_s / (2.0 * omega);
   return model.stable_step_safety * (2.0 / omega) * (std::sqrt(1.0 + xi * xi) - xi);
@@ -174,27 +181,233 @@ double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& see
   return stiffening;
 }
 
+namespace detail {
+
+double explicit_step_limit_s(const SimModel& model, const StepInputs& inputs, double stiffening,
+                             IntegratorKind kind) {
+  if (kind == IntegratorKind::central_difference)
+    return stable_time_step_s(model, inputs, stiffening);
+  const double omega = max_frequency_rad_per_s(model, inputs, stiffening);
+  double limit =
+      omega > 0.0 ? stability_interval(kind) / omega : std::numeric_limits<double>::infinity();
+  // Damping is explicit in Runge–Kutta: a decay rate d needs d·Δt inside the real-axis
+  // interval (RK4 2.785, Dormand–Prince 3.31; checked from the tableaus).
+  double decay_per_s = model.mass_damping_per_s;
+  for (const auto& spring : inputs.springs)
+    decay_per_s = std::max(decay_per_s,
+                           model.mass_damping_per_s +
+                               spring.damping_n_s_per_m * model.inverse_mass_per_kg[spring.node]);
+  const double real_interval = kind == IntegratorKind::rk4 ? 2.785 : 3.31;
+  if (decay_per_s > 0.0) limit = std::min(limit, real_interval / decay_per_s);
+  return model.stable_step_safety * limit;
+}
+
+double history_error_estimate(const SimModel& model, IntegratorScratch& scratch,
+                              const NodeArray& velocity, double dt_s, IntegratorKind kind) {
+  // Local position error C·Δt^(p+1)·x^(p+1) ≈ C·Δt·|Δᵖv| with Δᵖ the p-th backward difference of
+  // the end-of-step velocity; C is the scheme's error constant: backward Euler ½, BDF2 2/9,
+  // central difference (Störmer–Verlet, p counted on positions: Δt⁴x⁗/12) 1/12 with Δ³v.
+  int differences = 0;
+  double constant = 0.0;
+  switch (kind) {
+    case IntegratorKind::backward_euler:
+      differences = 1, constant = 0.5;
+      break;
+    case IntegratorKind::bdf2:
+      differences = 2, constant = 2.0 / 9.0;
+      break;
+    case IntegratorKind::central_difference:
+      differences = 3, constant = 1.0 / 12.0;
+      break;
+    default:
+      return std::numeric_limits<double>::quiet_NaN();
+  }
+  const bool same_step = std::abs(dt_s - scratch.history_step_s) <= 1e-9 * dt_s;
+  if (!same_step) scratch.history_count = 0;
+  double estimate = std::numeric_limits<double>::quiet_NaN();
+  auto& h = scratch.velocity_history;  // h[0] the previous step's, h[1] the one before, ...
+  if (scratch.history_count >= differences) {
+    // Binomial weights of Δᵏ: (1, −1), (1, −2, 1), (1, −3, 3, −1).
+    static constexpr double kWeights[3][3] = {{-1, 0, 0}, {-2, 1, 0}, {-3, 3, -1}};
+    const double* w = kWeights[differences - 1];
+    double largest_sq = 0.0;
+    for (std::size_t n = 0; n < model.node_count; ++n) {
+      if (model.inverse_mass_per_kg[n] == 0.0) continue;
+      double dx = velocity.x[n], dy = velocity.y[n], dz = velocity.z[n];
+      for (int k = 0; k < differences; ++k) {
+        dx += w[k] * h[k].x[n];
+        dy += w[k] * h[k].y[n];
+        dz += w[k] * h[k].z[n];
+      }
+      largest_sq = std::max(largest_sq, dx * dx + dy * dy + dz * dz);
+    }
+    estimate = constant * dt_s * std::sqrt(largest_sq);
+  }
+  std::rotate(h.begin(), h.end() - 1, h.end());  // swaps buffers; no allocation
+  h[0].x = velocity.x;
+  h[0].y = velocity.y;
+  h[0].z = velocity.z;
+  scratch.history_count = std::min(scratch.history_count + 1, 3);
+  scratch.history_step_s = dt_s;
+  return estimate;
+}
+
+void prepare_integrator_scratch(const SimModel& model, IntegratorScratch& scratch) {
+  const std::size_t n = model.node_count;
+  const IntegratorKind kind = model.integrator.kind;
+  for (auto& history : scratch.velocity_history) history.resize(n);
+  const std::size_t arm_count = model.effects.viscous ? model.tet_count : 0;
+  // The arm as an explicit stage reads it: Q = 1·q + 0·S_e (implicit steps set their own).
+  scratch.keep_by_region.assign(model.regions.size(), 1.0);
+  scratch.elastic_weight_by_region.assign(model.regions.size(), 0.0);
+  if (kind == IntegratorKind::rk4 || kind == IntegratorKind::dopri5) {
+    const int stages = kind == IntegratorKind::rk4 ? 4 : 7;
+    scratch.start_position_m.resize(n);
+    scratch.start_velocity_m_per_s.resize(n);
+    scratch.stage_position_m.resize(n);
+    scratch.stage_velocity_m_per_s.resize(n);
+    scratch.position_rate.assign(stages + 1, NodeArray{});  // + the next step's first (FSAL)
+    scratch.velocity_rate.assign(stages + 1, NodeArray{});
+    for (auto& rate : scratch.position_rate) rate.resize(n);
+    for (auto& rate : scratch.velocity_rate) rate.resize(n);
+    scratch.start_arm.assign(arm_count, Voigt6{});
+    scratch.stage_arm.assign(arm_count, Voigt6{});
+    scratch.elastic_stress.assign(arm_count, Voigt6{});
+    scratch.arm_rate.assign(stages + 1, std::vector<Voigt6>(arm_count));
+  }
+  if (!is_explicit(kind)) {
+    scratch.previous_position_m.resize(n);
+    scratch.previous_velocity_m_per_s.resize(n);
+    scratch.predicted_position_m.resize(n);
+    scratch.predicted_velocity_m_per_s.resize(n);
+    scratch.start_arm.assign(arm_count, Voigt6{});
+    scratch.stage_arm.assign(arm_count, Voigt6{});
+    scratch.previous_arm.assign(arm_count, Voigt6{});
+    scratch.predicted_arm.assign(arm_count, Voigt6{});
+    scratch.elastic_stress.assign(arm_count, Voigt6{});
+    prepare_implicit_solver(model, scratch.implicit);
+  }
+}
+
+void add_input_forces(const StepInputs& inputs, const NodeArray& position,
+                      const NodeArray& velocity, NodeArray& force) {
+  add_external_forces(inputs, position, force);
+  for (const auto& spring : inputs.springs) {
+    const auto n = spring.node;
+    force.x[n] -= spring.damping_n_s_per_m * velocity.x[n];
+    force.y[n] -= spring.damping_n_s_per_m * velocity.y[n];
+    force.z[n] -= spring.damping_n_s_per_m * velocity.z[n];
+  }
+}
+
+void acceleration_from_force(const SimModel& model, const NodeArray& force,
+                             const NodeArray& velocity, NodeArray& acceleration) {
+  const double alpha = model.mass_damping_per_s;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    const double w = model.inverse_mass_per_kg[n];
+    acceleration.x[n] = w == 0.0 ? 0.0 : w * force.x[n] - alpha * velocity.x[n];
+    acceleration.y[n] = w == 0.0 ? 0.0 : w * force.y[n] - alpha * velocity.y[n];
+    acceleration.z[n] = w == 0.0 ? 0.0 : w * force.z[n] - alpha * velocity.z[n];
+  }
+}
+
+void arm_of_committed_state(const SimModel& model, const SimState& state,
+                            std::vector<Voigt6>& arm) {
+  if (!model.effects.viscous) return;
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    if (!model.viscous_parameters[static_cast<std::size_t>(model.region[e])]) continue;
+    const ViscousTissueState& committed = state.viscous_state[e];
+    for (int k = 0; k < 6; ++k)
+      arm[e][k] = committed.elastic_stress_pa[k] - committed.maxwell_stress_pa[k];
+  }
+}
+
+void commit_arm(const SimModel& model, SimState& state, const NodeArray& position,
+                const std::vector<Voigt6>& arm, double dt_s) {
+  if (!model.effects.viscous) return;
+  for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
+    if (model.viscous_parameters[r])
+      state.viscous_step[r] =
+          ViscousTissueStep::plastic_flow_only(*model.viscous_parameters[r], dt_s);
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const auto r = static_cast<std::size_t>(model.region[e]);
+    if (!model.viscous_parameters[r]) continue;
+    const ViscousTissueStep& step = *state.viscous_step[r];
+    ViscousTissueState& committed = state.viscous_state[e];
+    const Eigen::Matrix3d F = deformation_gradient(model, position, e);
+    Voigt6 elastic;
+    viscoelastic_stress_rate_form(F, step, committed.inverse_plastic_deformation, arm[e], 1.0, 0.0,
+                                  elastic);
+    for (int k = 0; k < 6; ++k) {
+      committed.elastic_stress_pa[k] = elastic[k];
+      committed.maxwell_stress_pa[k] = elastic[k] - arm[e][k];
+    }
+    // Plastic flow after the step, the arm's Q held (g = h = 1): first order in the flow, exact
+    // under a held stress as the seed's Eq. 4.
+    if (step.viscoplastic) viscous_tissue_update(F, step, committed);
+  }
+}
+
+}  // namespace detail
+
+namespace {
+
+void advance_central_difference(const SimModel& model, SimState& state, const StepInputs& inputs,
+                                double interval_s, StepReport& report) {
+  const double requested_s = model.integrator.step_s;
+  double remaining = interval_s;
+  while (remaining > 0.0) {
+    const double stiffening = stiffening_since_rest(model, evaluate_forces(model, state, inputs));
+    ++report.force_evaluations;
+    report.max_stiffening = std::max(report.max_stiffening, stiffening);
+    double limit = stable_time_step_s(model, inputs, stiffening);
+    if (state.max_speed_m_per_s > 0.0)
+      limit = std::min(limit, 0.1 * model.min_element_height_m / state.max_speed_m_per_s);
+    double step = limit;
+    if (requested_s > 0.0) {
+      step = std::min(requested_s, limit);
+      if (limit < requested_s) {
+        report.smallest_stable_step_s = report.stability_limited_steps > 0
+                                            ? std::min(report.smallest_stable_step_s, limit)
+                                            : limit;
+        ++report.stability_limited_steps;
+      }
+    }
+    // Equal steps over what is left, so the interval ends exactly where asked.
+    const double steps_left = detail::steps_to_cover(remaining, step);
+    const double dt = steps_left <= 1.0 ? remaining : remaining / steps_left;
+    kick_drift(model, state, inputs, dt);
+    detail::note_error_estimate(
+        report, detail::history_error_estimate(model, state.integrator, state.velocity_m_per_s, dt,
+                                               IntegratorKind::central_difference));
+    remaining = steps_left <= 1.0 ? 0.0 : remaining - dt;
+    ++report.substeps;
+    report.smallest_substep_s = std::min(report.smallest_substep_s, dt);
+    report.largest_substep_s = std::max(report.largest_substep_s, dt);
+  }
+}
+
+}  // namespace
+
 StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
                    double interval_s) {
   StepReport report;
   if (!(interval_s > 0.0)) return report;
   report.smallest_substep_s = interval_s;
+  report.error_estimate_m = std::numeric_limits<double>::quiet_NaN();
   const double end_time = state.time_s + interval_s;
-  double remaining = interval_s;
-  while (remaining > 0.0) {
-    const double stiffening = stiffening_since_rest(model, evaluate_forces(model, state, inputs));
-    report.max_stiffening = std::max(report.max_stiffening, stiffening);
-    double limit = stable_time_step_s(model, inputs, stiffening);
-    if (state.max_speed_m_per_s > 0.0)
-      limit = std::min(limit, 0.1 * model.min_element_height_m / state.max_speed_m_per_s);
-    // Equal steps over what is left, so the interval ends exactly where asked.
-    const double steps_left = std::ceil(remaining / limit);
-    const double dt = steps_left <= 1.0 ? remaining : remaining / steps_left;
-    kick_drift(model, state, inputs, dt);
-    remaining = steps_left <= 1.0 ? 0.0 : remaining - dt;
-    ++report.substeps;
-    report.smallest_substep_s = std::min(report.smallest_substep_s, dt);
-    report.largest_substep_s = std::max(report.largest_substep_s, dt);
+  switch (model.integrator.kind) {
+    case IntegratorKind::central_difference:
+      advance_central_difference(model, state, inputs, interval_s, report);
+      break;
+    case IntegratorKind::rk4:
+    case IntegratorKind::dopri5:
+      detail::advance_runge_kutta(model, state, inputs, interval_s, report);
+      break;
+    case IntegratorKind::backward_euler:
+    case IntegratorKind::bdf2:
+      detail::advance_implicit(model, state, inputs, interval_s, report);
+      break;
   }
   state.time_s = end_time;  // no drift from summing substeps
   return report;

@@ -1,5 +1,7 @@
 #include "liversim/core/state.h"
 
+#include "integrator_internal.h"
+
 namespace liversim {
 
 ForceScratch make_force_scratch(const SimModel& model) {
@@ -23,6 +25,7 @@ SimState make_rest_state(const SimModel& model) {
     state.viscous_state.resize(model.tet_count);
     state.viscous_step.resize(model.viscous_parameters.size());
   }
+  detail::prepare_integrator_scratch(model, state.integrator);
   return state;
 }
 

@@ -114,6 +114,59 @@ ViscousTissueStep::ViscousTissueStep(const ViscousTissueParameters& parameters, 
   step_shear_modulus_pa = (relaxed_fraction + arm_fraction * arm_loading) * mu_instant_pa;
 }
 
+ViscousTissueStep ViscousTissueStep::plastic_flow_only(const ViscousTissueParameters& parameters,
+                                                       double dt_s) {
+  ViscousTissueStep step(parameters, dt_s);
+  step.arm_decay = 1.0;
+  step.arm_loading = 1.0;
+  step.step_shear_modulus_pa = step.mu_instant_pa;  // both springs carry the flow's unloading
+  return step;
+}
+
+Eigen::Matrix3d viscoelastic_stress_rate_form(const Eigen::Matrix3d& F,
+                                              const ViscousTissueStep& step,
+                                              const Eigen::Matrix3d& fp_inverse,
+                                              const Voigt6& q_known, double keep,
+                                              double elastic_weight, Voigt6& elastic_stress) {
+  const Eigen::Matrix3d fe = F * fp_inverse;
+  const Eigen::Matrix3d cof = cofactor(fe);
+  const double J = fe.col(0).dot(cof.col(0));
+  const Eigen::Matrix3d q = from_voigt(q_known);
+  const Eigen::Matrix3d p_elastic =
+      neo_hookean::first_piola_stress(fe, step.mu_instant_pa, step.lambda_instant_pa);
+  if (!(J >= neo_hookean::kMinVolumeRatio)) {
+    // S_e is unbounded as J → 0: freeze the arm, keep P finite through the continuation.
+    elastic_stress = q_known;
+    return (p_elastic - step.arm_fraction * fe * q) * fp_inverse.transpose();
+  }
+  const Eigen::Matrix3d elastic = symmetric_part((cof.transpose() / J) * p_elastic);
+  elastic_stress = to_voigt(elastic);
+  // S̄ = S_e − g1·(keep·Q + w·S_e), P = Fe·S̄·Fp⁻ᵀ.
+  const double g1 = step.arm_fraction;
+  return ((1.0 - g1 * elastic_weight) * p_elastic - g1 * keep * fe * q) * fp_inverse.transpose();
+}
+
+Eigen::Matrix<double, 9, 9> viscoelastic_stress_tangent_rate_form(
+    const Eigen::Matrix3d& F, const ViscousTissueStep& step, const Eigen::Matrix3d& fp_inverse,
+    const Voigt6& q_known, double keep, double elastic_weight) {
+  const Eigen::Matrix3d fe = F * fp_inverse;
+  const bool collapsed = !(fe.determinant() >= neo_hookean::kMinVolumeRatio);
+  const double elastic_scale = collapsed ? 1.0 : 1.0 - step.arm_fraction * elastic_weight;
+  if (collapsed) keep = 1.0;  // the frozen arm, as in the stress
+  // Row-major flattening: vec(A·B) = (I ⊗ Bᵀ)·vec(A) and vec(A·B) = (A ⊗ I)·vec(B).
+  auto right_factor = [](const Eigen::Matrix3d& b) {
+    Eigen::Matrix<double, 9, 9> m = Eigen::Matrix<double, 9, 9>::Zero();
+    for (int i = 0; i < 3; ++i) m.block<3, 3>(3 * i, 3 * i) = b.transpose();
+    return m;
+  };
+  // P = c·P_e(F·Fp⁻¹)·Fp⁻ᵀ − g1·keep·F·(Fp⁻¹·Q·Fp⁻ᵀ).
+  const Eigen::Matrix<double, 9, 9> elastic =
+      neo_hookean::stress_tangent(fe, step.mu_instant_pa, step.lambda_instant_pa);
+  const Eigen::Matrix3d w = fp_inverse * from_voigt(q_known) * fp_inverse.transpose();
+  return elastic_scale * right_factor(fp_inverse.transpose()) * elastic * right_factor(fp_inverse) -
+         step.arm_fraction * keep * right_factor(w);
+}
+
 Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
                                       const ViscousTissueState& committed,
                                       ViscousTissueState& trial) {

@@ -69,6 +69,28 @@ TEST_F(SteppingFixture, AdvanceAllocatesNothing) {
   EXPECT_GT(report.substeps, 1);
 }
 
+// Every integrator, viscous arm and sparse factorisation included, steps without allocating.
+TEST_F(SteppingFixture, EveryIntegratorAdvancesWithoutAllocating) {
+  for (IntegratorKind kind : kAllIntegrators) {
+    ModelOptions options;
+    options.fixed_nodes = mesh_->node_sets.at("ligament");
+    options.regions[0].tissue = TissueMaterial{3500.0, 0.45, 1060.0};
+    options.regions[0].viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
+    options.regions[0].viscoplastic = ViscoplasticParameters{50.0, 500.0, 0.5};
+    options.integrator.kind = kind;
+    options.integrator.step_s = is_explicit(kind) ? 0.0 : 0.002;
+    const SimModel model = build_model(*mesh_, options);
+    SimState state = make_rest_state(model);
+    const std::vector<PointLoad> loads{{anterior_marked_node(*mesh_), {0.0, 0.05, 0.0}}};
+    const StepInputs inputs{loads, {}};
+    advance(model, state, inputs, 0.004);  // warm-up
+    const long before = g_allocations.load();
+    const StepReport report = advance(model, state, inputs, 0.01);
+    EXPECT_EQ(g_allocations.load() - before, 0) << integrator_name(kind);
+    EXPECT_GT(report.substeps, 0);
+  }
+}
+
 TEST_F(SteppingFixture, RealtimeLoopFollowsTheDragAndAllocatesNothingWhileRunning) {
   RealtimeSimulation simulation(model_, make_rest_state(*model_));
   const BoundarySurface surface = extract_surface(*mesh_);

@@ -50,6 +50,32 @@ ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray&
 ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state,
                                           double dt_since_last_s);
 
+// The Maxwell arm of viscous elements as carried by an integrator (viscoelastic_stress_rate_form):
+// Q at the evaluation is keep·q_known + elastic_weight·S_e, the weights per region.
+struct ViscousArmInputs {
+  std::span<const Voigt6> q_known;  // per element (read for viscous elements only)
+  std::span<const double> keep_by_region;
+  std::span<const double> elastic_weight_by_region;
+  std::span<Voigt6> elastic_stress;  // out: S_e per element
+};
+
+// Internal forces at `position` with the viscous arm given by `arm` (plastic deformation as
+// committed in state.viscous_state); scratch from `state`. The committed viscous state is not
+// changed. Without viscous regions this is compute_elastic_forces. Allocates nothing.
+ElasticEvaluation compute_internal_forces_rate_form(const SimModel& model, SimState& state,
+                                                    const NodeArray& position,
+                                                    const ViscousArmInputs& arm, NodeArray& force);
+
+// ∂P/∂F of element e at F for an implicit step: the element's elastic tangent, or for a viscous
+// element the rate-form tangent with the arm weights of `arm` (the average nodal pressure is not
+// differentiated: its elements get their own-pressure tangent, so Newton is inexact there).
+Eigen::Matrix<double, 9, 9> element_step_tangent(const SimModel& model, const SimState& state,
+                                                 const ViscousArmInputs& arm, std::size_t e,
+                                                 const Eigen::Matrix3d& F);
+
+// Dm⁻¹ of element e: its rows are the reference gradients of the shape functions of corners 1–3.
+Eigen::Matrix3d element_dm_inverse(const SimModel& model, std::size_t e);
+
 // Strain energy density and first Piola–Kirchhoff stress of element e at deformation F (the
 // instantaneous elastic response for viscous regions, whose E is E1 + E2).
 double element_energy_density(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F);

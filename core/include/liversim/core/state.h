@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -19,9 +20,54 @@ struct ForceScratch {
 };
 ForceScratch make_force_scratch(const SimModel& model);
 
+class ImplicitSolver;  // sparse tangent and factorisation of the implicit schemes (integrator.cpp)
+
+// Owns an ImplicitSolver. A copy starts without one and sets it up again on its first implicit
+// step (a factorisation cannot be shared between states).
+class ImplicitSolverHandle {
+ public:
+  ImplicitSolverHandle();
+  ImplicitSolverHandle(const ImplicitSolverHandle&);
+  ImplicitSolverHandle& operator=(const ImplicitSolverHandle&);
+  ImplicitSolverHandle(ImplicitSolverHandle&&) noexcept;
+  ImplicitSolverHandle& operator=(ImplicitSolverHandle&&) noexcept;
+  ~ImplicitSolverHandle();
+  std::unique_ptr<ImplicitSolver> solver;
+};
+
+// Scratch of the integrators other than central difference, sized once for the model's scheme.
+struct IntegratorScratch {
+  // Runge–Kutta: the state at the start of the step, a stage's state, and the rates of each stage
+  // (velocity; acceleration; Q̇ of the Maxwell arm of viscous elements).
+  NodeArray start_position_m, start_velocity_m_per_s, stage_position_m, stage_velocity_m_per_s;
+  std::vector<NodeArray> position_rate, velocity_rate;
+  std::vector<Voigt6> start_arm, stage_arm, elastic_stress;
+  std::vector<std::vector<Voigt6>> arm_rate;
+  bool first_rate_valid = false;       // stage 1 already holds the rate at the state (FSAL)
+  double first_rate_stiffening = 1.0;  // what stage 1's evaluation saw
+  double adaptive_step_s = 0.0;        // dopri5: the step the error control proposes next
+  // RK4's embedded error needs the rate at the end of its step: the step's last stage, kept
+  // until the next step's first stage gives it.
+  bool error_pending = false;
+  double error_pending_step_s = 0.0;
+  // Error estimate of the fixed-step schemes: the velocity at the end of the last steps.
+  std::array<NodeArray, 3> velocity_history;
+  int history_count = 0;
+  double history_step_s = 0.0;
+  // Implicit schemes: the previous step (BDF2), Newton's residual and correction, arm weights.
+  NodeArray previous_position_m, previous_velocity_m_per_s, predicted_position_m,
+      predicted_velocity_m_per_s;
+  std::vector<Voigt6> previous_arm, predicted_arm;
+  bool has_previous = false;
+  double previous_step_s = 0.0;
+  std::vector<double> keep_by_region, elastic_weight_by_region;
+  ImplicitSolverHandle implicit;
+};
+
 struct SimState {
   NodeArray position_m;
-  // Leapfrog velocity, half a step behind the next position update (v at t − Δt/2).
+  // Central difference: the leapfrog velocity, half a step behind the next position update
+  // (v at t − Δt/2). Other schemes: the velocity at time_s.
   NodeArray velocity_m_per_s;
   NodeArray force_n;  // total nodal force of the last evaluation
   ForceScratch force_scratch;
@@ -32,6 +78,7 @@ struct SimState {
   // when the model's effects.viscous), and the per-region step constants (scratch).
   std::vector<ViscousTissueState> viscous_state;
   std::vector<std::optional<ViscousTissueStep>> viscous_step;
+  IntegratorScratch integrator;
   double time_s = 0.0;
   std::uint64_t step_count = 0;
 };

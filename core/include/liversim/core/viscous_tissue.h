@@ -69,7 +69,16 @@ struct ViscousTissueStep {
   double arm_loading;            // h = (1 − g)/(Δt/τ): weight of this step's elastic increment
   double step_shear_modulus_pa;  // (g0 + g1·h)·μ: shear stiffness of the response within the step
   std::optional<ViscoplasticParameters> viscoplastic;
+
+  // A step whose Maxwell arm follows the elastic stress without relaxing (g = h = 1): plastic
+  // flow alone over dt_s, for integrators that advance the arm in their own state (see
+  // viscoelastic_stress_rate_form) and apply the flow after each step.
+  static ViscousTissueStep plastic_flow_only(const ViscousTissueParameters& parameters,
+                                             double dt_s);
 };
+
+// Symmetric tensor in Voigt order (xx, yy, zz, yz, xz, xy).
+using Voigt6 = std::array<double, 6>;
 
 // History of one element, committed once per step. Its tensors live in the intermediate
 // configuration of F = Fe·Fp (unloaded, plastically deformed), so a rigid rotation of the
@@ -98,6 +107,27 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
 // viscous_tissue_stress, committing the step into `state`.
 Eigen::Matrix3d viscous_tissue_update(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
                                       ViscousTissueState& state);
+
+// The Maxwell arm as an ODE, for integrators that carry it in their own state (Runge–Kutta stages,
+// implicit solves), so that it advances with the scheme's own order. With Q = S_e − H (H the arm
+// variable above): Q̇ = (S_e(F_e) − Q)/τ and S̄ = S_e − g1·Q. No strain rate is needed, and the
+// exponential update above is this ODE's exact solution for S_e linear in time.
+//
+// The arm's Q at the evaluation is keep·q_known + elastic_weight·S_e(F_e): (1, 0) for an explicit
+// stage at q_known; (1/(1+θ), θ/(1+θ)) for an implicit step, θ = β/τ, q_known the predictor (Q_n
+// for backward Euler). Fp is held at `fp_inverse`. Writes S_e to `elastic_stress` (for the rate
+// and the commit) and returns P. Below J = neo_hookean::kMinVolumeRatio the arm is frozen (Q as
+// known, S_e reported as Q so that Q̇ = 0), as the incremental update does. Allocates nothing.
+Eigen::Matrix3d viscoelastic_stress_rate_form(const Eigen::Matrix3d& F,
+                                              const ViscousTissueStep& step,
+                                              const Eigen::Matrix3d& fp_inverse,
+                                              const Voigt6& q_known, double keep,
+                                              double elastic_weight, Voigt6& elastic_stress);
+
+// ∂P/∂F of viscoelastic_stress_rate_form at the same arguments, 9×9 over row-major indices.
+Eigen::Matrix<double, 9, 9> viscoelastic_stress_tangent_rate_form(
+    const Eigen::Matrix3d& F, const ViscousTissueStep& step, const Eigen::Matrix3d& fp_inverse,
+    const Voigt6& q_known, double keep, double elastic_weight);
 
 // A homogeneous material point under uniaxial stress: F = diag(λ_axial, λ_lateral, λ_lateral),
 // the lateral stretch solved by Newton's method so that the lateral stresses vanish. For

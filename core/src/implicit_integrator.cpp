@@ -1,0 +1,325 @@
+// Implicit schemes: backward Euler and BDF2 on M·v̇ = f(x, Q, v) − αM·v, ẋ = v, solved for the
+// end-of-step positions by Newton's method with the sparse tangent in a fixed pattern and a
+// sparse LDLᵀ factorisation (symbolic analysis once per state).
+//
+// Both schemes read  x₁ = x̂ + β·v₁,  v₁ = v̂ + β·a₁  with β = Δt, x̂ = xₙ, v̂ = vₙ for backward Euler
+// and β = 2Δt/3, x̂ = (4xₙ − xₙ₋₁)/3, v̂ = (4vₙ − vₙ₋₁)/3 for BDF2, so Newton solves
+//   r(x₁) = M·(v₁ − v̂)/β + αM·v₁ − f(x₁, v₁) = 0,  v₁ = (x₁ − x̂)/β,
+// with Jacobian M/β² + (αM + C)/β + K. The Maxwell arm follows the same rule in closed form per
+// element: Q₁ = (Q̂ + θ·S_e(x₁))/(1 + θ), θ = β/τ.
+
+#include "integrator_internal.h"
+
+#include "sparse_ldlt.h"
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCore>
+
+#include <limits>
+
+namespace liversim {
+
+class ImplicitSolver {
+ public:
+  explicit ImplicitSolver(const SimModel& model);
+
+  // The Newton matrix, upper triangle in compressed columns, in a fill-reducing (AMD) order of
+  // the unknowns; fixed degrees of freedom keep only a unit diagonal.
+  Eigen::SparseMatrix<double> matrix;
+  // Per element, the value index of each of its 12×12 entries that lands in the upper triangle
+  // (−1: its transpose does, or a fixed degree of freedom).
+  std::vector<int> element_entry;
+  std::vector<int> diagonal_entry;  // per degree of freedom 3·node + axis
+  std::vector<int> ordered_index;   // position of each degree of freedom in the factorised order
+  detail::SparseLdlt factorisation;
+  std::vector<double> rhs, ordered_rhs;
+  NodeArray force;
+};
+
+ImplicitSolver::ImplicitSolver(const SimModel& model) {
+  const auto dofs = static_cast<int>(3 * model.node_count);
+  auto dof = [&](std::size_t e, int local) {
+    return 3 * static_cast<int>(model.corner[local / 3][e]) + local % 3;
+  };
+  auto free = [&](int d) { return !model.is_fixed[static_cast<std::size_t>(d / 3)]; };
+
+  // Fill-reducing order from the symmetric pattern.
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(model.tet_count * 144 + static_cast<std::size_t>(dofs));
+  for (int d = 0; d < dofs; ++d) triplets.emplace_back(d, d, 1.0);
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    for (int i = 0; i < 12; ++i)
+      for (int j = 0; j < 12; ++j)
+        if (free(dof(e, i)) && free(dof(e, j))) triplets.emplace_back(dof(e, i), dof(e, j), 1.0);
+  Eigen::SparseMatrix<double> pattern(dofs, dofs);
+  pattern.setFromTriplets(triplets.begin(), triplets.end());
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse_order;
+  Eigen::AMDOrdering<int>()(pattern.selfadjointView<Eigen::Lower>(), inverse_order);
+  const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order =
+      inverse_order.inverse();
+  ordered_index.assign(order.indices().data(), order.indices().data() + dofs);
+
+  for (auto& t : triplets) {
+    const int r = ordered_index[static_cast<std::size_t>(t.row())];
+    const int c = ordered_index[static_cast<std::size_t>(t.col())];
+    t = Eigen::Triplet<double>(std::min(r, c), std::max(r, c), 0.0);
+  }
+  matrix.resize(dofs, dofs);
+  matrix.setFromTriplets(triplets.begin(), triplets.end());
+  matrix.makeCompressed();
+
+  auto entry_of = [&](int row, int col) {
+    const int* begin = matrix.innerIndexPtr() + matrix.outerIndexPtr()[col];
+    const int* end = matrix.innerIndexPtr() + matrix.outerIndexPtr()[col + 1];
+    const int* found = std::lower_bound(begin, end, row);
+    return found != end && *found == row ? static_cast<int>(found - matrix.innerIndexPtr()) : -1;
+  };
+  element_entry.assign(model.tet_count * 144, -1);
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    for (int i = 0; i < 12; ++i)
+      for (int j = 0; j < 12; ++j) {
+        if (!free(dof(e, i)) || !free(dof(e, j))) continue;
+        const int row = ordered_index[static_cast<std::size_t>(dof(e, i))];
+        const int col = ordered_index[static_cast<std::size_t>(dof(e, j))];
+        if (row <= col)
+          element_entry[e * 144 + static_cast<std::size_t>(i * 12 + j)] = entry_of(row, col);
+      }
+  diagonal_entry.resize(static_cast<std::size_t>(dofs));
+  for (int d = 0; d < dofs; ++d) {
+    const int at = ordered_index[static_cast<std::size_t>(d)];
+    diagonal_entry[static_cast<std::size_t>(d)] = entry_of(at, at);
+  }
+  const std::span<const int> columns(matrix.outerIndexPtr(), static_cast<std::size_t>(dofs) + 1);
+  const std::span<const int> rows(matrix.innerIndexPtr(),
+                                  static_cast<std::size_t>(matrix.nonZeros()));
+  factorisation.analyse(columns, rows);
+  rhs.resize(static_cast<std::size_t>(dofs));
+  ordered_rhs.resize(static_cast<std::size_t>(dofs));
+  force.resize(model.node_count);
+}
+
+ImplicitSolverHandle::ImplicitSolverHandle() = default;
+ImplicitSolverHandle::ImplicitSolverHandle(const ImplicitSolverHandle&) {}
+ImplicitSolverHandle& ImplicitSolverHandle::operator=(const ImplicitSolverHandle& other) {
+  if (this != &other) solver.reset();
+  return *this;
+}
+ImplicitSolverHandle::ImplicitSolverHandle(ImplicitSolverHandle&&) noexcept = default;
+ImplicitSolverHandle& ImplicitSolverHandle::operator=(ImplicitSolverHandle&&) noexcept = default;
+ImplicitSolverHandle::~ImplicitSolverHandle() = default;
+
+namespace detail {
+
+void prepare_implicit_solver(const SimModel& model, ImplicitSolverHandle& handle) {
+  handle.solver = std::make_unique<ImplicitSolver>(model);
+}
+
+namespace {
+
+// Assembles M/β² + (αM + C)/β + K_springs + K(x) into the solver's matrix.
+void assemble(const SimModel& model, const SimState& state, const StepInputs& inputs,
+              const ViscousArmInputs& arm, double beta, ImplicitSolver& solver) {
+  double* values = solver.matrix.valuePtr();
+  std::fill(values, values + solver.matrix.nonZeros(), 0.0);
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const Eigen::Matrix3d dm_inverse = element_dm_inverse(model, e);
+    const Eigen::Matrix3d F = deformation_gradient(model, state.position_m, e);
+    const Eigen::Matrix<double, 9, 9> tangent = element_step_tangent(model, state, arm, e, F);
+    // Reference shape-function gradients as columns: corners 1–3 are the rows of Dm⁻¹.
+    Eigen::Matrix<double, 3, 4> gradients;
+    gradients.rightCols<3>() = dm_inverse.transpose();
+    gradients.col(0) = -gradients.rightCols<3>().rowwise().sum();
+    const double volume = model.rest_volume_m3[e];
+    const int* entries = &solver.element_entry[e * 144];
+    // K_ab[i][k] = V·Σ_JL ∂N_a/∂X_J · ∂P_iJ/∂F_kL · ∂N_b/∂X_L.
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Matrix<double, 4, 4> block =
+            volume * gradients.transpose() * tangent.block<3, 3>(3 * i, 3 * k) * gradients;
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b) {
+            const int entry = entries[(3 * a + i) * 12 + 3 * b + k];
+            if (entry >= 0) values[entry] += block(a, b);
+          }
+      }
+  }
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    const double mass = model.lumped_mass_kg[n];
+    const double diagonal =
+        model.is_fixed[n] ? 1.0 : mass / (beta * beta) + model.mass_damping_per_s * mass / beta;
+    for (int axis = 0; axis < 3; ++axis)
+      values[solver.diagonal_entry[3 * n + static_cast<std::size_t>(axis)]] += diagonal;
+  }
+  for (const auto& spring : inputs.springs) {
+    if (model.is_fixed[spring.node]) continue;
+    for (int axis = 0; axis < 3; ++axis)
+      values[solver.diagonal_entry[3 * spring.node + static_cast<std::size_t>(axis)]] +=
+          spring.stiffness_n_per_m + spring.damping_n_s_per_m / beta;
+  }
+}
+
+void copy(const NodeArray& from, NodeArray& to) {
+  to.x = from.x;
+  to.y = from.y;
+  to.z = from.z;
+}
+
+}  // namespace
+
+void advance_implicit(const SimModel& model, SimState& state, const StepInputs& inputs,
+                      double interval_s, StepReport& report) {
+  IntegratorScratch& s = state.integrator;
+  if (!s.implicit.solver) prepare_implicit_solver(model, s.implicit);  // a copied state
+  ImplicitSolver& solver = *s.implicit.solver;
+  const auto dofs = static_cast<std::size_t>(solver.matrix.cols());
+  const std::span<const int> columns(solver.matrix.outerIndexPtr(), dofs + 1);
+  const std::span<const int> rows(solver.matrix.innerIndexPtr(),
+                                  static_cast<std::size_t>(solver.matrix.nonZeros()));
+  const std::span<const double> values(solver.matrix.valuePtr(), rows.size());
+  const IntegratorSettings& settings = model.integrator;
+  const double steps = steps_to_cover(interval_s, settings.step_s);
+  const double dt = interval_s / steps;
+  const std::size_t n_nodes = model.node_count;
+
+  for (int step = 0; step < static_cast<int>(steps); ++step) {
+    // BDF2 needs the previous step at the same length; otherwise (first step, changed step) the
+    // step is backward Euler, which keeps the global order 2.
+    const bool bdf2 = settings.kind == IntegratorKind::bdf2 && s.has_previous &&
+                      std::abs(s.previous_step_s - dt) <= 1e-9 * dt;
+    const double beta = bdf2 ? 2.0 * dt / 3.0 : dt;
+    arm_of_committed_state(model, state, s.start_arm);
+    auto& x = state.position_m;
+    auto& v = state.velocity_m_per_s;
+    for (std::size_t n = 0; n < n_nodes; ++n) {
+      if (bdf2) {
+        s.predicted_position_m.x[n] = (4.0 * x.x[n] - s.previous_position_m.x[n]) / 3.0;
+        s.predicted_position_m.y[n] = (4.0 * x.y[n] - s.previous_position_m.y[n]) / 3.0;
+        s.predicted_position_m.z[n] = (4.0 * x.z[n] - s.previous_position_m.z[n]) / 3.0;
+        s.predicted_velocity_m_per_s.x[n] = (4.0 * v.x[n] - s.previous_velocity_m_per_s.x[n]) / 3.0;
+        s.predicted_velocity_m_per_s.y[n] = (4.0 * v.y[n] - s.previous_velocity_m_per_s.y[n]) / 3.0;
+        s.predicted_velocity_m_per_s.z[n] = (4.0 * v.z[n] - s.previous_velocity_m_per_s.z[n]) / 3.0;
+      } else {
+        s.predicted_position_m.x[n] = x.x[n];
+        s.predicted_position_m.y[n] = x.y[n];
+        s.predicted_position_m.z[n] = x.z[n];
+        s.predicted_velocity_m_per_s.x[n] = v.x[n];
+        s.predicted_velocity_m_per_s.y[n] = v.y[n];
+        s.predicted_velocity_m_per_s.z[n] = v.z[n];
+      }
+    }
+    if (model.effects.viscous) {
+      for (std::size_t e = 0; e < s.start_arm.size(); ++e)
+        for (int k = 0; k < 6; ++k)
+          s.predicted_arm[e][k] =
+              bdf2 ? (4.0 * s.start_arm[e][k] - s.previous_arm[e][k]) / 3.0 : s.start_arm[e][k];
+      for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r) {
+        if (!model.viscous_parameters[r]) continue;
+        const double theta = beta / model.viscous_parameters[r]->viscoelastic.relaxation_time_s();
+        s.keep_by_region[r] = 1.0 / (1.0 + theta);
+        s.elastic_weight_by_region[r] = theta / (1.0 + theta);
+      }
+      std::swap(s.previous_arm, s.start_arm);  // Q_{n} becomes the previous step's
+    }
+    copy(x, s.previous_position_m);
+    copy(v, s.previous_velocity_m_per_s);
+    s.has_previous = true;
+    s.previous_step_s = dt;
+
+    // Start Newton from the predictor's free flight: x̂ + β·v̂.
+    for (std::size_t n = 0; n < n_nodes; ++n) {
+      x.x[n] = s.predicted_position_m.x[n] + beta * s.predicted_velocity_m_per_s.x[n];
+      x.y[n] = s.predicted_position_m.y[n] + beta * s.predicted_velocity_m_per_s.y[n];
+      x.z[n] = s.predicted_position_m.z[n] + beta * s.predicted_velocity_m_per_s.z[n];
+    }
+    const ViscousArmInputs arm{s.predicted_arm, s.keep_by_region, s.elastic_weight_by_region,
+                               s.elastic_stress};
+    bool converged = false;
+    double previous_correction = std::numeric_limits<double>::infinity();
+    bool refactor = true;
+    for (int iteration = 0; iteration < settings.max_newton_iterations; ++iteration) {
+      for (std::size_t n = 0; n < n_nodes; ++n) {
+        v.x[n] = (x.x[n] - s.predicted_position_m.x[n]) / beta;
+        v.y[n] = (x.y[n] - s.predicted_position_m.y[n]) / beta;
+        v.z[n] = (x.z[n] - s.predicted_position_m.z[n]) / beta;
+      }
+      const ElasticEvaluation seen =
+          compute_internal_forces_rate_form(model, state, x, arm, solver.force);
+      ++report.force_evaluations;
+      report.max_stiffening = std::max(report.max_stiffening, stiffening_since_rest(model, seen));
+      add_input_forces(inputs, x, v, solver.force);
+      for (std::size_t n = 0; n < n_nodes; ++n) {
+        const double mass = model.lumped_mass_kg[n];
+        const bool fixed = model.is_fixed[n] != 0;
+        const double inertia = mass / beta, damping = model.mass_damping_per_s * mass;
+        const double rx = inertia * (v.x[n] - s.predicted_velocity_m_per_s.x[n]) +
+                          damping * v.x[n] - solver.force.x[n];
+        const double ry = inertia * (v.y[n] - s.predicted_velocity_m_per_s.y[n]) +
+                          damping * v.y[n] - solver.force.y[n];
+        const double rz = inertia * (v.z[n] - s.predicted_velocity_m_per_s.z[n]) +
+                          damping * v.z[n] - solver.force.z[n];
+        solver.rhs[3 * n] = fixed ? 0.0 : -rx;
+        solver.rhs[3 * n + 1] = fixed ? 0.0 : -ry;
+        solver.rhs[3 * n + 2] = fixed ? 0.0 : -rz;
+      }
+      if (refactor) {
+        assemble(model, state, inputs, arm, beta, solver);
+        ++report.factorizations;
+        if (!solver.factorisation.factorise(columns, rows, values)) break;
+      }
+      for (std::size_t d = 0; d < dofs; ++d)
+        solver.ordered_rhs[static_cast<std::size_t>(solver.ordered_index[d])] = solver.rhs[d];
+      solver.factorisation.solve(solver.ordered_rhs);
+      for (std::size_t d = 0; d < dofs; ++d)
+        solver.rhs[d] = solver.ordered_rhs[static_cast<std::size_t>(solver.ordered_index[d])];
+      ++report.linear_solves;
+      ++report.newton_iterations;
+      double largest_sq = 0.0;
+      for (std::size_t n = 0; n < n_nodes; ++n) {
+        const double dx = solver.rhs[3 * n], dy = solver.rhs[3 * n + 1], dz = solver.rhs[3 * n + 2];
+        x.x[n] += dx;
+        x.y[n] += dy;
+        x.z[n] += dz;
+        largest_sq = std::max(largest_sq, dx * dx + dy * dy + dz * dz);
+      }
+      const double largest = std::sqrt(largest_sq);
+      if (!std::isfinite(largest)) break;
+      if (largest <= settings.newton_tolerance_m) {
+        converged = true;
+        break;
+      }
+      // Keep a factorisation while it still contracts fast; refresh it when it stalls (large
+      // rotations, stiffening) — quadratic convergence is not worth a factorisation per iteration.
+      refactor = largest > 0.25 * previous_correction;
+      previous_correction = largest;
+    }
+    if (!converged) ++report.unconverged_steps;
+    for (std::size_t n = 0; n < n_nodes; ++n) {
+      v.x[n] = (x.x[n] - s.predicted_position_m.x[n]) / beta;
+      v.y[n] = (x.y[n] - s.predicted_position_m.y[n]) / beta;
+      v.z[n] = (x.z[n] - s.predicted_position_m.z[n]) / beta;
+    }
+    if (model.effects.viscous) {
+      for (std::size_t e = 0; e < s.stage_arm.size(); ++e) {
+        const auto r = static_cast<std::size_t>(model.region[e]);
+        for (int k = 0; k < 6; ++k)
+          s.stage_arm[e][k] = s.keep_by_region[r] * s.predicted_arm[e][k] +
+                              s.elastic_weight_by_region[r] * s.elastic_stress[e][k];
+      }
+      commit_arm(model, state, x, s.stage_arm, dt);
+    }
+    note_error_estimate(report, history_error_estimate(model, s, v, dt, settings.kind));
+    double max_speed_sq = 0.0;
+    for (std::size_t n = 0; n < n_nodes; ++n)
+      max_speed_sq = std::max(max_speed_sq, v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n]);
+    state.max_speed_m_per_s = std::sqrt(max_speed_sq);
+    state.last_step_s = dt;
+    state.time_s += dt;
+    ++state.step_count;
+    ++report.substeps;
+    report.smallest_substep_s = std::min(report.smallest_substep_s, dt);
+    report.largest_substep_s = std::max(report.largest_substep_s, dt);
+  }
+}
+
+}  // namespace detail
+}  // namespace liversim
