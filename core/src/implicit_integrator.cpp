@@ -184,8 +184,11 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
   for (int step = 0; step < static_cast<int>(steps); ++step) {
     // BDF2 needs the previous step at the same length; otherwise (first step, changed step) the
     // step is backward Euler, which keeps the global order 2.
+    // A change of inputs is a kink in time that BDF2's history would smooth over (a first-order
+    // error at every change): restart there too.
     const bool bdf2 = settings.kind == IntegratorKind::bdf2 && s.has_previous &&
-                      std::abs(s.previous_step_s - dt) <= 1e-9 * dt;
+                      std::abs(s.previous_step_s - dt) <= 1e-9 * dt &&
+                      !(step == 0 && s.inputs_changed);
     const double beta = bdf2 ? 2.0 * dt / 3.0 : dt;
     arm_of_committed_state(model, state, s.start_arm);
     auto& x = state.position_m;
@@ -235,7 +238,13 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
                                s.elastic_stress};
     bool converged = false;
     double previous_correction = std::numeric_limits<double>::infinity();
-    bool refactor = true;
+    // The tangent changes slowly: keep a factorisation across iterations and steps while Newton
+    // still contracts well, and build a new one for a new β, new springs, or a slow last step.
+    bool refactor = !s.factorisation_valid || s.factorised_beta_s != beta ||
+                    s.last_newton_iterations > 8 ||
+                    (step == 0 && s.inputs_changed && !inputs.springs.empty());
+    int iterations = 0;
+    bool refreshed = false;
     for (int iteration = 0; iteration < settings.max_newton_iterations; ++iteration) {
       for (std::size_t n = 0; n < n_nodes; ++n) {
         v.x[n] = (x.x[n] - s.predicted_position_m.x[n]) / beta;
@@ -264,8 +273,12 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
       if (refactor) {
         assemble(model, state, inputs, arm, beta, solver);
         ++report.factorizations;
-        if (!solver.factorisation.factorise(columns, rows, values)) break;
+        s.factorisation_valid = solver.factorisation.factorise(columns, rows, values);
+        s.factorised_beta_s = beta;
+        refactor = false;
+        if (!s.factorisation_valid) break;
       }
+      ++iterations;
       for (std::size_t d = 0; d < dofs; ++d)
         solver.ordered_rhs[static_cast<std::size_t>(solver.ordered_index[d])] = solver.rhs[d];
       solver.factorisation.solve(solver.ordered_rhs);
@@ -287,11 +300,14 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
         converged = true;
         break;
       }
-      // Keep a factorisation while it still contracts fast; refresh it when it stalls (large
-      // rotations, stiffening) — quadratic convergence is not worth a factorisation per iteration.
-      refactor = largest > 0.25 * previous_correction;
+      // Refresh a factorisation that has nearly stopped contracting (large rotations,
+      // stiffening), once per step: a contraction slower than quadratic alone is the tangent's
+      // missing average-nodal-pressure coupling, which a new factorisation does not fix.
+      refactor = largest > 0.8 * previous_correction && !refreshed;
+      refreshed = refreshed || refactor;
       previous_correction = largest;
     }
+    s.last_newton_iterations = iterations;
     if (!converged) ++report.unconverged_steps;
     for (std::size_t n = 0; n < n_nodes; ++n) {
       v.x[n] = (x.x[n] - s.predicted_position_m.x[n]) / beta;

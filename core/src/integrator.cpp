@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 
@@ -14,7 +15,17 @@ ElasticEvaluation evaluate_forces(const SimModel& model, SimState& state,
                                   const StepInputs& inputs) {
   // The configuration was reached by the last step, so history-dependent materials advance by it.
   const ElasticEvaluation seen = compute_internal_forces(model, state, state.last_step_s);
-  add_external_forces(inputs, state.position_m, state.force_n);
+  // The external force is kept apart too: a kick across a change of inputs needs both sides.
+  NodeArray& external = state.integrator.external_force_n;
+  std::fill(external.x.begin(), external.x.end(), 0.0);
+  std::fill(external.y.begin(), external.y.end(), 0.0);
+  std::fill(external.z.begin(), external.z.end(), 0.0);
+  add_external_forces(inputs, state.position_m, external);
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    state.force_n.x[n] += external.x[n];
+    state.force_n.y[n] += external.y[n];
+    state.force_n.z[n] += external.z[n];
+  }
   for (const auto& spring : inputs.springs)
     state.spring_damping_per_s[spring.node] +=
         spring.damping_n_s_per_m * model.inverse_mass_per_kg[spring.node];
@@ -24,11 +35,17 @@ ElasticEvaluation evaluate_forces(const SimModel& model, SimState& state,
 // Leapfrog kick and drift with the forces in state.force_n. Damping (mass-proportional α plus
 // the springs' c/m) taken at the mid-step velocity keeps the scheme explicit, second order and
 // stable for any damping: v⁺ = ((1 − αΔt/2) v⁻ + Δt M⁻¹ f) / (1 + αΔt/2).
-void kick_drift(const SimModel& model, SimState& state, const StepInputs& inputs, double dt_s) {
+void kick_drift(const SimModel& model, SimState& state, const StepInputs& inputs, double dt_s,
+                bool inputs_changed = false) {
   // With a changing step the velocity lives at the midpoints, so the kick spans half of the last
   // step and half of this one; kicking by Δt alone would pump energy whenever the step changes.
   // The first step starts from v(t₀) (what a user sets), so it kicks by half a step only.
   const double kick_s = 0.5 * (state.last_step_s + dt_s);
+  // Inputs that changed at this instant act on the first half of the kick with their old value:
+  // kicking both halves with the new one is a first-order error at every change of load.
+  const double old_share = inputs_changed ? 0.5 * state.last_step_s / kick_s : 0.0;
+  const NodeArray& old_external = state.integrator.previous_external_force_n;
+  const NodeArray& new_external = state.integrator.external_force_n;
   auto& x = state.position_m;
   auto& v = state.velocity_m_per_s;
   const auto& f = state.force_n;
@@ -40,15 +57,22 @@ void kick_drift(const SimModel& model, SimState& state, const StepInputs& inputs
         0.5 * (model.mass_damping_per_s + state.spring_damping_per_s[n]) * kick_s;
     const double keep = (1.0 - half_damping) / (1.0 + half_damping);
     const double gain = kick_s * w / (1.0 + half_damping);
-    v.x[n] = keep * v.x[n] + gain * f.x[n];
-    v.y[n] = keep * v.y[n] + gain * f.y[n];
-    v.z[n] = keep * v.z[n] + gain * f.z[n];
+    double fx = f.x[n], fy = f.y[n], fz = f.z[n];
+    if (old_share > 0.0) {
+      fx += old_share * (old_external.x[n] - new_external.x[n]);
+      fy += old_share * (old_external.y[n] - new_external.y[n]);
+      fz += old_share * (old_external.z[n] - new_external.z[n]);
+    }
+    v.x[n] = keep * v.x[n] + gain * fx;
+    v.y[n] = keep * v.y[n] + gain * fy;
+    v.z[n] = keep * v.z[n] + gain * fz;
     x.x[n] += dt_s * v.x[n];
     x.y[n] += dt_s * v.y[n];
     x.z[n] += dt_s * v.z[n];
     max_speed_sq = std::max(max_speed_sq, v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n]);
   }
   for (const auto& spring : inputs.springs) state.spring_damping_per_s[spring.node] = 0.0;
+  std::swap(state.integrator.previous_external_force_n, state.integrator.external_force_n);
   state.max_speed_m_per_s = std::sqrt(max_speed_sq);
   state.last_step_s = dt_s;
   state.time_s += dt_s;
@@ -183,6 +207,35 @@ double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& see
 
 namespace detail {
 
+std::uint64_t fingerprint(const StepInputs& inputs) {
+  // FNV-1a over the values (not the bytes: structs have padding).
+  std::uint64_t hash = 1469598103934665603ull;
+  auto mix = [&](std::uint64_t value) {
+    for (int byte = 0; byte < 8; ++byte) {
+      hash ^= (value >> (8 * byte)) & 0xffu;
+      hash *= 1099511628211ull;
+    }
+  };
+  auto mix_double = [&](double value) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    mix(bits);
+  };
+  mix(inputs.point_loads.size());
+  for (const PointLoad& load : inputs.point_loads) {
+    mix(static_cast<std::uint64_t>(load.node));
+    for (int k = 0; k < 3; ++k) mix_double(load.force_n[k]);
+  }
+  mix(inputs.springs.size());
+  for (const NodeSpring& spring : inputs.springs) {
+    mix(static_cast<std::uint64_t>(spring.node));
+    for (int k = 0; k < 3; ++k) mix_double(spring.anchor_m[k]);
+    mix_double(spring.stiffness_n_per_m);
+    mix_double(spring.damping_n_s_per_m);
+  }
+  return hash;
+}
+
 double explicit_step_limit_s(const SimModel& model, const StepInputs& inputs, double stiffening,
                              IntegratorKind kind) {
   if (kind == IntegratorKind::central_difference)
@@ -256,6 +309,8 @@ void prepare_integrator_scratch(const SimModel& model, IntegratorScratch& scratc
   const std::size_t n = model.node_count;
   const IntegratorKind kind = model.integrator.kind;
   for (auto& history : scratch.velocity_history) history.resize(n);
+  scratch.external_force_n.resize(n);
+  scratch.previous_external_force_n.resize(n);
   const std::size_t arm_count = model.effects.viscous ? model.tet_count : 0;
   // The arm as an explicit stage reads it: Q = 1·q + 0·S_e (implicit steps set their own).
   scratch.keep_by_region.assign(model.regions.size(), 1.0);
@@ -356,6 +411,7 @@ void advance_central_difference(const SimModel& model, SimState& state, const St
                                 double interval_s, StepReport& report) {
   const double requested_s = model.integrator.step_s;
   double remaining = interval_s;
+  bool first = true;
   while (remaining > 0.0) {
     const double stiffening = stiffening_since_rest(model, evaluate_forces(model, state, inputs));
     ++report.force_evaluations;
@@ -376,7 +432,8 @@ void advance_central_difference(const SimModel& model, SimState& state, const St
     // Equal steps over what is left, so the interval ends exactly where asked.
     const double steps_left = detail::steps_to_cover(remaining, step);
     const double dt = steps_left <= 1.0 ? remaining : remaining / steps_left;
-    kick_drift(model, state, inputs, dt);
+    kick_drift(model, state, inputs, dt, first && state.integrator.inputs_changed);
+    first = false;
     detail::note_error_estimate(
         report, detail::history_error_estimate(model, state.integrator, state.velocity_m_per_s, dt,
                                                IntegratorKind::central_difference));
@@ -396,6 +453,9 @@ StepReport advance(const SimModel& model, SimState& state, const StepInputs& inp
   report.smallest_substep_s = interval_s;
   report.error_estimate_m = std::numeric_limits<double>::quiet_NaN();
   const double end_time = state.time_s + interval_s;
+  const std::uint64_t fingerprint = detail::fingerprint(inputs);
+  state.integrator.inputs_changed = fingerprint != state.integrator.inputs_fingerprint;
+  state.integrator.inputs_fingerprint = fingerprint;
   switch (model.integrator.kind) {
     case IntegratorKind::central_difference:
       advance_central_difference(model, state, inputs, interval_s, report);

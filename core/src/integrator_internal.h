@@ -8,6 +8,9 @@
 
 namespace liversim::detail {
 
+// A hash of the inputs' values: advance() compares it with the last call's to see a change.
+std::uint64_t fingerprint(const StepInputs& inputs);
+
 // Sizes the scratch of the model's integrator (allocation happens here, never while stepping).
 void prepare_integrator_scratch(const SimModel& model, IntegratorScratch& scratch);
 

@@ -50,6 +50,14 @@ struct IntegratorScratch {
   // until the next step's first stage gives it.
   bool error_pending = false;
   double error_pending_step_s = 0.0;
+  // Inputs of the last advance(): a change of load is a kink in time that leapfrog's kick and
+  // BDF2's history must not smooth over (see integrator.cpp).
+  std::uint64_t inputs_fingerprint = 0;
+  bool inputs_changed = false;
+  NodeArray external_force_n, previous_external_force_n;  // central difference, per step
+  bool factorisation_valid = false;  // implicit: the last factorisation may be reused
+  double factorised_beta_s = 0.0;
+  int last_newton_iterations = 0;
   // Error estimate of the fixed-step schemes: the velocity at the end of the last steps.
   std::array<NodeArray, 3> velocity_history;
   int history_count = 0;
