@@ -4,6 +4,7 @@
 #include "liversim/core/fibres.h"
 #include "liversim/core/forces.h"
 #include "liversim/core/material.h"
+#include "liversim/core/viscous_tissue.h"
 
 #include <gtest/gtest.h>
 
@@ -86,6 +87,56 @@ TEST(Tangent, ElementWithTwoFibreFamiliesAndALesionRegion) {
         [&](const Eigen::Matrix3d& G) { return element_first_piola_stress(model, e, G); }, F);
     EXPECT_LT((analytic - numeric).norm(), 1e-6 * analytic.norm()) << "element " << e;
   }
+}
+
+// The viscous arm in rate form (for integrators that carry it) with a plastic deformation held:
+// its tangent is the finite-difference derivative of its stress, for an explicit stage
+// (keep 1, weight 0) and a backward-Euler step (keep 1/(1+θ), weight θ/(1+θ)), and below the
+// collapse limit where the arm is frozen.
+TEST(Tangent, ViscoelasticRateForm) {
+  const ViscousTissueParameters parameters{{2000.0, 1500.0, 2000.0}, 0.45, std::nullopt};
+  const ViscousTissueStep step(parameters, 0.0);
+  std::mt19937 random(31);
+  Eigen::Matrix3d fp_inverse = random_deformation(random, 1.0);  // isochoric
+  const Voigt6 q{40.0, -25.0, 10.0, 5.0, -8.0, 12.0};
+  const double theta = 0.4;
+  for (const auto& [keep, weight] :
+       {std::pair{1.0, 0.0}, std::pair{1.0 / (1.0 + theta), theta / (1.0 + theta)}}) {
+    for (double J : {1.0, 1.2, 0.7, 0.1}) {
+      const Eigen::Matrix3d F = random_deformation(random, J);
+      const Tangent analytic =
+          viscoelastic_stress_tangent_rate_form(F, step, fp_inverse, q, keep, weight);
+      const Tangent numeric = numeric_tangent(
+          [&](const Eigen::Matrix3d& G) {
+            Voigt6 elastic;
+            return viscoelastic_stress_rate_form(G, step, fp_inverse, q, keep, weight, elastic);
+          },
+          F);
+      EXPECT_LT((analytic - numeric).norm(), 1e-6 * analytic.norm())
+          << "J = " << J << ", keep " << keep;
+    }
+  }
+}
+
+// The two forms of the arm describe one state: with Q = S_e − H, the rate form's stress at the
+// committed deformation equals the incremental update's instantaneous (Δt = 0) stress.
+TEST(ViscousRateForm, AgreesWithTheIncrementalUpdateOnOneState) {
+  const ViscousTissueParameters parameters{{2000.0, 1500.0, 2000.0}, 0.45, std::nullopt};
+  ViscousTissueState state;
+  std::mt19937 random(37);
+  const Eigen::Matrix3d F1 = random_deformation(random, 1.1), F2 = random_deformation(random, 0.9);
+  viscous_tissue_update(F1, ViscousTissueStep(parameters, 0.0), state);  // load
+  viscous_tissue_update(F2, ViscousTissueStep(parameters, 0.3), state);  // relax and move
+  Voigt6 q, elastic;
+  for (int k = 0; k < 6; ++k) q[k] = state.elastic_stress_pa[k] - state.maxwell_stress_pa[k];
+  ViscousTissueState trial;
+  const Eigen::Matrix3d incremental =
+      viscous_tissue_stress(F2, ViscousTissueStep(parameters, 0.0), state, trial);
+  const Eigen::Matrix3d rate_form =
+      viscoelastic_stress_rate_form(F2, ViscousTissueStep(parameters, 0.0),
+                                    state.inverse_plastic_deformation, q, 1.0, 0.0, elastic);
+  EXPECT_LT((incremental - rate_form).norm(), 1e-12 * incremental.norm());
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(elastic[k], state.elastic_stress_pa[k], 1e-9);
 }
 
 }  // namespace
