@@ -1,16 +1,36 @@
 #include "main_window.h"
 
+#include "accuracy_panel.h"
 #include "render/liver_scene.h"
 #include "vtk_viewport.h"
 
+#include "liversim/core/integrator.h"
 #include "liversim/core/surface.h"
 
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
+#include <QDockWidget>
 #include <QLabel>
 #include <QStatusBar>
 
+#include <cmath>
+#include <exception>
+#include <string_view>
+
 namespace liversim {
+namespace {
+
+QString fromView(std::string_view text) {
+  return QString::fromUtf8(text.data(), static_cast<qsizetype>(text.size()));
+}
+
+// A positive number with two or three significant digits and no exponent: 0.81, 2.6, 15, 480.
+QString formatAmount(double value) {
+  const double size = std::abs(value);
+  return QString::number(value, 'f', size < 1.0 ? 2 : size < 10.0 ? 1 : 0);
+}
+
+}  // namespace
 
 MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
     : QMainWindow(parent), setup_(std::move(setup)) {
@@ -35,6 +55,17 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   connect(viewport_, &QOpenGLWidget::frameSwapped, this, [this] { ++framesInWindow_; });
   setCentralWidget(viewport_);
 
+  accuracyPanel_ = new AccuracyPanel(this);
+  accuracyPanel_->setObjectName("accuracyPanel");
+  accuracyPanel_->setSettings(setup_.model_options.integrator);
+  connect(accuracyPanel_, &AccuracyPanel::applyRequested, this,
+          [this](const IntegratorSettings& settings) { applyIntegratorSettings(settings); });
+  auto* accuracyDock = new QDockWidget(tr("Accuracy"), this);
+  accuracyDock->setObjectName("accuracyDock");
+  accuracyDock->setWidget(accuracyPanel_);
+  accuracyDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
+  addDockWidget(Qt::RightDockWidgetArea, accuracyDock);
+
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("simulationStatus");
   statusBar()->addPermanentWidget(statusLabel_, 1);
@@ -53,7 +84,73 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
 }
 
 MainWindow::~MainWindow() {
+  if (modelBuilder_.joinable()) modelBuilder_.join();
   simulation_->stop();
+}
+
+bool MainWindow::applyIntegratorSettings(const IntegratorSettings& settings) {
+  if (changingIntegrator_) return false;
+  if (modelBuilder_.joinable()) modelBuilder_.join();  // the last one has reported back
+  changingIntegrator_ = true;
+  accuracyPanel_->setBusy(true);
+  ModelOptions options = setup_.model_options;
+  options.integrator = settings;
+  modelBuilder_ = std::thread([this, options = std::move(options), settings] {
+    std::shared_ptr<const SimModel> model;
+    QString error;
+    try {
+      // build_model checks the settings first, so a bad entry is refused at once.
+      model = std::make_shared<const SimModel>(build_model(setup_.mesh, options));
+    } catch (const std::exception& e) {
+      error = QString::fromUtf8(e.what());
+    }
+    // Runs on the GUI thread; dropped if the window is gone (its destructor joins this thread
+    // first, and a QObject discards the events posted to it when it is destroyed).
+    QMetaObject::invokeMethod(
+        this, [this, settings, model, error] { finishIntegratorChange(settings, model, error); },
+        Qt::QueuedConnection);
+  });
+  return true;
+}
+
+void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
+                                        std::shared_ptr<const SimModel> model,
+                                        const QString& error) {
+  modelBuilder_.join();  // it ends right after posting this
+  changingIntegrator_ = false;
+  accuracyPanel_->setBusy(false);
+  if (!model) {
+    accuracyPanel_->showError(error);
+    emit integratorChangeFinished(false);
+    return;
+  }
+
+  // Carry the liver's motion over: the same mesh, so the same node order. The new scheme starts
+  // its own history (a multistep scheme its first step, an adaptive one its step size).
+  simulation_->stop();
+  const SimState& old = simulation_->state();
+  SimState state = make_rest_state(*model);
+  state.position_m = old.position_m;
+  state.velocity_m_per_s = old.velocity_m_per_s;
+  state.max_speed_m_per_s = old.max_speed_m_per_s;  // the node-travel limit of the first step
+  if (state.viscous_state.size() == old.viscous_state.size())
+    state.viscous_state = old.viscous_state;
+  state.time_s = old.time_s;
+  state.step_count = old.step_count;
+  try {
+    auto replacement = std::make_unique<RealtimeSimulation>(model, std::move(state));
+    simulation_ = std::move(replacement);
+  } catch (const std::exception& e) {
+    simulation_->start();  // the old one goes on where it stopped
+    accuracyPanel_->showError(QString::fromUtf8(e.what()));
+    emit integratorChangeFinished(false);
+    return;
+  }
+  if (grab_) simulation_->set_springs(springs_);
+  simulation_->start();
+  setup_.model_options.integrator = settings;
+  accuracyPanel_->setSettings(settings);
+  emit integratorChangeFinished(true);
 }
 
 bool MainWindow::beginGrab(QPoint pos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers) {
@@ -103,12 +200,38 @@ void MainWindow::updateStatus() {
                      .arg(stats.real_time_factor, 0, 'f', 2)
                      .arg(stats.step_s * 1e3, 0, 'f', 3);
   if (stats.behind) text += tr(" | slower than real time");
+  text += tr(" | ") + accuracyStatus(stats);
   if (grab_) {
     const Eigen::Vector3d force =
         grab_reaction_force_n(*grab_, handle_m_, simulation_->snapshot().position_m);
     text += tr(" | pulling %1 N").arg(force.norm(), 0, 'f', 2);
   }
   statusLabel_->setText(text);
+}
+
+// The error estimate for the status bar, in the unit that suits it: "≈ 2.1 µm". Below a picometre
+// it is round-off, not a number worth reading.
+QString MainWindow::formatError(double error_m) {
+  if (std::isnan(error_m)) return tr("n/a");
+  const double size = std::abs(error_m);
+  if (size < 1e-12) return tr("< 1 pm");
+  if (size < 1e-9) return tr("≈ %1 pm").arg(formatAmount(error_m * 1e12));
+  if (size < 1e-6) return tr("≈ %1 nm").arg(formatAmount(error_m * 1e9));
+  if (size < 1e-3) return tr("≈ %1 µm").arg(formatAmount(error_m * 1e6));
+  return tr("≈ %1 mm").arg(formatAmount(error_m * 1e3));
+}
+
+QString MainWindow::accuracyStatus(const RealtimeStats& stats) const {
+  QString text =
+      tr("%1 · error %2").arg(fromView(stats.integrator_name), formatError(stats.error_estimate_m));
+  if (stats.wall_s_per_simulated_s > 0.0) {
+    // Both are per millisecond of simulated time: the scale of a step.
+    text += tr(" · %1 ms wall per ms simulated · %2 force evaluations per ms simulated")
+                .arg(formatAmount(stats.wall_s_per_simulated_s),
+                     formatAmount(stats.force_evaluations_per_simulated_s * 1e-3));
+  }
+  if (stats.stability_limited) text += tr(" · stability-limited");
+  return text;
 }
 
 }  // namespace liversim

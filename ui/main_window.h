@@ -1,6 +1,7 @@
 #pragma once
-// The workstation's main window: the liver viewport in the middle, live statistics in the status
-// bar. The simulation runs on its own thread; the viewport renders from its newest snapshot.
+// The workstation's main window: the liver viewport in the middle, the accuracy setting (time
+// integrator and step) beside it, live statistics in the status bar. The simulation runs on its own
+// thread; the viewport renders from its newest snapshot.
 
 #include "liversim/core/default_scene.h"
 #include "liversim/core/grab.h"
@@ -12,11 +13,13 @@
 
 #include <memory>
 #include <optional>
+#include <thread>
 
 class QLabel;
 
 namespace liversim {
 
+class AccuracyPanel;
 class LiverScene;
 class VtkViewport;
 
@@ -31,22 +34,39 @@ class MainWindow : public QMainWindow {
   LiverScene& scene() { return *scene_; }
   RealtimeSimulation& simulation() { return *simulation_; }
   const Grab* activeGrab() const { return grab_ ? &*grab_ : nullptr; }
+  AccuracyPanel* accuracyPanel() const { return accuracyPanel_; }
+
+  // Rebuilds the model with these integrator settings on a worker thread (the simulation runs on
+  // meanwhile; a large mesh takes seconds), then restarts the simulation from the liver's current
+  // positions and velocities. When the settings are invalid the panel shows why and the running
+  // simulation stays. integratorChangeFinished tells which. Returns false, and does nothing, while
+  // an earlier change is still being built.
+  bool applyIntegratorSettings(const IntegratorSettings& settings);
+  bool changingIntegrator() const { return changingIntegrator_; }
 
   // Spring stiffness of a mouse grab and the radius of tissue it holds.
   static constexpr double kGrabStiffnessNPerM = 300.0;
   static constexpr double kGrabRadiusM = 0.02;
 
+ signals:
+  void integratorChangeFinished(bool applied);
+
  private:
   bool beginGrab(QPoint vtkDisplayPos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers);
   void moveGrab(QPoint vtkDisplayPos);
   void endGrab();
+  void finishIntegratorChange(const IntegratorSettings& settings,
+                              std::shared_ptr<const SimModel> model, const QString& error);
   void showNewestSnapshot();
   void updateStatus();
+  QString accuracyStatus(const RealtimeStats& stats) const;
+  static QString formatError(double error_m);
 
   SceneSetup setup_;
   std::unique_ptr<RealtimeSimulation> simulation_;
   std::unique_ptr<LiverScene> scene_;
   VtkViewport* viewport_ = nullptr;
+  AccuracyPanel* accuracyPanel_ = nullptr;
   QLabel* statusLabel_ = nullptr;
   QTimer frameTimer_;
   QTimer statusTimer_;
@@ -58,6 +78,10 @@ class MainWindow : public QMainWindow {
   int framesInWindow_ = 0;
   QElapsedTimer frameWindow_;
   double framesPerSecond_ = 0.0;
+
+  // Builds the model of an integrator change; reads setup_.mesh, which never changes.
+  std::thread modelBuilder_;
+  bool changingIntegrator_ = false;
 };
 
 }  // namespace liversim

@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace liversim {
 namespace {
@@ -13,7 +16,44 @@ SimulationSnapshot snapshot_of(const SimState& state) {
   return {state.position_m, state.time_s, state.step_count};
 }
 
+// Whole steps that fit in `cycle_s`, at least one: a step longer than a cycle is still taken.
+int steps_per_cycle(double cycle_s, double step_s) {
+  if (!(cycle_s > 0.0) || !std::isfinite(cycle_s)) return 1;
+  return static_cast<int>(std::clamp(std::ceil(cycle_s / step_s - 1e-9), 1.0, 1e6));
+}
+
 }  // namespace
+
+StepAccumulator::StepAccumulator(double step_s, int max_steps)
+    : step_s_(step_s), max_steps_(max_steps) {
+  if (!(step_s > 0.0) || !std::isfinite(step_s))
+    throw std::invalid_argument("real-time step must be a finite value > 0 s, not " +
+                                std::to_string(step_s));
+  if (max_steps < 1)
+    throw std::invalid_argument("real-time step cap must be at least 1 step per cycle, not " +
+                                std::to_string(max_steps));
+}
+
+StepAccumulator::Due StepAccumulator::add(double elapsed_s) {
+  if (std::isfinite(elapsed_s) && elapsed_s > 0.0) backlog_s_ += elapsed_s;
+  // A relative slack of 1e-9 step keeps wall times that sum to a whole step in floating point
+  // (10 × 0.1 ms) from coming out one step short.
+  const double whole = std::floor(backlog_s_ / step_s_ + 1e-9);
+  Due due;
+  if (whole > static_cast<double>(max_steps_)) {
+    due.steps = max_steps_;
+    due.capped = true;
+    due.dropped_s = (whole - max_steps_) * step_s_;
+  } else {
+    due.steps = static_cast<int>(whole);
+  }
+  backlog_s_ = std::max(0.0, backlog_s_ - whole * step_s_);
+  return due;
+}
+
+double realtime_step_s(const SimModel& model) {
+  return model.integrator.step_s > 0.0 ? model.integrator.step_s : model.stable_time_step_s;
+}
 
 RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
                                        SimState initial_state)
@@ -24,7 +64,14 @@ RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
     : model_(std::move(model)),
       state_(std::move(initial_state)),
       options_(options),
+      step_s_(realtime_step_s(*model_)),
+      max_steps_per_cycle_(options.max_steps_per_cycle > 0
+                               ? options.max_steps_per_cycle
+                               : steps_per_cycle(options.cycle_s, step_s_)),
       snapshots_(snapshot_of(state_)) {
+  if (!(step_s_ > 0.0) || !std::isfinite(step_s_))
+    throw std::invalid_argument("the model has no usable time step (" + std::to_string(step_s_) +
+                                " s)");
   pending_springs_.reserve(options_.spring_capacity);
   active_springs_.reserve(options_.spring_capacity);
 }
@@ -53,19 +100,44 @@ bool RealtimeSimulation::set_springs(std::span<const NodeSpring> springs) {
 }
 
 RealtimeStats RealtimeSimulation::stats() const {
-  return {steps_per_second_.load(), real_time_factor_.load(), step_s_.load(), behind_.load()};
+  RealtimeStats stats;
+  stats.steps_per_second = steps_per_second_.load();
+  stats.real_time_factor = real_time_factor_.load();
+  stats.step_s = smallest_step_s_.load();
+  stats.behind = behind_.load();
+  stats.integrator = model_->integrator.kind;
+  stats.integrator_name = integrator_name(model_->integrator.kind);
+  stats.requested_step_s = step_s_;
+  stats.error_estimate_m = error_estimate_m_.load();
+  stats.wall_s_per_simulated_s = wall_s_per_simulated_s_.load();
+  stats.force_evaluations_per_simulated_s = force_evaluations_per_simulated_s_.load();
+  stats.stability_limited = stability_limited_.load();
+  stats.dropped_s = dropped_s_.load();
+  return stats;
 }
 
 void RealtimeSimulation::run() {
   using Clock = std::chrono::steady_clock;
+  using Seconds = std::chrono::duration<double>;
   const SimModel& model = *model_;
-  auto wall_anchor = Clock::now();
-  double sim_anchor_s = state_.time_s;
-  auto window_start = wall_anchor;
+  StepAccumulator clock(step_s_, max_steps_per_cycle_);
+  auto last_cycle = Clock::now();
+
+  // The statistics window: what the integrator reported, the wall time it took and whether the
+  // cap bit, since the window began.
+  constexpr double kWindowS = 0.25;
+  const auto empty_window = [] {
+    StepReport report;
+    report.error_estimate_m = std::numeric_limits<double>::quiet_NaN();  // none yet
+    return report;
+  };
+  auto window_start = last_cycle;
   double window_sim_start_s = state_.time_s;
   std::uint64_t window_start_steps = state_.step_count;
-  bool behind = false;
-  double step_s = model.stable_time_step_s;
+  StepReport window_report = empty_window();
+  double window_integrating_s = 0.0;
+  bool window_capped = false;
+  double dropped_s = 0.0;
 
   while (!stop_requested_.load(std::memory_order_relaxed)) {
     {
@@ -77,21 +149,16 @@ void RealtimeSimulation::run() {
     }
     const StepInputs inputs{{}, active_springs_};
     const auto cycle_start = Clock::now();
-    const double due_s = sim_anchor_s +
-                         std::chrono::duration<double>(cycle_start - wall_anchor).count() -
-                         state_.time_s;
-    if (due_s >= 0.5 * step_s) {
-      const double interval_s = std::min(due_s, options_.cycle_s);
-      const StepReport report = advance(model, state_, inputs, interval_s);
-      step_s = report.smallest_substep_s;
-      // Slower than real time when the cycle took longer than the simulated time it covered:
-      // drop the backlog so simulated time slows down instead of the loop spiralling.
-      const double wall_s = std::chrono::duration<double>(Clock::now() - cycle_start).count();
-      behind = due_s > options_.cycle_s && wall_s > interval_s;
-      if (behind) {
-        wall_anchor = Clock::now();
-        sim_anchor_s = state_.time_s;
-      }
+    const StepAccumulator::Due due = clock.add(Seconds(cycle_start - last_cycle).count());
+    last_cycle = cycle_start;
+    if (due.capped) {
+      window_capped = true;
+      dropped_s += due.dropped_s;
+    }
+    if (due.steps > 0) {
+      const StepReport report = advance(model, state_, inputs, due.steps * step_s_);
+      window_integrating_s += Seconds(Clock::now() - cycle_start).count();
+      accumulate(window_report, report);
       SimulationSnapshot& out = snapshots_.back();
       out.position_m.x = state_.position_m.x;  // same size: copies without allocating
       out.position_m.y = state_.position_m.y;
@@ -100,19 +167,34 @@ void RealtimeSimulation::run() {
       out.step_count = state_.step_count;
       snapshots_.publish();
     } else {
-      std::this_thread::sleep_for(std::chrono::microseconds(500));
+      // Sleep towards the next step, but wake often enough to stop and to pick up springs.
+      const double sleep_s = std::clamp(clock.time_to_next_step_s(), 0.5e-3, 2e-3);
+      std::this_thread::sleep_for(Seconds(sleep_s));
     }
 
     const auto now = Clock::now();
-    const double window_s = std::chrono::duration<double>(now - window_start).count();
-    if (window_s >= 0.25) {
+    const double window_s = Seconds(now - window_start).count();
+    if (window_s >= kWindowS) {
+      const double simulated_s = state_.time_s - window_sim_start_s;
       steps_per_second_ = static_cast<double>(state_.step_count - window_start_steps) / window_s;
-      real_time_factor_ = (state_.time_s - window_sim_start_s) / window_s;
-      step_s_ = step_s;
-      behind_ = behind;
+      real_time_factor_ = simulated_s / window_s;
+      if (window_report.substeps > 0) {
+        smallest_step_s_ = window_report.smallest_substep_s;
+        error_estimate_m_ = window_report.error_estimate_m;
+        stability_limited_ = window_report.stability_limited_steps > 0;
+      }
+      if (simulated_s > 0.0) {
+        wall_s_per_simulated_s_ = window_integrating_s / simulated_s;
+        force_evaluations_per_simulated_s_ = window_report.force_evaluations / simulated_s;
+      }
+      behind_ = window_capped;
+      dropped_s_ = dropped_s;
       window_start = now;
       window_sim_start_s = state_.time_s;
       window_start_steps = state_.step_count;
+      window_report = empty_window();
+      window_integrating_s = 0.0;
+      window_capped = false;
     }
   }
 }

@@ -1,17 +1,22 @@
 // MainWindow under a real X server (Xvfb in CI): a left drag on the liver grabs and pulls the
 // tissue, which springs back after the release; a left drag on the background turns the camera;
-// the status bar reports the frame rate and the simulation's speed.
+// the status bar reports the frame rate and the simulation's speed; the accuracy panel changes the
+// time integrator of the running simulation, and refuses invalid settings with a reason.
 #include <gtest/gtest.h>
 
 #include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
 #include <QApplication>
+#include <QComboBox>
 #include <QDir>
+#include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QImage>
 #include <QLabel>
 #include <QMouseEvent>
+#include <QPushButton>
+#include <QSignalSpy>
 #include <QTest>
 #include <algorithm>
 #include <array>
@@ -23,7 +28,9 @@
 #include <numbers>
 #include <optional>
 
+#include "accuracy_panel.h"
 #include "liversim/core/default_scene.h"
+#include "liversim/core/integrator.h"
 #include "main_window.h"
 #include "render/liver_scene.h"
 #include "vtk_viewport.h"
@@ -189,6 +196,46 @@ class MainWindowTest : public ::testing::Test {
     sendMouse(QEvent::MouseButtonRelease, at, Qt::LeftButton, Qt::NoButton);
   }
 
+  // Chooses an integrator, step and tolerance in the accuracy panel as a user would, presses Apply
+  // and waits until the window has built the model and either applied or refused the setting.
+  // Returns whether it was applied.
+  std::optional<bool> applyInPanel(IntegratorKind kind, double step_ms, double tolerance_um = 1.0) {
+    auto* panel = window_->findChild<AccuracyPanel*>("accuracyPanel");
+    auto* choice = panel ? panel->findChild<QComboBox*>("integratorChoice") : nullptr;
+    auto* step = panel ? panel->findChild<QDoubleSpinBox*>("integratorStepMs") : nullptr;
+    auto* tolerance = panel ? panel->findChild<QDoubleSpinBox*>("integratorToleranceUm") : nullptr;
+    auto* apply = panel ? panel->findChild<QPushButton*>("applyAccuracy") : nullptr;
+    if (!choice || !step || !tolerance || !apply) {
+      ADD_FAILURE() << "the accuracy panel or one of its fields is missing";
+      return std::nullopt;
+    }
+    EXPECT_EQ(choice->count(), static_cast<int>(kAllIntegrators.size()));
+    choice->setCurrentIndex(choice->findData(static_cast<int>(kind)));
+    step->setValue(step_ms);
+    tolerance->setValue(tolerance_um);
+    EXPECT_TRUE(apply->isVisible() && apply->isEnabled());
+    return clickApplyAndWait(apply);
+  }
+
+  std::optional<bool> clickApplyAndWait(QPushButton* apply) {
+    QSignalSpy finished(window_.get(), &MainWindow::integratorChangeFinished);
+    QTest::mouseClick(apply, Qt::LeftButton);
+    return waitForIntegratorChange(finished);
+  }
+
+  static std::optional<bool> waitForIntegratorChange(QSignalSpy& finished) {
+    if (finished.isEmpty() && !finished.wait(kStartTimeoutMs)) {
+      ADD_FAILURE() << "the integrator change did not finish within " << kStartTimeoutMs << " ms";
+      return std::nullopt;
+    }
+    return finished.first().first().toBool();
+  }
+
+  QString statusText() const {
+    auto* status = window_->findChild<QLabel*>("simulationStatus");
+    return status ? status->text() : QString();
+  }
+
   TetMesh mesh_;
   std::unique_ptr<MainWindow> window_;
   std::vector<std::pair<QString, QImage>> pictures_;
@@ -293,6 +340,115 @@ TEST_F(MainWindowTest, TheStatusBarReportsFrameRateAndSimulationSpeed) {
         << "'" << part << "' missing from the status: " << status->text().toStdString();
   }
   EXPECT_FALSE(status->text().contains("pulling")) << "nothing is grabbed";
+  // The accuracy part: the scenario's integrator and its error estimate.
+  EXPECT_TRUE(status->text().contains(QStringLiteral("central-difference · error")))
+      << status->text().toStdString();
+}
+
+TEST_F(MainWindowTest, EveryIntegratorChosenInThePanelRunsTheSimulation) {
+  auto* panel = window_->accuracyPanel();
+  ASSERT_NE(panel, nullptr);
+  EXPECT_EQ(panel->settingsInUse().kind, IntegratorKind::central_difference);
+  struct Choice {
+    IntegratorKind kind;
+    double step_ms;  // 0: the largest stable step of an explicit scheme
+  };
+  // The last one back to the default, so that a change to the same scheme works as well.
+  for (const Choice choice :
+       {Choice{IntegratorKind::rk4, 0.5}, Choice{IntegratorKind::dopri5, 0.0},
+        Choice{IntegratorKind::backward_euler, 5.0}, Choice{IntegratorKind::bdf2, 4.0},
+        Choice{IntegratorKind::central_difference, 0.0}}) {
+    const std::string name(integrator_name(choice.kind));
+    SCOPED_TRACE(name);
+    const double timeBefore = window_->simulation().snapshot().time_s;
+    const std::uint64_t stepsBefore = window_->simulation().snapshot().step_count;
+    ASSERT_EQ(applyInPanel(choice.kind, choice.step_ms), true) << panel->errorText().toStdString();
+    EXPECT_TRUE(panel->errorText().isEmpty()) << panel->errorText().toStdString();
+    EXPECT_EQ(window_->simulation().model().integrator.kind, choice.kind);
+    EXPECT_NEAR(window_->simulation().model().integrator.step_s, choice.step_ms * 1e-3, 1e-12);
+    EXPECT_EQ(panel->settingsInUse().kind, choice.kind);
+    // The new simulation goes on from where the old one stopped.
+    EXPECT_GE(window_->simulation().snapshot().time_s, timeBefore);
+    EXPECT_GE(window_->simulation().snapshot().step_count, stepsBefore);
+    EXPECT_TRUE(window_->simulation().running());
+
+    const std::uint64_t stepsAtChange = window_->simulation().snapshot().step_count;
+    ASSERT_TRUE(waitSimulated(0.05)) << "simulated time stalled with " << name;
+    EXPECT_GT(window_->simulation().snapshot().step_count, stepsAtChange);
+    EXPECT_TRUE(QTest::qWaitFor(
+        [&] { return statusText().contains(QString::fromStdString(name + " · error")); }, 5'000))
+        << statusText().toStdString();
+    // At rest nothing moves whichever scheme runs.
+    EXPECT_LT(maxDisplacementFromRest(), 1e-4) << name;
+    std::cout << statusText().toStdString() << '\n';
+  }
+  // The status bar reports what the scheme costs once it has run a statistics window.
+  EXPECT_TRUE(
+      QTest::qWaitFor([&] { return statusText().contains("ms wall per ms simulated"); }, 5'000))
+      << statusText().toStdString();
+}
+
+TEST_F(MainWindowTest, ChangingTheIntegratorDuringAPullKeepsTheTissueWhereItIs) {
+  const std::optional<QPoint> start = pointOnTheLiver();
+  ASSERT_TRUE(start);
+  pressAndMove(*start, *start + kDrag, [] {});
+  ASSERT_NE(window_->activeGrab(), nullptr);
+  const Grab grab = *window_->activeGrab();
+  ASSERT_TRUE(waitSimulated(0.5));
+  const double pulled_m = grabbedDisplacement(grab);
+  ASSERT_GT(pulled_m, 0.003) << "the pull did not move the tissue";
+
+  QSignalSpy finished(window_.get(), &MainWindow::integratorChangeFinished);
+  ASSERT_TRUE(window_->applyIntegratorSettings({.kind = IntegratorKind::rk4, .step_s = 0.0}));
+  // One change at a time: a second request while the model is being built is turned away.
+  EXPECT_TRUE(window_->changingIntegrator());
+  EXPECT_FALSE(window_->applyIntegratorSettings({.kind = IntegratorKind::dopri5}));
+  ASSERT_EQ(waitForIntegratorChange(finished), true);
+  EXPECT_FALSE(window_->changingIntegrator());
+  ASSERT_EQ(window_->simulation().model().integrator.kind, IntegratorKind::rk4);
+  // The first snapshot of the new simulation is where the old one stopped, still pulled...
+  EXPECT_GT(grabbedDisplacement(grab), 0.8 * pulled_m);
+  // ...and the handle still holds it there.
+  ASSERT_TRUE(waitSimulated(0.5));
+  EXPECT_NE(window_->activeGrab(), nullptr);
+  EXPECT_GT(grabbedDisplacement(grab), 0.8 * pulled_m)
+      << "pulled " << pulled_m * 1e3 << " mm before the change";
+  release(*start + kDrag);
+}
+
+TEST_F(MainWindowTest, AnInvalidAccuracySettingIsExplainedAndTheRunningOneStays) {
+  auto* panel = window_->accuracyPanel();
+  const RealtimeSimulation* before = &window_->simulation();
+
+  // An implicit scheme has no "largest stable step": a step of 0 is refused.
+  ASSERT_EQ(applyInPanel(IntegratorKind::backward_euler, 0.0), false);
+  const QString error = panel->errorText();
+  EXPECT_TRUE(error.contains("step")) << error.toStdString();
+  EXPECT_TRUE(panel->findChild<QLabel*>("accuracyError")->isVisible());
+  EXPECT_EQ(&window_->simulation(), before) << "the simulation was replaced";
+  EXPECT_EQ(window_->simulation().model().integrator.kind, IntegratorKind::central_difference);
+  EXPECT_EQ(panel->settingsInUse().kind, IntegratorKind::central_difference);
+  // The fields keep what the user typed, to be corrected.
+  auto* choice = panel->findChild<QComboBox*>("integratorChoice");
+  EXPECT_EQ(choice->currentData().toInt(), static_cast<int>(IntegratorKind::backward_euler));
+
+  // dopri5 without an error tolerance is refused too.
+  ASSERT_EQ(applyInPanel(IntegratorKind::dopri5, 0.0, 0.0), false);
+  EXPECT_TRUE(panel->errorText().contains("tolerance")) << panel->errorText().toStdString();
+  EXPECT_EQ(window_->simulation().model().integrator.kind, IntegratorKind::central_difference);
+
+  // The old setting goes on running.
+  EXPECT_TRUE(window_->simulation().running());
+  const std::uint64_t steps = window_->simulation().snapshot().step_count;
+  ASSERT_TRUE(waitSimulated(0.05));
+  EXPECT_GT(window_->simulation().snapshot().step_count, steps);
+  EXPECT_TRUE(QTest::qWaitFor([&] { return statusText().contains("central-difference"); }, 5'000))
+      << statusText().toStdString();
+
+  // A valid setting afterwards is applied and clears the message.
+  ASSERT_EQ(applyInPanel(IntegratorKind::backward_euler, 5.0), true);
+  EXPECT_TRUE(panel->errorText().isEmpty()) << panel->errorText().toStdString();
+  EXPECT_EQ(window_->simulation().model().integrator.kind, IntegratorKind::backward_euler);
 }
 
 }  // namespace

@@ -1,16 +1,25 @@
 #pragma once
 // Runs a simulation on its own thread in step with the wall clock, takes inputs (springs from a
 // dragged point) from other threads and publishes snapshots of the node positions.
+//
+// Time advances in whole steps of a fixed length (the model's integrator step, or its stable
+// explicit step when none is set): the wall time that passes is added to a backlog and the whole
+// steps in it are taken, at most max_steps_per_cycle at a time. When the machine cannot keep up,
+// the backlog beyond that cap is dropped, so simulated time runs slower than the wall clock instead
+// of the loop spiralling into ever longer catch-up cycles.
 
 #include "liversim/core/forces.h"
+#include "liversim/core/model.h"
 #include "liversim/core/state.h"
 #include "liversim/core/triple_buffer.h"
 
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <span>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -23,17 +32,68 @@ struct SimulationSnapshot {
 };
 
 struct RealtimeStats {
-  double steps_per_second = 0.0;
+  // Measured over the last statistics window (about a quarter of a second of wall time).
+  double steps_per_second = 0.0;  // integrator steps (substeps included)
   double real_time_factor = 0.0;  // simulated seconds per wall-clock second
-  double step_s = 0.0;            // current explicit step
-  bool behind = false;            // the step budget bit: simulated time runs slower than real time
+  double step_s = 0.0;            // smallest step the integrator actually took
+  bool behind = false;            // the step cap bit: simulated time runs slower than real time
+
+  IntegratorKind integrator = IntegratorKind::central_difference;
+  std::string_view integrator_name;  // integrator_name(integrator); static storage
+  double requested_step_s = 0.0;     // the fixed step the loop advances by
+  // Largest local error estimate of the steps taken (m, node positions); NaN when the integrator
+  // gave none (e.g. right after a step change).
+  double error_estimate_m = std::numeric_limits<double>::quiet_NaN();
+  // Cost: wall seconds spent integrating per simulated second (below 1 keeps up with real time),
+  // and internal-force evaluations of the whole mesh per simulated second.
+  double wall_s_per_simulated_s = 0.0;
+  double force_evaluations_per_simulated_s = 0.0;
+  // An explicit scheme had to shorten the requested step to stay stable (it substepped).
+  bool stability_limited = false;
+  double dropped_s = 0.0;  // wall time dropped from the backlog since the start (see `behind`)
 };
+
+// The fixed-step clock of the real-time loop, without the loop: wall time is added, whole steps
+// come out, at most max_steps at a time; the rest of a backlog beyond the cap is dropped.
+class StepAccumulator {
+ public:
+  struct Due {
+    int steps = 0;           // whole steps to take now (at most max_steps)
+    bool capped = false;     // the cap bit and whole steps were dropped
+    double dropped_s = 0.0;  // backlog dropped by this call
+  };
+
+  // step_s > 0 and max_steps >= 1, else std::invalid_argument.
+  StepAccumulator(double step_s, int max_steps);
+
+  // Adds elapsed wall time (negative or non-finite values count as 0) and takes the steps due.
+  // The fraction of a step left over stays in the backlog.
+  Due add(double elapsed_s);
+
+  double step_s() const { return step_s_; }
+  int max_steps() const { return max_steps_; }
+  double backlog_s() const { return backlog_s_; }
+  // Wall time until the next whole step is due.
+  double time_to_next_step_s() const { return step_s_ - backlog_s_; }
+
+ private:
+  double step_s_;
+  int max_steps_;
+  double backlog_s_ = 0.0;
+};
+
+// The fixed step the real-time loop advances by: the model's integrator step, or its stable
+// explicit step when that is 0.
+double realtime_step_s(const SimModel& model);
 
 class RealtimeSimulation {
  public:
   struct Options {
     std::size_t spring_capacity = 1024;
-    double cycle_s = 1.0 / 120.0;  // simulated time covered per cycle at most (publish rate)
+    double cycle_s = 1.0 / 120.0;  // simulated time a cycle may cover, when max_steps_per_cycle=0
+    // Steps one cycle (one published snapshot) may take at most; 0: as many as fit in cycle_s
+    // (at least one).
+    int max_steps_per_cycle = 0;
   };
 
   RealtimeSimulation(std::shared_ptr<const SimModel> model, SimState initial_state);
@@ -56,8 +116,15 @@ class RealtimeSimulation {
   bool update_snapshot() { return snapshots_.update(); }
   const SimulationSnapshot& snapshot() const { return snapshots_.front(); }
 
+  // The simulation's own state; only while it is stopped (e.g. to carry positions and velocities
+  // over to a rebuilt model).
+  const SimState& state() const { return state_; }
+
   RealtimeStats stats() const;
   const SimModel& model() const { return *model_; }
+  std::shared_ptr<const SimModel> shared_model() const { return model_; }
+  double step_s() const { return step_s_; }
+  int max_steps_per_cycle() const { return max_steps_per_cycle_; }
 
  private:
   void run();
@@ -65,6 +132,8 @@ class RealtimeSimulation {
   std::shared_ptr<const SimModel> model_;
   SimState state_;
   Options options_;
+  double step_s_;
+  int max_steps_per_cycle_;
   TripleBuffer<SimulationSnapshot> snapshots_;
 
   std::mutex springs_mutex_;  // UI ↔ simulation only; never on the haptic servo path
@@ -73,8 +142,13 @@ class RealtimeSimulation {
   std::vector<NodeSpring> active_springs_;  // simulation thread's copy
 
   std::atomic<bool> stop_requested_{false};
-  std::atomic<double> steps_per_second_{0.0}, real_time_factor_{0.0}, step_s_{0.0};
-  std::atomic<bool> behind_{false};
+  // Statistics, written by the simulation thread once per window; each field on its own (a reader
+  // may see fields of two neighbouring windows, which is harmless for a display).
+  std::atomic<double> steps_per_second_{0.0}, real_time_factor_{0.0}, smallest_step_s_{0.0};
+  std::atomic<double> error_estimate_m_{std::numeric_limits<double>::quiet_NaN()};
+  std::atomic<double> wall_s_per_simulated_s_{0.0}, force_evaluations_per_simulated_s_{0.0},
+      dropped_s_{0.0};
+  std::atomic<bool> behind_{false}, stability_limited_{false};
   std::thread thread_;
 };
 

@@ -1,0 +1,178 @@
+// The real-time loop's fixed-step clock: wall time in, whole steps out, at most a cap per cycle,
+// and the backlog beyond the cap dropped (simulated time slows down instead of spiralling). The
+// clock is tested with made-up elapsed times; the running loop only for what a tiny cap on a
+// heavy model must give whatever the machine's speed.
+#include "liversim/core/integrator.h"
+#include "liversim/core/liver_geometry.h"
+#include "liversim/core/realtime_simulation.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <thread>
+
+namespace liversim {
+namespace {
+
+constexpr double kStepS = 1e-3;
+
+TEST(StepAccumulator, TakesOnlyWholeStepsAndKeepsTheFractionForLater) {
+  StepAccumulator clock(kStepS, 100);
+  EXPECT_EQ(clock.add(0.4e-3).steps, 0);
+  EXPECT_EQ(clock.add(0.4e-3).steps, 0);
+  const StepAccumulator::Due due = clock.add(0.4e-3);  // 1.2 steps in all
+  EXPECT_EQ(due.steps, 1);
+  EXPECT_FALSE(due.capped);
+  EXPECT_NEAR(clock.backlog_s(), 0.2e-3, 1e-15);
+  EXPECT_NEAR(clock.time_to_next_step_s(), 0.8e-3, 1e-15);
+  EXPECT_EQ(clock.add(3.5e-3).steps, 3);  // 3.7 steps: 3 now, 0.7 kept
+  EXPECT_NEAR(clock.backlog_s(), 0.7e-3, 1e-15);
+}
+
+TEST(StepAccumulator, WallTimesThatSumToWholeStepsGiveThemAll) {
+  // 0.1 is not exact in binary: ten of them fall short of 1.0 by an ulp without the slack.
+  StepAccumulator clock(0.1, 1000);
+  int steps = 0;
+  for (int i = 0; i < 10; ++i) steps += clock.add(0.01).steps;
+  EXPECT_EQ(steps, 1);
+  for (int i = 0; i < 1000; ++i) steps += clock.add(0.1).steps;
+  EXPECT_EQ(steps, 1001);
+  EXPECT_LT(clock.backlog_s(), 1e-9);
+}
+
+TEST(StepAccumulator, TheCapDropsTheBacklogBeyondItAndSaysSo) {
+  StepAccumulator clock(kStepS, 4);
+  const StepAccumulator::Due due = clock.add(10.3e-3);
+  EXPECT_EQ(due.steps, 4);
+  EXPECT_TRUE(due.capped);
+  EXPECT_NEAR(due.dropped_s, 6e-3, 1e-12);
+  // Only the fraction of a step is kept: the next cycle does not start with a backlog to catch up.
+  EXPECT_NEAR(clock.backlog_s(), 0.3e-3, 1e-12);
+  const StepAccumulator::Due next = clock.add(0.8e-3);
+  EXPECT_EQ(next.steps, 1);
+  EXPECT_FALSE(next.capped);
+  EXPECT_EQ(next.dropped_s, 0.0);
+  // Exactly the cap is not "behind".
+  StepAccumulator exact(kStepS, 4);
+  const StepAccumulator::Due four = exact.add(4e-3);
+  EXPECT_EQ(four.steps, 4);
+  EXPECT_FALSE(four.capped);
+}
+
+TEST(StepAccumulator, AHeavyStepSlowsSimulatedTimeDownInsteadOfSpiralling) {
+  // A loop where every step costs three times its own length in wall time: uncapped, each cycle
+  // would owe three times more steps than the last. With a cap every cycle takes the cap's steps
+  // and simulated time runs at a third of the wall clock's pace.
+  constexpr int kCap = 5;
+  StepAccumulator clock(kStepS, kCap);
+  double elapsed_s = kStepS;  // the first cycle starts one step late
+  double simulated_s = 0.0, wall_s = 0.0, dropped_s = 0.0;
+  int largest_cycle = 0;
+  for (int cycle = 0; cycle < 200; ++cycle) {
+    const StepAccumulator::Due due = clock.add(elapsed_s);
+    wall_s += elapsed_s;
+    simulated_s += due.steps * kStepS;
+    dropped_s += due.dropped_s;
+    largest_cycle = std::max(largest_cycle, due.steps);
+    elapsed_s = 3.0 * kStepS * due.steps;  // the next cycle starts when this one is done
+  }
+  EXPECT_EQ(largest_cycle, kCap);
+  // Every second of wall time is simulated, dropped or still in the backlog.
+  EXPECT_NEAR(simulated_s + dropped_s + clock.backlog_s(), wall_s, 1e-9);
+  // After the first cycles the loop settles at cap steps per 3 × cap steps of wall time.
+  EXPECT_NEAR(simulated_s / wall_s, 1.0 / 3.0, 0.02);
+}
+
+TEST(StepAccumulator, IgnoresElapsedTimesThatAreNotTimeAndRejectsABadStepOrCap) {
+  StepAccumulator clock(kStepS, 10);
+  EXPECT_EQ(clock.add(-1.0).steps, 0);
+  EXPECT_EQ(clock.add(std::nan("")).steps, 0);
+  EXPECT_EQ(clock.add(std::numeric_limits<double>::infinity()).steps, 0);
+  EXPECT_EQ(clock.backlog_s(), 0.0);
+  EXPECT_THROW(StepAccumulator(0.0, 10), std::invalid_argument);
+  EXPECT_THROW(StepAccumulator(-1e-3, 10), std::invalid_argument);
+  EXPECT_THROW(StepAccumulator(std::nan(""), 10), std::invalid_argument);
+  EXPECT_THROW(StepAccumulator(kStepS, 0), std::invalid_argument);
+}
+
+struct RealtimeSteppingFixture : ::testing::Test {
+  static void SetUpTestSuite() { mesh_ = new TetMesh(generate_liver_mesh(1500).mesh); }
+  static void TearDownTestSuite() {
+    delete mesh_;
+    mesh_ = nullptr;
+  }
+  static std::shared_ptr<const SimModel> model_with(IntegratorSettings integrator) {
+    ModelOptions options;
+    options.fixed_nodes = mesh_->node_sets.at("ligament");
+    options.integrator = integrator;
+    return std::make_shared<const SimModel>(build_model(*mesh_, options));
+  }
+  static TetMesh* mesh_;
+};
+TetMesh* RealtimeSteppingFixture::mesh_ = nullptr;
+
+TEST_F(RealtimeSteppingFixture, TheFixedStepIsTheIntegratorStepOrElseTheStableStep) {
+  const auto stable = model_with({});
+  EXPECT_EQ(realtime_step_s(*stable), stable->stable_time_step_s);
+  const RealtimeSimulation by_cycle(stable, make_rest_state(*stable));
+  EXPECT_EQ(by_cycle.step_s(), stable->stable_time_step_s);
+  // The default cap covers one publish cycle (1/120 s) of simulated time.
+  EXPECT_EQ(by_cycle.max_steps_per_cycle(),
+            static_cast<int>(std::ceil((1.0 / 120.0) / stable->stable_time_step_s)));
+
+  IntegratorSettings implicit;
+  implicit.kind = IntegratorKind::backward_euler;
+  implicit.step_s = 0.02;  // longer than a cycle: still one step at a time
+  const auto slow = model_with(implicit);
+  EXPECT_EQ(realtime_step_s(*slow), 0.02);
+  const RealtimeSimulation one_step(slow, make_rest_state(*slow));
+  EXPECT_EQ(one_step.max_steps_per_cycle(), 1);
+  EXPECT_EQ(one_step.stats().integrator_name, "backward-euler");
+  EXPECT_EQ(one_step.stats().requested_step_s, 0.02);
+
+  RealtimeSimulation::Options options;
+  options.max_steps_per_cycle = 7;
+  const RealtimeSimulation capped(stable, make_rest_state(*stable), options);
+  EXPECT_EQ(capped.max_steps_per_cycle(), 7);
+}
+
+TEST_F(RealtimeSteppingFixture, ATinyCapOnAHeavyModelReportsBehindAndKeepsWholeSteps) {
+  // A step of 0.1 µs, one per cycle: a force evaluation of 1500 elements takes far longer than the
+  // step on any machine, so every cycle owes more than the cap and drops the rest.
+  IntegratorSettings tiny;
+  tiny.step_s = 1e-7;
+  const auto model = model_with(tiny);
+  RealtimeSimulation::Options options;
+  options.max_steps_per_cycle = 1;
+  RealtimeSimulation simulation(model, make_rest_state(*model), options);
+  simulation.start();
+  bool behind = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!behind && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    behind = simulation.stats().behind;
+  }
+  simulation.stop();
+  ASSERT_TRUE(behind) << "the loop never reported falling behind";
+
+  const RealtimeStats stats = simulation.stats();
+  EXPECT_EQ(stats.integrator_name, "central-difference");
+  EXPECT_EQ(stats.requested_step_s, 1e-7);
+  EXPECT_GT(stats.dropped_s, 0.0);
+  EXPECT_GT(stats.steps_per_second, 0.0);
+  EXPECT_GT(stats.wall_s_per_simulated_s, 0.0);
+  // At least one force evaluation per step taken.
+  EXPECT_GE(stats.force_evaluations_per_simulated_s, 0.99 / 1e-7);
+  // One step per cycle, and every cycle a whole step: simulated time is a whole number of steps.
+  const SimState& state = simulation.state();
+  ASSERT_GT(state.step_count, 0u);
+  const double steps = state.time_s / 1e-7;
+  EXPECT_NEAR(steps, std::round(steps), 1e-3) << state.time_s << " s";
+}
+
+}  // namespace
+}  // namespace liversim
