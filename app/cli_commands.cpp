@@ -30,28 +30,39 @@ int fail(const std::string& message) {
   return 2;
 }
 
+std::string number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+IntegratorKind integrator_kind(const std::string& name) {
+  if (auto kind = integrator_from_name(name)) return *kind;
+  std::string valid;
+  for (IntegratorKind kind : kAllIntegrators)
+    valid += (valid.empty() ? "" : ", ") + std::string(integrator_name(kind));
+  throw std::invalid_argument("unknown integrator '" + name + "': expected one of " + valid);
+}
+
+IntegratorSettings integrator_settings(const std::string& name, double dt_s) {
+  IntegratorSettings settings;
+  settings.kind = integrator_kind(name);
+  if (!std::isfinite(dt_s) || dt_s < 0.0)
+    throw std::invalid_argument("--dt " + number(dt_s) +
+                                " s is invalid: expected a finite value >= 0 (0: the stable step)");
+  if (dt_s == 0.0 && !is_explicit(settings.kind))
+    throw std::invalid_argument("--integrator " + name +
+                                " is implicit and needs a step: give --dt S (e.g. --dt 0.002)");
+  settings.step_s = dt_s;
+  return settings;
+}
+
 namespace {
 
 SceneSetup load_scene(const MeshSource& source) {
   if (source.file) return scene_from_file(*source.file, source.fixed_set);
   if (source.fixed_set) throw std::invalid_argument("--fixed-set needs --mesh");
   return default_scene(source.tet_count);
-}
-
-// Runs `body` and turns the exceptions of bad input into an error message and exit code 2.
-template <typename Body>
-int guarded(Body&& body) {
-  try {
-    return body();
-  } catch (const std::exception& e) {
-    return fail(e.what());
-  }
-}
-
-std::string number(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
 }
 
 // What a material test records and the closed form it is compared with.
@@ -120,7 +131,9 @@ int mesh_report(const MeshSource& mesh) {
 int simulate(const SimulateOptions& options) {
   return guarded([&]() -> int {
     if (!options.force_n.allFinite()) return fail("--force must be three finite numbers");
-    const SceneSetup scene = load_scene(options.mesh);
+    const IntegratorSettings integrator = integrator_settings(options.integrator, options.dt_s);
+    SceneSetup scene = load_scene(options.mesh);
+    scene.model_options.integrator = integrator;
     const SimModel model = build_model(scene.mesh, scene.model_options);
     const NodeIndex node = options.node.value_or(anterior_marked_node(scene.mesh));
     if (node < 0 || static_cast<std::size_t>(node) >= model.node_count)
@@ -153,12 +166,9 @@ int simulate(const SimulateOptions& options) {
     const auto wall_start = std::chrono::steady_clock::now();
     const int samples =
         std::max(1, static_cast<int>(std::ceil(options.duration_s / options.sample_interval_s)));
-    double smallest_step = options.duration_s, largest_step = 0.0, stiffening = 1.0;
+    StepReport steps;
     for (int i = 0; i < samples; ++i) {
-      const StepReport report = advance(model, state, inputs, options.duration_s / samples);
-      smallest_step = std::min(smallest_step, report.smallest_substep_s);
-      largest_step = std::max(largest_step, report.largest_substep_s);
-      stiffening = std::max(stiffening, report.max_stiffening);
+      accumulate(steps, advance(model, state, inputs, options.duration_s / samples));
       write_sample();
     }
     const double wall_s =
@@ -169,11 +179,29 @@ int simulate(const SimulateOptions& options) {
     std::cout << std::setprecision(6) << scene.description << "; load "
               << options.force_n.transpose() << " N on node " << node << " spread over "
               << patch.nodes.size() << " surface nodes\n"
-              << "explicit central difference: " << state.step_count << " steps of "
-              << smallest_step * 1e3 << " to " << largest_step * 1e3 << " ms (rest stable step "
-              << model.stable_time_step_s * 1e3 << " ms; compression stiffened it up to "
-              << stiffening << "x), " << wall_s << " s wall time\n"
-              << "displacement of node " << node << " after " << state.time_s
+              << integrator_name(model.integrator.kind) << ": " << steps.substeps << " steps of "
+              << steps.smallest_substep_s * 1e3 << " to " << steps.largest_substep_s * 1e3
+              << " ms, " << steps.force_evaluations << " force evaluations";
+    if (!is_explicit(model.integrator.kind))
+      std::cout << ", " << steps.newton_iterations << " Newton iterations, " << steps.factorizations
+                << " factorisations"
+                << (steps.unconverged_steps > 0
+                        ? " (" + std::to_string(steps.unconverged_steps) + " steps unconverged)"
+                        : std::string());
+    std::cout << "; " << wall_s << " s wall time\n";
+    if (is_explicit(model.integrator.kind)) {
+      // What the engine had to do to stay stable (the seed's RK4 at 2 ms needs this).
+      std::cout << "stable explicit step at rest " << model.stable_time_step_s * 1e3
+                << " ms (central difference); compression and fibres stiffened it up to "
+                << steps.max_stiffening << "x";
+      if (steps.stability_limited_steps > 0)
+        std::cout << "; " << steps.stability_limited_steps << " steps shortened below the "
+                  << "requested " << model.integrator.step_s * 1e3
+                  << " ms by the stability limit (smallest " << steps.smallest_stable_step_s * 1e3
+                  << " ms)";
+      std::cout << "\n";
+    }
+    std::cout << "displacement of node " << node << " after " << state.time_s
               << " s (mm): " << (u * 1e3).transpose() << "  |u| = " << u.norm() * 1e3 << "\n";
     if (csv) std::cout << "wrote " << options.csv_output->string() << "\n";
     return 0;

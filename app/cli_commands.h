@@ -2,10 +2,13 @@
 // The headless commands of liversim-cli. Each returns the process exit code and reports problems
 // on stderr as "liversim-cli: error: ...".
 
+#include "liversim/core/model.h"
+
 #include <Eigen/Core>
 
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace liversim::cli {
@@ -18,6 +21,8 @@ struct MeshSource {
 
 struct SimulateOptions {
   MeshSource mesh;
+  std::string integrator = "central-difference";  // a name of integrator_from_name
+  double dt_s = 0.0;  // requested integrator step; 0: the stable step (explicit schemes only)
   double duration_s = 1.0;
   std::optional<int> node;  // default: a point on the anterior surface of the right lobe
   Eigen::Vector3d force_n{0.0, 0.1, 0.0};
@@ -66,6 +71,25 @@ int screenshot(const ScreenshotOptions& options);
 int material_test(const MaterialTestOptions& options);
 // Reports a problem on stderr as "liversim-cli: error: <message>" and returns exit code 2.
 int fail(const std::string& message);
+
+// Runs `body` and turns the exceptions of bad input into an error message and exit code 2.
+template <typename Body>
+int guarded(Body&& body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+}
+
+// A number as the user would type it (shortest round trip is not needed: 6 digits).
+std::string number(double value);
+
+// The integrator of --integrator NAME; throws std::invalid_argument naming it and listing the
+// valid names.
+IntegratorKind integrator_kind(const std::string& name);
+// The integrator settings of --integrator and --dt, checked before the (slow) model build.
+IntegratorSettings integrator_settings(const std::string& name, double dt_s);
 // A short pull on the liver, released, with a screenshot of the deformed organ while pulled.
 int demo(const ScreenshotOptions& options);
 

@@ -1,5 +1,7 @@
 // liversim-cli: headless simulation, mesh reports and screenshots.
 #include "cli_commands.h"
+#include "experiment_commands.h"
+#include "study_command.h"
 
 #include <CLI/CLI.hpp>
 
@@ -47,6 +49,14 @@ int main(int argc, char** argv) {
       ->add_option("--load-radius", sim.load_radius_m,
                    "Spread the load over surface nodes within this radius (m)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  simulate_cmd
+      ->add_option("--integrator", sim.integrator,
+                   "central-difference, rk4, dopri5, backward-euler or bdf2")
+      ->capture_default_str();
+  simulate_cmd
+      ->add_option("--dt", sim.dt_s,
+                   "Requested integrator step (s; 0: the stable step, explicit schemes only)")
       ->capture_default_str();
   simulate_cmd->add_option("--output", sim.csv_output, "Write the displacement history as CSV");
   simulate_cmd->add_option("--sample-interval", sim.sample_interval_s, "CSV sample interval (s)")
@@ -121,6 +131,9 @@ int main(int argc, char** argv) {
   material_cmd->add_option("--plot", material.plot_output,
                            "Write a PNG plot of both curves (needs X or xvfb-run)");
 
+  const auto run_experiment = add_experiment_command(app);
+  const auto run_study = add_study_command(app);
+
   try {
     app.parse(argc, argv);
     if (force.size() == 3) sim.force_n = {force[0], force[1], force[2]};
@@ -128,6 +141,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
 
+  if (auto exit_code = run_experiment()) return *exit_code;
+  if (auto exit_code = run_study()) return *exit_code;
   if (report->parsed()) return mesh_report(report_mesh);
   if (simulate_cmd->parsed()) return simulate(sim);
   if (screenshot_cmd->parsed()) return screenshot(shot);

@@ -43,6 +43,11 @@ struct ViscousContext {
   const ViscousArmInputs* arm = nullptr;  // set: the arm is carried by the integrator
 };
 
+bool in_viscous_region(const SimModel& model, std::size_t e) {
+  return model.effects.viscous &&
+         model.viscous_parameters[static_cast<std::size_t>(model.region[e])].has_value();
+}
+
 // `averaged_volume_ratio` is used only with average nodal pressure (kAveragedPressure).
 template <bool kFibres, bool kViscous, bool kAveragedPressure, bool kMooneyRivlin>
 Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F,
@@ -60,7 +65,9 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
     } else {
       P = viscous_tissue_update(F, **step, (*viscous.state)[e]);
     }
-  } else if (kAveragedPressure)
+  } else if (kAveragedPressure && !in_viscous_region(model, e))
+    // A viscous region's law works with its element's own volume ratio, so its instantaneous
+    // elastic response (what the stable step is estimated from) must too.
     P = neo_hookean::first_piola_stress_averaged_pressure(
         F, model.shear_modulus_pa[e], model.lame_lambda_pa[e], averaged_volume_ratio);
   else

@@ -15,6 +15,7 @@
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
 
+#include <array>
 #include <limits>
 
 namespace liversim {
@@ -34,7 +35,18 @@ class ImplicitSolver {
   detail::SparseLdlt factorisation;
   std::vector<double> rhs, ordered_rhs;
   NodeArray force;
+  // Newton–Krylov: the residual, the correction, the Krylov basis (kKrylovDimension + 1 vectors)
+  // and the perturbed state of the Jacobian-vector products.
+  std::vector<double> residual, correction, krylov_basis, krylov_work, perturbed_residual;
+  NodeArray perturbed_position_m, perturbed_velocity_m_per_s;
 };
+
+namespace {
+constexpr int kKrylovDimension = 30;
+// Relative residual of the Newton equation at which GMRES stops: inexact Newton, whose
+// contraction per iteration is then about this (plus the quadratic term).
+constexpr double kKrylovTolerance = 1e-4;
+}  // namespace
 
 ImplicitSolver::ImplicitSolver(const SimModel& model) {
   const auto dofs = static_cast<int>(3 * model.node_count);
@@ -93,9 +105,17 @@ ImplicitSolver::ImplicitSolver(const SimModel& model) {
   const std::span<const int> rows(matrix.innerIndexPtr(),
                                   static_cast<std::size_t>(matrix.nonZeros()));
   factorisation.analyse(columns, rows);
-  rhs.resize(static_cast<std::size_t>(dofs));
-  ordered_rhs.resize(static_cast<std::size_t>(dofs));
+  const auto size = static_cast<std::size_t>(dofs);
+  rhs.resize(size);
+  ordered_rhs.resize(size);
   force.resize(model.node_count);
+  residual.resize(size);
+  correction.resize(size);
+  krylov_basis.resize((kKrylovDimension + 1) * size);
+  krylov_work.resize(size);
+  perturbed_residual.resize(size);
+  perturbed_position_m.resize(model.node_count);
+  perturbed_velocity_m_per_s.resize(model.node_count);
 }
 
 ImplicitSolverHandle::ImplicitSolverHandle() = default;
@@ -156,6 +176,96 @@ void assemble(const SimModel& model, const SimState& state, const StepInputs& in
       values[solver.diagonal_entry[3 * spring.node + static_cast<std::size_t>(axis)]] +=
           spring.stiffness_n_per_m + spring.damping_n_s_per_m / beta;
   }
+}
+
+// GMRES on J·δ = −r (r in solver.residual, evaluated at x), right-preconditioned by the
+// factorised tangent P, with J·u ≈ (r(x + εu) − r(x))/ε. Writes δ; returns the iterations used.
+// Allocates nothing (the basis is the solver's).
+template <typename Residual, typename Precondition>
+int solve_newton_equation(const SimModel& model, ImplicitSolver& solver, Residual& residual,
+                          Precondition& precondition, const NodeArray& x,
+                          std::vector<double>& delta) {
+  const std::size_t size = solver.residual.size();
+  auto basis = [&](int j) {
+    return solver.krylov_basis.data() + static_cast<std::size_t>(j) * size;
+  };
+  const std::vector<double>& r0 = solver.residual;
+  double beta0 = 0.0;
+  for (double value : r0) beta0 += value * value;
+  beta0 = std::sqrt(beta0);
+  std::fill(delta.begin(), delta.end(), 0.0);
+  if (!(beta0 > 0.0)) return 0;
+  for (std::size_t i = 0; i < size; ++i) basis(0)[i] = -r0[i] / beta0;
+
+  std::array<double, (kKrylovDimension + 1) * kKrylovDimension> h{};
+  auto H = [&](int i, int j) -> double& {
+    return h[static_cast<std::size_t>(i * kKrylovDimension + j)];
+  };
+  std::array<double, kKrylovDimension> cs{}, sn{};
+  std::array<double, kKrylovDimension + 1> g{};
+  g[0] = beta0;
+  // A perturbation of a millionth of the smallest element: far inside the force's nonlinearity,
+  // far above its round-off.
+  const double perturbation_m = 1e-6 * model.min_element_height_m;
+  std::vector<double>& z = solver.krylov_work;
+  int k = 0;
+  for (int j = 0; j < kKrylovDimension; ++j) {
+    std::copy(basis(j), basis(j) + size, z.begin());
+    precondition(z);
+    double largest = 0.0;
+    for (double value : z) largest = std::max(largest, std::abs(value));
+    if (!(largest > 0.0) || !std::isfinite(largest)) break;
+    const double eps = perturbation_m / largest;
+    NodeArray& xp = solver.perturbed_position_m;
+    for (std::size_t n = 0; n < model.node_count; ++n) {
+      xp.x[n] = x.x[n] + eps * z[3 * n];
+      xp.y[n] = x.y[n] + eps * z[3 * n + 1];
+      xp.z[n] = x.z[n] + eps * z[3 * n + 2];
+    }
+    residual(xp, solver.perturbed_velocity_m_per_s, solver.perturbed_residual);
+    double* w = basis(j + 1);
+    for (std::size_t i = 0; i < size; ++i) w[i] = (solver.perturbed_residual[i] - r0[i]) / eps;
+    for (int i = 0; i <= j; ++i) {  // modified Gram–Schmidt
+      double dot = 0.0;
+      const double* vi = basis(i);
+      for (std::size_t l = 0; l < size; ++l) dot += w[l] * vi[l];
+      H(i, j) = dot;
+      for (std::size_t l = 0; l < size; ++l) w[l] -= dot * vi[l];
+    }
+    double norm = 0.0;
+    for (std::size_t l = 0; l < size; ++l) norm += w[l] * w[l];
+    norm = std::sqrt(norm);
+    H(j + 1, j) = norm;
+    for (int i = 0; i < j; ++i) {  // earlier rotations on the new column
+      const double upper = cs[i] * H(i, j) + sn[i] * H(i + 1, j);
+      H(i + 1, j) = -sn[i] * H(i, j) + cs[i] * H(i + 1, j);
+      H(i, j) = upper;
+    }
+    const double radius = std::hypot(H(j, j), H(j + 1, j));
+    if (!(radius > 0.0)) break;
+    cs[j] = H(j, j) / radius;
+    sn[j] = H(j + 1, j) / radius;
+    H(j, j) = radius;
+    H(j + 1, j) = 0.0;
+    g[j + 1] = -sn[j] * g[j];
+    g[j] = cs[j] * g[j];
+    k = j + 1;
+    if (std::abs(g[j + 1]) <= kKrylovTolerance * beta0 || norm == 0.0) break;
+    for (std::size_t l = 0; l < size; ++l) w[l] /= norm;
+  }
+  // y from the triangular system, then δ = P⁻¹·Σ yᵢ·vᵢ.
+  std::array<double, kKrylovDimension> y{};
+  for (int i = k - 1; i >= 0; --i) {
+    double sum = g[i];
+    for (int l = i + 1; l < k; ++l) sum -= H(i, l) * y[l];
+    y[i] = sum / H(i, i);
+  }
+  for (int i = 0; i < k; ++i) {
+    const double* vi = basis(i);
+    for (std::size_t l = 0; l < size; ++l) delta[l] += y[i] * vi[l];
+  }
+  precondition(delta);
+  return k;
 }
 
 void copy(const NodeArray& from, NodeArray& to) {
@@ -236,40 +346,59 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
     }
     const ViscousArmInputs arm{s.predicted_arm, s.keep_by_region, s.elastic_weight_by_region,
                                s.elastic_stress};
-    bool converged = false;
-    double previous_correction = std::numeric_limits<double>::infinity();
-    // The tangent changes slowly: keep a factorisation across iterations and steps while Newton
-    // still contracts well, and build a new one for a new β, new springs, or a slow last step.
-    bool refactor = !s.factorisation_valid || s.factorised_beta_s != beta ||
-                    s.last_newton_iterations > 8 ||
-                    (step == 0 && s.inputs_changed && !inputs.springs.empty());
-    int iterations = 0;
-    bool refreshed = false;
-    for (int iteration = 0; iteration < settings.max_newton_iterations; ++iteration) {
+    // r(x) into `r` (DOF order, 0 on fixed DOFs), velocities v = (x − x̂)/β into `velocity`.
+    auto residual = [&](const NodeArray& position, NodeArray& velocity, std::vector<double>& r) {
       for (std::size_t n = 0; n < n_nodes; ++n) {
-        v.x[n] = (x.x[n] - s.predicted_position_m.x[n]) / beta;
-        v.y[n] = (x.y[n] - s.predicted_position_m.y[n]) / beta;
-        v.z[n] = (x.z[n] - s.predicted_position_m.z[n]) / beta;
+        velocity.x[n] = (position.x[n] - s.predicted_position_m.x[n]) / beta;
+        velocity.y[n] = (position.y[n] - s.predicted_position_m.y[n]) / beta;
+        velocity.z[n] = (position.z[n] - s.predicted_position_m.z[n]) / beta;
       }
       const ElasticEvaluation seen =
-          compute_internal_forces_rate_form(model, state, x, arm, solver.force);
+          compute_internal_forces_rate_form(model, state, position, arm, solver.force);
       ++report.force_evaluations;
-      report.max_stiffening = std::max(report.max_stiffening, stiffening_since_rest(model, seen));
-      add_input_forces(inputs, x, v, solver.force);
+      add_input_forces(inputs, position, velocity, solver.force);
       for (std::size_t n = 0; n < n_nodes; ++n) {
         const double mass = model.lumped_mass_kg[n];
         const bool fixed = model.is_fixed[n] != 0;
         const double inertia = mass / beta, damping = model.mass_damping_per_s * mass;
-        const double rx = inertia * (v.x[n] - s.predicted_velocity_m_per_s.x[n]) +
-                          damping * v.x[n] - solver.force.x[n];
-        const double ry = inertia * (v.y[n] - s.predicted_velocity_m_per_s.y[n]) +
-                          damping * v.y[n] - solver.force.y[n];
-        const double rz = inertia * (v.z[n] - s.predicted_velocity_m_per_s.z[n]) +
-                          damping * v.z[n] - solver.force.z[n];
-        solver.rhs[3 * n] = fixed ? 0.0 : -rx;
-        solver.rhs[3 * n + 1] = fixed ? 0.0 : -ry;
-        solver.rhs[3 * n + 2] = fixed ? 0.0 : -rz;
+        const double* vp[3] = {&velocity.x[n], &velocity.y[n], &velocity.z[n]};
+        const double* hat[3] = {&s.predicted_velocity_m_per_s.x[n],
+                                &s.predicted_velocity_m_per_s.y[n],
+                                &s.predicted_velocity_m_per_s.z[n]};
+        const double* f[3] = {&solver.force.x[n], &solver.force.y[n], &solver.force.z[n]};
+        for (int a = 0; a < 3; ++a)
+          r[3 * n + static_cast<std::size_t>(a)] =
+              fixed ? 0.0 : inertia * (*vp[a] - *hat[a]) + damping * *vp[a] - *f[a];
       }
+      return seen;
+    };
+    // M⁻¹-like solve with the factorised approximate tangent, in place on a DOF-order vector.
+    auto precondition = [&](std::vector<double>& vector) {
+      for (std::size_t d = 0; d < dofs; ++d)
+        solver.ordered_rhs[static_cast<std::size_t>(solver.ordered_index[d])] = vector[d];
+      solver.factorisation.solve(solver.ordered_rhs);
+      for (std::size_t d = 0; d < dofs; ++d)
+        vector[d] = solver.ordered_rhs[static_cast<std::size_t>(solver.ordered_index[d])];
+      ++report.linear_solves;
+    };
+
+    bool converged = false;
+    // The tangent changes slowly, and the Krylov solve below absorbs what it misses: keep a
+    // factorisation across iterations and steps, and build a new one for a new β, new springs,
+    // or when the Krylov solve needed many iterations.
+    bool refactor = !s.factorisation_valid || s.factorised_beta_s != beta ||
+                    s.last_newton_iterations > 8 ||
+                    (step == 0 && s.inputs_changed && !inputs.springs.empty());
+    int krylov_iterations = 0;
+    double last_correction = std::numeric_limits<double>::infinity();
+    for (int iteration = 0; iteration <= settings.max_newton_iterations; ++iteration) {
+      const ElasticEvaluation seen = residual(x, v, solver.residual);
+      report.max_stiffening = std::max(report.max_stiffening, stiffening_since_rest(model, seen));
+      if (last_correction <= settings.newton_tolerance_m) {
+        converged = true;  // the residual (and the arm's S_e) is now that of the final x
+        break;
+      }
+      if (iteration == settings.max_newton_iterations) break;
       if (refactor) {
         assemble(model, state, inputs, arm, beta, solver);
         ++report.factorizations;
@@ -278,36 +407,27 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
         refactor = false;
         if (!s.factorisation_valid) break;
       }
-      ++iterations;
-      for (std::size_t d = 0; d < dofs; ++d)
-        solver.ordered_rhs[static_cast<std::size_t>(solver.ordered_index[d])] = solver.rhs[d];
-      solver.factorisation.solve(solver.ordered_rhs);
-      for (std::size_t d = 0; d < dofs; ++d)
-        solver.rhs[d] = solver.ordered_rhs[static_cast<std::size_t>(solver.ordered_index[d])];
-      ++report.linear_solves;
       ++report.newton_iterations;
+      // Newton's equation J·δ = −r by GMRES, right-preconditioned with the factorised tangent, J·u
+      // by a difference of residuals: the true Jacobian, average nodal pressure included (the
+      // assembled tangent leaves its coupling out, and alone converges slowly or not at all).
+      const int used =
+          solve_newton_equation(model, solver, residual, precondition, x, solver.correction);
+      krylov_iterations = std::max(krylov_iterations, used);
+      if (used > 10) refactor = true;
       double largest_sq = 0.0;
       for (std::size_t n = 0; n < n_nodes; ++n) {
-        const double dx = solver.rhs[3 * n], dy = solver.rhs[3 * n + 1], dz = solver.rhs[3 * n + 2];
+        const double dx = solver.correction[3 * n], dy = solver.correction[3 * n + 1],
+                     dz = solver.correction[3 * n + 2];
         x.x[n] += dx;
         x.y[n] += dy;
         x.z[n] += dz;
         largest_sq = std::max(largest_sq, dx * dx + dy * dy + dz * dz);
       }
-      const double largest = std::sqrt(largest_sq);
-      if (!std::isfinite(largest)) break;
-      if (largest <= settings.newton_tolerance_m) {
-        converged = true;
-        break;
-      }
-      // Refresh a factorisation that has nearly stopped contracting (large rotations,
-      // stiffening), once per step: a contraction slower than quadratic alone is the tangent's
-      // missing average-nodal-pressure coupling, which a new factorisation does not fix.
-      refactor = largest > 0.8 * previous_correction && !refreshed;
-      refreshed = refreshed || refactor;
-      previous_correction = largest;
+      last_correction = std::sqrt(largest_sq);
+      if (!std::isfinite(last_correction)) break;
     }
-    s.last_newton_iterations = iterations;
+    s.last_newton_iterations = krylov_iterations;
     if (!converged) ++report.unconverged_steps;
     for (std::size_t n = 0; n < n_nodes; ++n) {
       v.x[n] = (x.x[n] - s.predicted_position_m.x[n]) / beta;

@@ -28,4 +28,20 @@ void write_curve_plot_png(const std::filesystem::path& file, const std::string& 
                           const std::vector<double>& x, const std::vector<CurveSeries>& series,
                           int width, int height);
 
+// A set of (x, y) points of its own, drawn as markers joined by a line, e.g. one integrator's runs
+// in an error-versus-cost plot.
+struct ScatterSeries {
+  std::string name;
+  std::vector<double> x;
+  std::vector<double> y;
+};
+
+// Like write_curve_plot_png, for series with their own abscissae; logarithmic axes on request
+// (non-positive values are left out of a logarithmic plot). Throws std::invalid_argument when
+// there is no series or a series' x and y differ in length.
+void write_scatter_plot_png(const std::filesystem::path& file, const std::string& title,
+                            const std::string& x_label, const std::string& y_label,
+                            const std::vector<ScatterSeries>& series, bool log_x, bool log_y,
+                            int width, int height);
+
 }  // namespace liversim

@@ -1,0 +1,98 @@
+#pragma once
+// "What accuracy costs in time": runs the seed's loaded-liver experiment over a grid of
+// integrator × step (or tolerance) × mesh size × enabled effects, and measures each run's error
+// against a reference and its cost. The CLI's `study accuracy` writes the results as CSV, plots
+// and a report (docs/accuracy-study.md).
+
+#include "liversim/core/integrator.h"
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace liversim {
+
+// Which effects the study's tissue has (docs/accuracy-study.md gives the assumed parameters).
+enum class StudyEffects {
+  elastic,       // Neo-Hookean, ν = 0.49, average nodal pressure (the default scene)
+  viscoelastic,  // + the seed's three-element viscoelasticity (Eq. 1–3)
+  viscoplastic,  // + viscoplastic flow above a yield limit (Eq. 4): non-smooth at the yield
+  fibres,        // elastic + one HGO fibre family (Eq. 5–6)
+};
+inline constexpr StudyEffects kAllStudyEffects[] = {
+    StudyEffects::elastic, StudyEffects::viscoelastic, StudyEffects::viscoplastic,
+    StudyEffects::fibres};
+std::string_view study_effects_name(StudyEffects effects);
+std::optional<StudyEffects> study_effects_from_name(std::string_view name);
+
+struct AccuracyStudyOptions {
+  std::vector<int> tet_counts{3841};  // built-in liver sizes; the last (largest) is the finest
+  std::vector<StudyEffects> effects{StudyEffects::elastic};
+  std::vector<IntegratorKind> integrators{std::begin(kAllIntegrators), std::end(kAllIntegrators)};
+  std::vector<double> steps_s{1e-3, 5e-4, 2.5e-4};      // fixed-step schemes
+  std::vector<double> tolerances_m{1e-7, 1e-9, 1e-11};  // dopri5
+  // The seed's tension at the marked point, rising smoothly (C¹, x²(3 − 2x)) from 0 to the peak
+  // over the whole run. It is updated once per load interval (the largest step), so every step
+  // divides it and each scheme sees the same forcing, piecewise constant.
+  double duration_s = 0.05;
+  double peak_force_n = 0.63;
+  double load_radius_m = 0.02;
+  // The reference of each mesh: RK4 at the smallest step / reference_refinement.
+  int reference_refinement = 64;
+};
+
+struct AccuracyStudyRow {
+  int requested_tets = 0;
+  std::size_t tet_count = 0;
+  StudyEffects effects = StudyEffects::elastic;
+  IntegratorKind integrator = IntegratorKind::central_difference;
+  double step_s = 0.0;       // requested (fixed-step schemes; 0 for dopri5)
+  double tolerance_m = 0.0;  // dopri5
+  // Position error at the end: of the marked point, and the largest over all nodes.
+  double marked_point_error_m = 0.0;
+  double max_node_error_m = 0.0;
+  double displacement_m = 0.0;  // |u| of the marked point at the end
+  double wall_s = 0.0;          // wall time of the advance() calls only
+  StepReport steps;
+  double wall_per_simulated_s(const AccuracyStudyOptions& options) const {
+    return wall_s / options.duration_s;
+  }
+  // The step the scheme actually took on average (stability-limited explicit steps are shorter
+  // than requested).
+  double mean_step_s(const AccuracyStudyOptions& options) const {
+    return options.duration_s / steps.substeps;
+  }
+};
+
+// Discretisation error in space: the reference answer of each mesh against the finest mesh's, at
+// the same material point (the finest mesh's marked node, interpolated in each mesh).
+struct MeshConvergenceRow {
+  int requested_tets = 0;
+  std::size_t tet_count = 0;
+  StudyEffects effects = StudyEffects::elastic;
+  Eigen::Vector3d displacement_m = Eigen::Vector3d::Zero();  // at the material point, reference
+  double difference_from_finest_m = 0.0;                     // |u − u_finest|
+  double reference_wall_s = 0.0;
+};
+
+struct AccuracyStudyResult {
+  std::vector<AccuracyStudyRow> rows;
+  std::vector<MeshConvergenceRow> mesh_rows;
+};
+
+// Observed order between two runs of one scheme: log(e₁/e₂)/log(Δt₁/Δt₂). NaN if either error is
+// not positive or either run was stability-limited (its step was not the requested one).
+double observed_order(const AccuracyStudyRow& coarse, const AccuracyStudyRow& fine);
+
+// Progress: runs finished, runs in all, and what runs next.
+using StudyProgress = std::function<void(int done, int total, const std::string& next)>;
+
+// Throws std::invalid_argument naming a bad option (empty lists, non-positive steps or
+// tolerances, a step that does not divide the load interval) and std::runtime_error when a run
+// stops being finite.
+AccuracyStudyResult run_accuracy_study(const AccuracyStudyOptions& options,
+                                       const StudyProgress& progress = {});
+
+}  // namespace liversim
