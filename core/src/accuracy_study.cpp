@@ -2,6 +2,7 @@
 
 #include "liversim/core/default_scene.h"
 #include "liversim/core/seed_experiments.h"
+#include "liversim/core/surface.h"
 
 #include <Eigen/Dense>
 
@@ -133,6 +134,20 @@ Eigen::Vector3d displacement_at(const SimModel& model, const NodeArray& position
   return u;
 }
 
+NodeIndex nearest_surface_node(const TetMesh& mesh, const Eigen::Vector3d& point) {
+  const BoundarySurface surface = extract_surface(mesh);
+  NodeIndex best = surface.nodes.front();
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (NodeIndex n : surface.nodes) {
+    const double distance = (mesh.rest_position_m.at(n) - point).squaredNorm();
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = n;
+    }
+  }
+  return best;
+}
+
 void validate(const AccuracyStudyOptions& options, double load_interval_s) {
   auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
   if (options.tet_counts.empty()) fail("the study needs at least one mesh size");
@@ -203,8 +218,11 @@ AccuracyStudyResult run_accuracy_study(const AccuracyStudyOptions& options,
   AccuracyStudyResult result;
   for (int tets : tet_counts) {
     const SceneSetup scene = default_scene(tets);
-    const NodeIndex marked = anterior_marked_node(scene.mesh);
-    if (!material_point) material_point = scene.mesh.rest_position_m.at(marked);
+    // Every mesh is loaded at the same place: the finest mesh's marked point, or the surface
+    // node of this mesh nearest to it.
+    if (!material_point)
+      material_point = scene.mesh.rest_position_m.at(anterior_marked_node(scene.mesh));
+    const NodeIndex marked = nearest_surface_node(scene.mesh, *material_point);
     for (StudyEffects effects : options.effects) {
       ModelOptions base = scene.model_options;
       apply_effects(effects, base);

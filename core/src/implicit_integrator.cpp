@@ -287,7 +287,7 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
                                   static_cast<std::size_t>(solver.matrix.nonZeros()));
   const std::span<const double> values(solver.matrix.valuePtr(), rows.size());
   const IntegratorSettings& settings = model.integrator;
-  const double steps = steps_to_cover(interval_s, settings.step_s);
+  const double steps = steps_to_cover(interval_s, settings.step_s * s.step_scale);
   const double dt = interval_s / steps;
   const std::size_t n_nodes = model.node_count;
 
@@ -384,9 +384,10 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
 
     bool converged = false;
     // The tangent changes slowly, and the Krylov solve below absorbs what it misses: keep a
-    // factorisation across iterations and steps, and build a new one for a new β, new springs,
-    // or when the Krylov solve needed many iterations.
-    bool refactor = !s.factorisation_valid || s.factorised_beta_s != beta ||
+    // factorisation across iterations and steps, and build a new one for a quite different β,
+    // new springs, or when the Krylov solve needed many iterations.
+    // (BDF2's restarts switch β between Δt and 2Δt/3: GMRES absorbs that much.)
+    bool refactor = !s.factorisation_valid || std::abs(beta / s.factorised_beta_s - 1.0) > 0.6 ||
                     s.last_newton_iterations > 8 ||
                     (step == 0 && s.inputs_changed && !inputs.springs.empty());
     int krylov_iterations = 0;

@@ -67,7 +67,8 @@ struct AccuracyStudyRow {
 };
 
 // Discretisation error in space: the reference answer of each mesh against the finest mesh's, at
-// the same material point (the finest mesh's marked node, interpolated in each mesh).
+// the same material point (the finest mesh's marked node, interpolated in each mesh). Every mesh
+// is loaded at its surface node nearest to that point.
 struct MeshConvergenceRow {
   int requested_tets = 0;
   std::size_t tet_count = 0;
