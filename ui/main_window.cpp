@@ -201,12 +201,40 @@ void MainWindow::updateStatus() {
                      .arg(stats.step_s * 1e3, 0, 'f', 3);
   if (stats.behind) text += tr(" | slower than real time");
   text += tr(" | ") + accuracyStatus(stats);
+  // The step guards: what went wrong and what the simulation did about it.
+  if (stats.halted)
+    text = tr("Simulation halted: %1; every retry with shorter steps failed. Apply a setting in "
+              "the Accuracy panel (another integrator or a shorter step) to go on from the last "
+              "good state. | ")
+               .arg(healthProblemText(stats.last_problem)) +
+           text;
+  else if (stats.rollbacks > 0 || stats.rejected_inputs > 0)
+    text += tr(" | recovered %1 times, refused %2 inputs (last: %3)")
+                .arg(stats.rollbacks)
+                .arg(stats.rejected_inputs)
+                .arg(healthProblemText(stats.last_problem));
   if (grab_) {
     const Eigen::Vector3d force =
         grab_reaction_force_n(*grab_, handle_m_, simulation_->snapshot().position_m);
     text += tr(" | pulling %1 N").arg(force.norm(), 0, 'f', 2);
   }
   statusLabel_->setText(text);
+}
+
+QString MainWindow::healthProblemText(HealthProblem problem) {
+  switch (problem) {
+    case HealthProblem::none:
+      return tr("no problem");
+    case HealthProblem::non_finite_input:
+      return tr("a tool input was not a number");
+    case HealthProblem::non_finite_position:
+      return tr("a node position became not a number");
+    case HealthProblem::non_finite_velocity:
+      return tr("a node velocity became not a number");
+    case HealthProblem::runaway_speed:
+      return tr("a node moved implausibly fast");
+  }
+  return tr("unknown problem");
 }
 
 // The error estimate for the status bar, in the unit that suits it: "≈ 2.1 µm". Below a picometre

@@ -60,6 +60,7 @@ class MainWindow : public QMainWindow {
   void showNewestSnapshot();
   void updateStatus();
   QString accuracyStatus(const RealtimeStats& stats) const;
+  static QString healthProblemText(HealthProblem problem);
   static QString formatError(double error_m);
 
   SceneSetup setup_;

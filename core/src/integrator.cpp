@@ -429,6 +429,7 @@ void advance_central_difference(const SimModel& model, SimState& state, const St
         ++report.stability_limited_steps;
       }
     }
+    step *= state.integrator.step_scale;
     // Equal steps over what is left, so the interval ends exactly where asked.
     const double steps_left = detail::steps_to_cover(remaining, step);
     const double dt = steps_left <= 1.0 ? remaining : remaining / steps_left;

@@ -74,6 +74,7 @@ RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
                                 " s)");
   pending_springs_.reserve(options_.spring_capacity);
   active_springs_.reserve(options_.spring_capacity);
+  checkpoint_ = make_checkpoint(*model_);
 }
 
 RealtimeSimulation::~RealtimeSimulation() {
@@ -113,6 +114,10 @@ RealtimeStats RealtimeSimulation::stats() const {
   stats.force_evaluations_per_simulated_s = force_evaluations_per_simulated_s_.load();
   stats.stability_limited = stability_limited_.load();
   stats.dropped_s = dropped_s_.load();
+  stats.rollbacks = rollbacks_.load();
+  stats.rejected_inputs = rejected_inputs_.load();
+  stats.last_problem = last_problem_.load();
+  stats.halted = halted_.load();
   return stats;
 }
 
@@ -155,8 +160,16 @@ void RealtimeSimulation::run() {
       window_capped = true;
       dropped_s += due.dropped_s;
     }
-    if (due.steps > 0) {
-      const StepReport report = advance(model, state_, inputs, due.steps * step_s_);
+    if (due.steps > 0 && !halted_.load(std::memory_order_relaxed)) {
+      // Guarded: a bad step goes back to the last good state and is retried with shorter steps;
+      // a bad input (a NaN from a device) is refused.
+      const GuardedReport guarded =
+          guarded_advance(model, state_, inputs, due.steps * step_s_, checkpoint_);
+      if (guarded.problem != HealthProblem::none) last_problem_ = guarded.problem;
+      rollbacks_ += guarded.rollbacks;
+      if (guarded.inputs_rejected) ++rejected_inputs_;
+      if (guarded.gave_up) halted_ = true;
+      const StepReport& report = guarded.steps;
       window_integrating_s += Seconds(Clock::now() - cycle_start).count();
       accumulate(window_report, report);
       SimulationSnapshot& out = snapshots_.back();

@@ -174,11 +174,13 @@ void advance_runge_kutta(const SimModel& model, SimState& state, const StepInput
       s.error_pending = false;
     }
 
-    double limit = explicit_step_limit_s(model, inputs, stiffening, model.integrator.kind);
+    double limit =
+        explicit_step_limit_s(model, inputs, stiffening, model.integrator.kind) * s.step_scale;
     const double speed = max_speed(s.start_velocity_m_per_s);
     if (speed > 0.0) limit = std::min(limit, 0.1 * model.min_element_height_m / speed);
-    double wanted = adaptive ? s.adaptive_step_s
-                             : (model.integrator.step_s > 0.0 ? model.integrator.step_s : limit);
+    double wanted =
+        adaptive ? s.adaptive_step_s
+                 : (model.integrator.step_s > 0.0 ? model.integrator.step_s * s.step_scale : limit);
     double h = std::min(wanted, limit);
     const bool limited = limit < wanted && limit < remaining;
     double steps_left = 1.0;

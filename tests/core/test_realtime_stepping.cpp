@@ -174,5 +174,34 @@ TEST_F(RealtimeSteppingFixture, ATinyCapOnAHeavyModelReportsBehindAndKeepsWholeS
   EXPECT_NEAR(steps, std::round(steps), 1e-3) << state.time_s << " s";
 }
 
+// A device that sends a NaN (issue 5, case 11): the loop refuses the input, keeps the liver finite
+// and goes on stepping; it does not halt.
+TEST_F(RealtimeSteppingFixture, ANanFromTheToolIsRefusedAndTheLoopGoesOn) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  const NodeIndex node = static_cast<NodeIndex>(mesh_->node_count() / 2);
+  const NodeSpring bad{node, Eigen::Vector3d(std::nan(""), 0.0, 0.0), 50.0, 0.1};
+  simulation.set_springs(std::span<const NodeSpring>(&bad, 1));
+  simulation.start();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (simulation.stats().rejected_inputs == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  // Snapshots, not the state: the state is the simulation thread's while it runs.
+  auto published_steps = [&] {
+    simulation.update_snapshot();
+    return simulation.snapshot().step_count;
+  };
+  const std::uint64_t steps_when_refused = published_steps();
+  while (published_steps() <= steps_when_refused && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  simulation.stop();
+  const RealtimeStats stats = simulation.stats();
+  EXPECT_GT(stats.rejected_inputs, 0);
+  EXPECT_EQ(stats.last_problem, HealthProblem::non_finite_input);
+  EXPECT_FALSE(stats.halted);
+  EXPECT_GT(simulation.state().step_count, steps_when_refused);  // still stepping
+  EXPECT_EQ(check_health(*model, simulation.state(), 50.0), HealthProblem::none);
+}
+
 }  // namespace
 }  // namespace liversim

@@ -1,6 +1,7 @@
 // Stepping allocates nothing, and the real-time loop runs the liver off the caller's thread.
 #include "liversim/core/default_scene.h"
 #include "liversim/core/grab.h"
+#include "liversim/core/health.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/liver_geometry.h"
 #include "liversim/core/realtime_simulation.h"
@@ -84,10 +85,17 @@ TEST_F(SteppingFixture, EveryIntegratorAdvancesWithoutAllocating) {
     const std::vector<PointLoad> loads{{anterior_marked_node(*mesh_), {0.0, 0.05, 0.0}}};
     const StepInputs inputs{loads, {}};
     advance(model, state, inputs, 0.004);  // warm-up
+    StateCheckpoint checkpoint = make_checkpoint(model);
+    guarded_advance(model, state, inputs, 0.002, checkpoint);  // warm-up of the guard
     const long before = g_allocations.load();
     const StepReport report = advance(model, state, inputs, 0.01);
+    // The guards too, a rollback included (a NaN written into the state).
+    guarded_advance(model, state, inputs, 0.004, checkpoint);
+    state.position_m.x[0] = std::nan("");
+    const GuardedReport guarded = guarded_advance(model, state, inputs, 0.004, checkpoint);
     EXPECT_EQ(g_allocations.load() - before, 0) << integrator_name(kind);
     EXPECT_GT(report.substeps, 0);
+    EXPECT_EQ(guarded.rollbacks, 1);
   }
 }
 

@@ -9,6 +9,7 @@
 // of the loop spiralling into ever longer catch-up cycles.
 
 #include "liversim/core/forces.h"
+#include "liversim/core/health.h"
 #include "liversim/core/model.h"
 #include "liversim/core/state.h"
 #include "liversim/core/triple_buffer.h"
@@ -51,6 +52,14 @@ struct RealtimeStats {
   // An explicit scheme had to shorten the requested step to stay stable (it substepped).
   bool stability_limited = false;
   double dropped_s = 0.0;  // wall time dropped from the backlog since the start (see `behind`)
+
+  // Guards (health.h), since the start: attempts rolled back to the last good state, inputs
+  // refused as not finite, the last problem met, and whether the simulation gave up and halted
+  // (the liver stays as it last was good; a new simulation is needed to go on).
+  int rollbacks = 0;
+  int rejected_inputs = 0;
+  HealthProblem last_problem = HealthProblem::none;
+  bool halted = false;
 };
 
 // The fixed-step clock of the real-time loop, without the loop: wall time is added, whole steps
@@ -149,6 +158,10 @@ class RealtimeSimulation {
   std::atomic<double> wall_s_per_simulated_s_{0.0}, force_evaluations_per_simulated_s_{0.0},
       dropped_s_{0.0};
   std::atomic<bool> behind_{false}, stability_limited_{false};
+  StateCheckpoint checkpoint_;  // simulation thread only
+  std::atomic<int> rollbacks_{0}, rejected_inputs_{0};
+  std::atomic<HealthProblem> last_problem_{HealthProblem::none};
+  std::atomic<bool> halted_{false};
   std::thread thread_;
 };
 

@@ -1,0 +1,64 @@
+#pragma once
+// Guards of the step: cheap health checks, a checkpoint of the last good state, and an advance()
+// that rolls back and retries with shorter steps when a step goes bad (a NaN, a runaway node), or
+// refuses inputs that are not finite. Nothing here allocates after the checkpoint is made.
+
+#include "liversim/core/integrator.h"
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace liversim {
+
+enum class HealthProblem : std::uint8_t {
+  none,
+  non_finite_input,     // a load or spring with a NaN or infinite value (rejected, not stepped)
+  non_finite_position,  // the step produced a NaN or infinite position
+  non_finite_velocity,  // ... or velocity
+  runaway_speed,        // a node moved faster than the speed limit (no tissue does)
+};
+std::string_view health_problem_text(HealthProblem problem);
+
+// Finite positions and velocities, no node faster than speed_limit_m_per_s. O(nodes).
+HealthProblem check_health(const SimModel& model, const SimState& state,
+                           double speed_limit_m_per_s);
+bool inputs_finite(const StepInputs& inputs);
+
+// What a rollback restores: the evolving state (not scratch). Sized once by make_checkpoint.
+struct StateCheckpoint {
+  NodeArray position_m, velocity_m_per_s;
+  std::vector<ViscousTissueState> viscous_state;
+  double time_s = 0.0;
+  std::uint64_t step_count = 0;
+  bool valid = false;
+};
+StateCheckpoint make_checkpoint(const SimModel& model);
+void save_checkpoint(const SimState& state, StateCheckpoint& checkpoint);
+// Restores the state; the integrators restart their history (BDF2, error estimates, FSAL), and
+// leapfrog takes the restored velocity as the velocity at that time.
+void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state);
+
+struct GuardOptions {
+  double speed_limit_m_per_s = 50.0;  // far above any tissue motion, far below a blow-up
+  int max_retries = 4;                // each retry halves the step
+};
+
+struct GuardedReport {
+  StepReport steps;                             // of the attempt that was kept
+  int rollbacks = 0;                            // attempts undone
+  HealthProblem problem = HealthProblem::none;  // the last problem met (none: clean)
+  double step_scale = 1.0;                      // the step scale that succeeded
+  bool gave_up = false;                         // every retry failed: the state is the checkpoint's
+  bool inputs_rejected = false;
+};
+
+// advance() with a checkpoint: saves the state, advances, checks its health; on a problem restores
+// the checkpoint and retries with the step halved, up to max_retries times. Non-finite inputs are
+// not stepped at all (the state advances with no inputs and the report says so). Allocates
+// nothing once `checkpoint` is made for the model.
+GuardedReport guarded_advance(const SimModel& model, SimState& state, const StepInputs& inputs,
+                              double interval_s, StateCheckpoint& checkpoint,
+                              const GuardOptions& options = {});
+
+}  // namespace liversim

@@ -1,0 +1,139 @@
+#include "liversim/core/health.h"
+
+#include <cmath>
+
+namespace liversim {
+
+std::string_view health_problem_text(HealthProblem problem) {
+  switch (problem) {
+    case HealthProblem::none:
+      return "healthy";
+    case HealthProblem::non_finite_input:
+      return "an input (load or tool) was not finite";
+    case HealthProblem::non_finite_position:
+      return "a node position became NaN or infinite";
+    case HealthProblem::non_finite_velocity:
+      return "a node velocity became NaN or infinite";
+    case HealthProblem::runaway_speed:
+      return "a node moved faster than the speed limit";
+  }
+  return "unknown";
+}
+
+HealthProblem check_health(const SimModel& model, const SimState& state,
+                           double speed_limit_m_per_s) {
+  const double limit_sq = speed_limit_m_per_s * speed_limit_m_per_s;
+  const auto& x = state.position_m;
+  const auto& v = state.velocity_m_per_s;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    // A sum is NaN if any term is NaN or infinities of opposite sign meet; check each.
+    if (!std::isfinite(x.x[n]) || !std::isfinite(x.y[n]) || !std::isfinite(x.z[n]))
+      return HealthProblem::non_finite_position;
+    if (!std::isfinite(v.x[n]) || !std::isfinite(v.y[n]) || !std::isfinite(v.z[n]))
+      return HealthProblem::non_finite_velocity;
+    if (v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n] > limit_sq)
+      return HealthProblem::runaway_speed;
+  }
+  return HealthProblem::none;
+}
+
+bool inputs_finite(const StepInputs& inputs) {
+  for (const PointLoad& load : inputs.point_loads)
+    if (!load.force_n.allFinite()) return false;
+  for (const NodeSpring& spring : inputs.springs)
+    if (!spring.anchor_m.allFinite() || !std::isfinite(spring.stiffness_n_per_m) ||
+        !std::isfinite(spring.damping_n_s_per_m))
+      return false;
+  return true;
+}
+
+StateCheckpoint make_checkpoint(const SimModel& model) {
+  StateCheckpoint checkpoint;
+  checkpoint.position_m.resize(model.node_count);
+  checkpoint.velocity_m_per_s.resize(model.node_count);
+  if (model.effects.viscous) checkpoint.viscous_state.resize(model.tet_count);
+  return checkpoint;
+}
+
+namespace {
+void copy(const NodeArray& from, NodeArray& to) {
+  to.x = from.x;  // same sizes: no allocation
+  to.y = from.y;
+  to.z = from.z;
+}
+}  // namespace
+
+void save_checkpoint(const SimState& state, StateCheckpoint& checkpoint) {
+  copy(state.position_m, checkpoint.position_m);
+  copy(state.velocity_m_per_s, checkpoint.velocity_m_per_s);
+  checkpoint.viscous_state = state.viscous_state;
+  checkpoint.time_s = state.time_s;
+  checkpoint.step_count = state.step_count;
+  checkpoint.valid = true;
+}
+
+void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state) {
+  copy(checkpoint.position_m, state.position_m);
+  copy(checkpoint.velocity_m_per_s, state.velocity_m_per_s);
+  state.viscous_state = checkpoint.viscous_state;
+  state.time_s = checkpoint.time_s;
+  state.step_count = checkpoint.step_count;
+  // Restart: no step behind the restored velocity, no multistep history, no reused rates.
+  state.last_step_s = 0.0;
+  IntegratorScratch& s = state.integrator;
+  s.has_previous = false;
+  s.history_count = 0;
+  s.first_rate_valid = false;
+  s.error_pending = false;
+  s.inputs_fingerprint = 0;
+  double largest_sq = 0.0;
+  const auto& v = state.velocity_m_per_s;
+  for (std::size_t n = 0; n < v.size(); ++n)
+    largest_sq = std::max(largest_sq, v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n]);
+  state.max_speed_m_per_s = std::sqrt(largest_sq);
+}
+
+GuardedReport guarded_advance(const SimModel& model, SimState& state, const StepInputs& inputs,
+                              double interval_s, StateCheckpoint& checkpoint,
+                              const GuardOptions& options) {
+  GuardedReport report;
+  // The checkpoint is the last good state (saved after every good advance, and here if the state
+  // was changed since and is still good): a state that went bad since (a NaN written into it)
+  // goes back to it rather than being saved.
+  const HealthProblem on_entry = check_health(model, state, options.speed_limit_m_per_s);
+  if (on_entry == HealthProblem::none || !checkpoint.valid) {
+    save_checkpoint(state, checkpoint);
+  } else {
+    report.problem = on_entry;
+    ++report.rollbacks;
+    restore_checkpoint(checkpoint, state);
+  }
+  StepInputs effective = inputs;
+  if (!inputs_finite(inputs)) {
+    report.inputs_rejected = true;
+    report.problem = HealthProblem::non_finite_input;
+    effective = StepInputs{};  // step as if the tool let go, never with the bad values
+  }
+  double scale = 1.0;
+  for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
+    state.integrator.step_scale = scale;
+    const StepReport steps = advance(model, state, effective, interval_s);
+    const HealthProblem problem = check_health(model, state, options.speed_limit_m_per_s);
+    if (problem == HealthProblem::none) {
+      save_checkpoint(state, checkpoint);  // the newest good state
+      report.steps = steps;
+      report.step_scale = scale;
+      state.integrator.step_scale = 1.0;
+      return report;
+    }
+    report.problem = problem;
+    ++report.rollbacks;
+    restore_checkpoint(checkpoint, state);
+    scale *= 0.5;
+  }
+  state.integrator.step_scale = 1.0;
+  report.gave_up = true;
+  return report;
+}
+
+}  // namespace liversim
