@@ -86,6 +86,8 @@ void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state) {
   s.first_rate_valid = false;
   s.error_pending = false;
   s.inputs_fingerprint = 0;
+  s.speed_envelope_m_per_s = 0.0;
+  s.smoothed_limit_s = 0.0;
   double largest_sq = 0.0;
   const auto& v = state.velocity_m_per_s;
   for (std::size_t n = 0; n < v.size(); ++n)
@@ -118,7 +120,10 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
   for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
     state.integrator.step_scale = scale;
     const StepReport steps = advance(model, state, effective, interval_s);
-    const HealthProblem problem = check_health(model, state, options.speed_limit_m_per_s);
+    // An unconverged implicit step is not a solution, however finite it looks.
+    const HealthProblem problem = steps.unconverged_steps > 0
+                                      ? HealthProblem::solver_failed
+                                      : check_health(model, state, options.speed_limit_m_per_s);
     if (problem == HealthProblem::none) {
       save_checkpoint(state, checkpoint);  // the newest good state
       report.steps = steps;

@@ -108,6 +108,30 @@ TEST_P(GuardFixture, GivingUpLeavesTheLastGoodState) {
   EXPECT_NEAR(state.time_s, 0.01, 1e-12);
 }
 
+// An implicit step whose Newton iteration stops short is not a solution: it is rolled back and
+// retried with shorter steps, and when none converges the state stays the last good one.
+TEST(Guard, UnconvergedImplicitStepsAreRolledBack) {
+  const TetMesh mesh = testing::block_mesh(4, 1, 1, {0.04, 0.01, 0.01});
+  ModelOptions options;
+  for (std::size_t n = 0; n < mesh.node_count(); ++n)
+    if (mesh.rest_position_m.x[n] < 1e-12) options.fixed_nodes.push_back(NodeIndex(n));
+  options.integrator.kind = IntegratorKind::backward_euler;
+  options.integrator.step_s = 1e-3;
+  options.integrator.max_newton_iterations = 1;  // one iteration cannot reach 1e-15 m
+  options.integrator.newton_tolerance_m = 1e-15;
+  const SimModel model = build_model(mesh, options);
+  SimState state = make_rest_state(model);
+  StateCheckpoint checkpoint = make_checkpoint(model);
+  const std::vector<PointLoad> pull{{NodeIndex(mesh.node_count() - 1), {0.0, 0.05, 0.0}}};
+  GuardOptions guard;
+  guard.max_retries = 2;
+  const GuardedReport report = guarded_advance(model, state, {pull, {}}, 0.004, checkpoint, guard);
+  EXPECT_EQ(report.problem, HealthProblem::solver_failed);
+  EXPECT_TRUE(report.gave_up);
+  EXPECT_EQ(report.rollbacks, 3);
+  EXPECT_EQ(state.time_s, 0.0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Integrators, GuardFixture, ::testing::ValuesIn(kAllIntegrators),
                          [](const auto& info) {
                            std::string name(integrator_name(info.param));

@@ -17,6 +17,7 @@ enum class HealthProblem : std::uint8_t {
   non_finite_position,  // the step produced a NaN or infinite position
   non_finite_velocity,  // ... or velocity
   runaway_speed,        // a node moved faster than the speed limit (no tissue does)
+  solver_failed,        // an implicit step's Newton iteration did not converge
 };
 std::string_view health_problem_text(HealthProblem problem);
 
