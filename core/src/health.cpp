@@ -86,8 +86,7 @@ void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state) {
   s.first_rate_valid = false;
   s.error_pending = false;
   s.inputs_fingerprint = 0;
-  s.speed_envelope_m_per_s = 0.0;
-  s.smoothed_limit_s = 0.0;
+  s.chosen_step_s = 0.0;
   double largest_sq = 0.0;
   const auto& v = state.velocity_m_per_s;
   for (std::size_t n = 0; n < v.size(); ++n)

@@ -417,9 +417,8 @@ void advance_central_difference(const SimModel& model, SimState& state, const St
     ++report.force_evaluations;
     report.max_stiffening = std::max(report.max_stiffening, stiffening);
     double limit = stable_time_step_s(model, inputs, stiffening);
-    limit =
-        std::min(limit, detail::travel_limit_s(model, state.integrator, state.max_speed_m_per_s));
-    limit = detail::smoothed_limit_s(state.integrator, limit);
+    if (state.max_speed_m_per_s > 0.0)
+      limit = std::min(limit, 0.1 * model.min_element_height_m / state.max_speed_m_per_s);
     double step = limit;
     if (requested_s > 0.0) {
       step = std::min(requested_s, limit);
@@ -431,9 +430,11 @@ void advance_central_difference(const SimModel& model, SimState& state, const St
       }
     }
     step *= state.integrator.step_scale;
-    // The step itself may grow by at most 2 % (see smoothed_limit_s): the equal split of what is
-    // left of an interval must not make it jump either.
-    if (state.last_step_s > 0.0) step = std::min(step, 1.02 * state.last_step_s);
+    // The chosen step may fall at once but grows slowly (detail::kStepGrowth); the equal split
+    // of an interval below does not feed back into it.
+    if (state.integrator.chosen_step_s > 0.0)
+      step = std::min(step, detail::kStepGrowth * state.integrator.chosen_step_s);
+    state.integrator.chosen_step_s = step;
     // Equal steps over what is left, so the interval ends exactly where asked.
     const double steps_left = detail::steps_to_cover(remaining, step);
     const double dt = steps_left <= 1.0 ? remaining : remaining / steps_left;

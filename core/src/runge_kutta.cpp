@@ -177,13 +177,15 @@ void advance_runge_kutta(const SimModel& model, SimState& state, const StepInput
     double limit =
         explicit_step_limit_s(model, inputs, stiffening, model.integrator.kind) * s.step_scale;
     const double speed = max_speed(s.start_velocity_m_per_s);
-    limit = std::min(limit, travel_limit_s(model, s, speed));
-    limit = smoothed_limit_s(s, limit);
+    if (speed > 0.0) limit = std::min(limit, 0.1 * model.min_element_height_m / speed);
     double wanted =
         adaptive ? s.adaptive_step_s
                  : (model.integrator.step_s > 0.0 ? model.integrator.step_s * s.step_scale : limit);
     double h = std::min(wanted, limit);
-    if (!adaptive && state.last_step_s > 0.0) h = std::min(h, 1.02 * state.last_step_s);
+    if (!adaptive) {
+      if (s.chosen_step_s > 0.0) h = std::min(h, kStepGrowth * s.chosen_step_s);
+      s.chosen_step_s = h;
+    }
     const bool limited = limit < wanted && limit < remaining;
     double steps_left = 1.0;
     if (adaptive) {

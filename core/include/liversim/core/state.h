@@ -55,8 +55,9 @@ struct IntegratorScratch {
   std::uint64_t inputs_fingerprint = 0;
   bool inputs_changed = false;
   NodeArray external_force_n, previous_external_force_n;  // central difference, per step
-  double speed_envelope_m_per_s = 0.0;  // see travel_limit_s (integrator_internal.h)
-  double smoothed_limit_s = 0.0;        // see smoothed_limit_s (integrator_internal.h)
+  // Explicit fixed-step schemes: the step chosen last, before the equal split of an interval
+  // (the next may grow from it by at most kStepGrowth; 0: no limit).
+  double chosen_step_s = 0.0;
   // Every step is this fraction of what the scheme would take (guarded_advance's retries).
   double step_scale = 1.0;
   bool factorisation_valid = false;  // implicit: the last factorisation may be reused
