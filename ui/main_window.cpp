@@ -233,6 +233,8 @@ QString MainWindow::healthProblemText(HealthProblem problem) {
       return tr("a node velocity became not a number");
     case HealthProblem::runaway_speed:
       return tr("a node moved implausibly fast");
+    case HealthProblem::solver_failed:
+      return tr("an implicit step did not converge");
   }
   return tr("unknown problem");
 }

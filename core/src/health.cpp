@@ -1,5 +1,7 @@
 #include "liversim/core/health.h"
 
+#include "integrator_internal.h"
+
 #include <cmath>
 
 namespace liversim {
@@ -16,6 +18,8 @@ std::string_view health_problem_text(HealthProblem problem) {
       return "a node velocity became NaN or infinite";
     case HealthProblem::runaway_speed:
       return "a node moved faster than the speed limit";
+    case HealthProblem::solver_failed:
+      return "an implicit step did not converge";
   }
   return "unknown";
 }
@@ -55,17 +59,9 @@ StateCheckpoint make_checkpoint(const SimModel& model) {
   return checkpoint;
 }
 
-namespace {
-void copy(const NodeArray& from, NodeArray& to) {
-  to.x = from.x;  // same sizes: no allocation
-  to.y = from.y;
-  to.z = from.z;
-}
-}  // namespace
-
 void save_checkpoint(const SimState& state, StateCheckpoint& checkpoint) {
-  copy(state.position_m, checkpoint.position_m);
-  copy(state.velocity_m_per_s, checkpoint.velocity_m_per_s);
+  checkpoint.position_m = state.position_m;
+  checkpoint.velocity_m_per_s = state.velocity_m_per_s;
   checkpoint.viscous_state = state.viscous_state;
   checkpoint.time_s = state.time_s;
   checkpoint.step_count = state.step_count;
@@ -73,8 +69,8 @@ void save_checkpoint(const SimState& state, StateCheckpoint& checkpoint) {
 }
 
 void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state) {
-  copy(checkpoint.position_m, state.position_m);
-  copy(checkpoint.velocity_m_per_s, state.velocity_m_per_s);
+  state.position_m = checkpoint.position_m;
+  state.velocity_m_per_s = checkpoint.velocity_m_per_s;
   state.viscous_state = checkpoint.viscous_state;
   state.time_s = checkpoint.time_s;
   state.step_count = checkpoint.step_count;
@@ -87,23 +83,21 @@ void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state) {
   s.error_pending = false;
   s.inputs_fingerprint = 0;
   s.chosen_step_s = 0.0;
-  double largest_sq = 0.0;
-  const auto& v = state.velocity_m_per_s;
-  for (std::size_t n = 0; n < v.size(); ++n)
-    largest_sq = std::max(largest_sq, v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n]);
-  state.max_speed_m_per_s = std::sqrt(largest_sq);
+  state.max_speed_m_per_s = detail::largest_norm(state.velocity_m_per_s);
 }
 
 GuardedReport guarded_advance(const SimModel& model, SimState& state, const StepInputs& inputs,
                               double interval_s, StateCheckpoint& checkpoint,
                               const GuardOptions& options) {
   GuardedReport report;
-  // The checkpoint is the last good state (saved after every good advance, and here if the state
-  // was changed since and is still good): a state that went bad since (a NaN written into it)
-  // goes back to it rather than being saved.
+  // The checkpoint is the last good state (saved after every good advance, and here only if the
+  // state was stepped or set elsewhere since and is still good): a state that went bad since (a
+  // NaN written into it) goes back to it rather than being saved.
   const HealthProblem on_entry = check_health(model, state, options.speed_limit_m_per_s);
+  const bool saved_already = checkpoint.valid && checkpoint.step_count == state.step_count &&
+                             checkpoint.time_s == state.time_s;
   if (on_entry == HealthProblem::none || !checkpoint.valid) {
-    save_checkpoint(state, checkpoint);
+    if (!saved_already) save_checkpoint(state, checkpoint);
   } else {
     report.problem = on_entry;
     ++report.rollbacks;

@@ -268,12 +268,6 @@ int solve_newton_equation(const SimModel& model, ImplicitSolver& solver, Residua
   return k;
 }
 
-void copy(const NodeArray& from, NodeArray& to) {
-  to.x = from.x;
-  to.y = from.y;
-  to.z = from.z;
-}
-
 }  // namespace
 
 void advance_implicit(const SimModel& model, SimState& state, const StepInputs& inputs,
@@ -333,8 +327,8 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
       }
       std::swap(s.previous_arm, s.start_arm);  // Q_{n} becomes the previous step's
     }
-    copy(x, s.previous_position_m);
-    copy(v, s.previous_velocity_m_per_s);
+    s.previous_position_m = x;
+    s.previous_velocity_m_per_s = v;
     s.has_previous = true;
     s.previous_step_s = dt;
 
@@ -445,10 +439,7 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
       commit_arm(model, state, x, s.stage_arm, dt);
     }
     note_error_estimate(report, history_error_estimate(model, s, v, dt, settings.kind));
-    double max_speed_sq = 0.0;
-    for (std::size_t n = 0; n < n_nodes; ++n)
-      max_speed_sq = std::max(max_speed_sq, v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n]);
-    state.max_speed_m_per_s = std::sqrt(max_speed_sq);
+    state.max_speed_m_per_s = largest_norm(v);
     state.last_step_s = dt;
     state.time_s += dt;
     ++state.step_count;

@@ -60,6 +60,14 @@ inline void note_error_estimate(StepReport& report, double estimate_m) {
     report.error_estimate_m = estimate_m;
 }
 
+// Largest Euclidean norm of the per-node vectors (e.g. the fastest node's speed).
+inline double largest_norm(const NodeArray& a) {
+  double largest_sq = 0.0;
+  for (std::size_t n = 0; n < a.size(); ++n)
+    largest_sq = std::max(largest_sq, a.x[n] * a.x[n] + a.y[n] * a.y[n] + a.z[n] * a.z[n]);
+  return std::sqrt(largest_sq);
+}
+
 // Explicit fixed-step schemes let the chosen step fall at once but grow by at most this factor per
 // step (0.1 %: a dip recovers by 2× in ≈ 700 steps). A step that followed the compression or
 // speed of an oscillating mode (through the stiffening or node-travel limits) changed in step with

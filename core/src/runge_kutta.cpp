@@ -118,23 +118,10 @@ double local_error_m(const SimModel& model, const IntegratorScratch& s, double h
   return largest;
 }
 
-double max_speed(const NodeArray& v) {
-  double largest_sq = 0.0;
-  for (std::size_t n = 0; n < v.size(); ++n)
-    largest_sq = std::max(largest_sq, v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n]);
-  return std::sqrt(largest_sq);
-}
-
 bool has_plastic_flow(const SimModel& model) {
   for (const auto& parameters : model.viscous_parameters)
     if (parameters && parameters->viscoplastic) return true;
   return false;
-}
-
-void copy(const NodeArray& from, NodeArray& to) {
-  to.x = from.x;
-  to.y = from.y;
-  to.z = from.z;
 }
 
 }  // namespace
@@ -154,8 +141,8 @@ void advance_runge_kutta(const SimModel& model, SimState& state, const StepInput
 
   double remaining = interval_s;
   while (remaining > 0.0) {
-    copy(state.position_m, s.start_position_m);
-    copy(state.velocity_m_per_s, s.start_velocity_m_per_s);
+    s.start_position_m = state.position_m;
+    s.start_velocity_m_per_s = state.velocity_m_per_s;
     arm_of_committed_state(model, state, s.start_arm);
     if (!s.first_rate_valid) {
       s.first_rate_stiffening = evaluate_rate(model, state, inputs, s.start_position_m,
@@ -176,7 +163,7 @@ void advance_runge_kutta(const SimModel& model, SimState& state, const StepInput
 
     double limit =
         explicit_step_limit_s(model, inputs, stiffening, model.integrator.kind) * s.step_scale;
-    const double speed = max_speed(s.start_velocity_m_per_s);
+    const double speed = largest_norm(s.start_velocity_m_per_s);
     if (speed > 0.0) limit = std::min(limit, 0.1 * model.min_element_height_m / speed);
     double wanted =
         adaptive ? s.adaptive_step_s
@@ -219,8 +206,8 @@ void advance_runge_kutta(const SimModel& model, SimState& state, const StepInput
       }
       note_error_estimate(report, error);
       // The last stage was evaluated at the new state: it is the next step's first (FSAL).
-      copy(s.stage_position_m, state.position_m);
-      copy(s.stage_velocity_m_per_s, state.velocity_m_per_s);
+      state.position_m = s.stage_position_m;
+      state.velocity_m_per_s = s.stage_velocity_m_per_s;
       std::swap(s.position_rate[0], s.position_rate[stages - 1]);
       std::swap(s.velocity_rate[0], s.velocity_rate[stages - 1]);
       if (model.effects.viscous) {
@@ -249,7 +236,7 @@ void advance_runge_kutta(const SimModel& model, SimState& state, const StepInput
                                           : limit;
       ++report.stability_limited_steps;
     }
-    state.max_speed_m_per_s = max_speed(state.velocity_m_per_s);
+    state.max_speed_m_per_s = largest_norm(state.velocity_m_per_s);
     state.last_step_s = h;
     state.time_s += h;
     ++state.step_count;
