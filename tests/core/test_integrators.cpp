@@ -228,8 +228,9 @@ void expect_seed_recipe_stays_stable(const TetMesh& mesh, const std::vector<Node
     ASSERT_TRUE(std::isfinite(now));
     // Free and damped, a hyperelastic model's energy may not grow beyond round-off. The average
     // nodal pressure is not derived from an energy, so there only the end is compared.
-    if (!average_nodal_pressure)
+    if (!average_nodal_pressure) {
       EXPECT_LE(now, previous * (1.0 + 1e-9) + 1e-15) << "after " << (i + 1) * 2 << " ms free";
+    }
     previous = now;
   }
   EXPECT_LT(previous, released);
