@@ -63,6 +63,7 @@ void save_checkpoint(const SimState& state, StateCheckpoint& checkpoint) {
   checkpoint.position_m = state.position_m;
   checkpoint.velocity_m_per_s = state.velocity_m_per_s;
   checkpoint.viscous_state = state.viscous_state;
+  checkpoint.energy = state.energy;
   checkpoint.time_s = state.time_s;
   checkpoint.step_count = state.step_count;
   checkpoint.valid = true;
@@ -72,6 +73,7 @@ void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state) {
   state.position_m = checkpoint.position_m;
   state.velocity_m_per_s = checkpoint.velocity_m_per_s;
   state.viscous_state = checkpoint.viscous_state;
+  state.energy = checkpoint.energy;
   state.time_s = checkpoint.time_s;
   state.step_count = checkpoint.step_count;
   // Restart: no step behind the restored velocity, no multistep history, no reused rates.
@@ -121,6 +123,10 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
       save_checkpoint(state, checkpoint);  // the newest good state
       report.steps = steps;
       report.step_scale = scale;
+      if (options.check_energy) {
+        report.energy = energy_balance(model, state, effective);
+        report.energy_created = report.energy->created_beyond(options.energy_tolerance);
+      }
       state.integrator.step_scale = 1.0;
       return report;
     }

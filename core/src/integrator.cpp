@@ -462,6 +462,12 @@ StepReport advance(const SimModel& model, SimState& state, const StepInputs& inp
   const std::uint64_t fingerprint = detail::fingerprint(inputs);
   state.integrator.inputs_changed = fingerprint != state.integrator.inputs_fingerprint;
   state.integrator.inputs_fingerprint = fingerprint;
+  // Work of the inputs: a moved spring anchor did the work of the energy it added; point loads are
+  // constant over the interval, so F·(x_end − x_start) is their exact work.
+  EnergyLedger& books = state.energy;
+  books.tool_work_j += spring_energy_j(inputs.springs, state.position_m) - books.spring_energy_j;
+  for (const PointLoad& load : inputs.point_loads)
+    books.tool_work_j -= load.force_n.dot(state.position_m.at(load.node));
   switch (model.integrator.kind) {
     case IntegratorKind::central_difference:
       advance_central_difference(model, state, inputs, interval_s, report);
@@ -475,6 +481,9 @@ StepReport advance(const SimModel& model, SimState& state, const StepInputs& inp
       detail::advance_implicit(model, state, inputs, interval_s, report);
       break;
   }
+  for (const PointLoad& load : inputs.point_loads)
+    books.tool_work_j += load.force_n.dot(state.position_m.at(load.node));
+  books.spring_energy_j = spring_energy_j(inputs.springs, state.position_m);
   state.time_s = end_time;  // no drift from summing substeps
   return report;
 }

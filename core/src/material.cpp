@@ -120,6 +120,14 @@ double lambda_pressure_term(double J, double lambda) {
 
 }  // namespace
 
+double lambda_energy_density(double J, double lambda) {
+  const double j0 = kMinVolumeRatio, log_j0 = std::log(j0);
+  if (J >= j0) return 0.5 * lambda * std::log(J) * std::log(J);
+  const double d = J - j0;
+  return 0.5 * lambda * log_j0 * log_j0 + lambda * log_j0 / j0 * d +
+         0.5 * lambda * (1.0 - log_j0) / (j0 * j0) * d * d;
+}
+
 Eigen::Matrix3d first_piola_stress_averaged_pressure(const Eigen::Matrix3d& F, double mu,
                                                      double lambda, double averaged_volume_ratio) {
   const Eigen::Matrix3d cof = cofactor(F);

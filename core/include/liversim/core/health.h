@@ -3,9 +3,12 @@
 // that rolls back and retries with shorter steps when a step goes bad (a NaN, a runaway node), or
 // refuses inputs that are not finite. Nothing here allocates after the checkpoint is made.
 
+#include "liversim/core/energy.h"
 #include "liversim/core/integrator.h"
+#include "liversim/core/state.h"
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -30,6 +33,7 @@ bool inputs_finite(const StepInputs& inputs);
 struct StateCheckpoint {
   NodeArray position_m, velocity_m_per_s;
   std::vector<ViscousTissueState> viscous_state;
+  EnergyLedger energy;
   double time_s = 0.0;
   std::uint64_t step_count = 0;
   bool valid = false;
@@ -43,6 +47,12 @@ void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state);
 struct GuardOptions {
   double speed_limit_m_per_s = 50.0;  // far above any tissue motion, far below a blow-up
   int max_retries = 4;                // each retry halves the step
+  // Close the energy books after the advance (one pass over the elements; a caller stepping at
+  // 1 kHz asks every so many steps). Energy created beyond `energy_tolerance` × the energy
+  // supplied is reported, not rolled back: it builds up over many steps, so the last checkpoint
+  // would not undo it, and leapfrog's energy oscillates by O(Δt²) around the true one.
+  bool check_energy = false;
+  double energy_tolerance = 0.05;
 };
 
 struct GuardedReport {
@@ -52,6 +62,8 @@ struct GuardedReport {
   double step_scale = 1.0;                      // the step scale that succeeded
   bool gave_up = false;                         // every retry failed: the state is the checkpoint's
   bool inputs_rejected = false;
+  std::optional<EnergyBalance> energy;  // when options.check_energy: the books after the advance
+  bool energy_created = false;          // the books show energy created beyond the tolerance
 };
 
 // advance() with a checkpoint: saves the state, advances, checks its health; on a problem restores

@@ -51,6 +51,10 @@ Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, double mu, double l
 Eigen::Matrix3d first_piola_stress_averaged_pressure(const Eigen::Matrix3d& F, double mu,
                                                      double lambda, double averaged_volume_ratio);
 
+// W_λ(J) = λ/2·ln²J, the λ part of U(J) (its derivative is p_λ), continued below kMinVolumeRatio
+// as p_λ is. Σ over nodes of V·W_λ(J_avg) is the volumetric energy of average nodal pressure.
+double lambda_energy_density(double J, double lambda);
+
 // ∂P/∂F as a 9×9 matrix over row-major flattened indices (row 3i+J for P_iJ, column 3k+L for
 // F_kL): μ δik δJL + U''(J) cof_iJ cof_kL + U'(J) ∂cof_iJ/∂F_kL. Needed by implicit integrators.
 Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, double mu, double lambda);

@@ -1,6 +1,7 @@
 #pragma once
 // The changing simulation state, with the scratch buffers stepping needs, sized once for a model.
 
+#include "liversim/core/energy.h"
 #include "liversim/core/model.h"
 #include "liversim/core/viscous_tissue.h"
 
@@ -92,6 +93,7 @@ struct SimState {
   std::vector<ViscousTissueState> viscous_state;
   std::vector<std::optional<ViscousTissueStep>> viscous_step;
   IntegratorScratch integrator;
+  EnergyLedger energy;  // books of work in and energy held (energy.h)
   double time_s = 0.0;
   std::uint64_t step_count = 0;
 };

@@ -1,0 +1,119 @@
+#include "liversim/core/energy.h"
+
+#include "liversim/core/forces.h"
+#include "liversim/core/state.h"
+
+#include <Eigen/Dense>
+
+namespace liversim {
+namespace {
+
+// ½·g1·H : C⁻¹ : H for the isotropic stiffness C = 2μ·I + λ·1⊗1, whose compliance is
+// (I − λ/(2μ + 3λ)·1⊗1)/(2μ). H in Voigt order (xx, yy, zz, yz, xz, xy).
+double arm_energy_density(const Voigt6& h, double arm_fraction, double mu, double lambda) {
+  const double trace = h[0] + h[1] + h[2];
+  const double contraction =
+      h[0] * h[0] + h[1] * h[1] + h[2] * h[2] + 2.0 * (h[3] * h[3] + h[4] * h[4] + h[5] * h[5]);
+  return arm_fraction / (4.0 * mu) *
+         (contraction - lambda / (2.0 * mu + 3.0 * lambda) * trace * trace);
+}
+
+double viscous_element_energy_density(const SimModel& model, const SimState& state,
+                                      const ViscousTissueParameters& law, std::size_t e,
+                                      const Eigen::Matrix3d& F) {
+  const ViscousTissueState& history = state.viscous_state[e];
+  const double mu = model.shear_modulus_pa[e], lambda = model.lame_lambda_pa[e];
+  const double instantaneous = law.viscoelastic.instantaneous_modulus_pa();
+  const double relaxed_fraction = law.viscoelastic.e2_pa / instantaneous;
+  const double arm_fraction = law.viscoelastic.e1_pa / instantaneous;
+  double psi = relaxed_fraction *
+               neo_hookean::energy_density(F * history.inverse_plastic_deformation, mu, lambda);
+  psi += arm_energy_density(history.maxwell_stress_pa, arm_fraction, mu, lambda);
+  if (model.effects.fibres)
+    for (const auto& family : model.fibre_direction)
+      psi += hgo::energy_density(F, family[e], model.fibre_parameters[e]);
+  return psi;
+}
+
+bool is_viscous(const SimModel& model, std::size_t e) {
+  return model.effects.viscous &&
+         model.viscous_parameters[static_cast<std::size_t>(model.region[e])].has_value();
+}
+
+// Average nodal pressure: the λ part of the volumetric energy sits at the nodes, W_λ(J̄) with J̄
+// the volume-weighted mean of the node's element volume ratios, each element handing a quarter
+// of its volume to each corner. (The forces take p_λ at the element's mean of its corners' J̄,
+// which differs from this potential's gradient at second order in the spread of J̄.) Each
+// element's J is recomputed once per corner rather than stored, so nothing is allocated.
+double nodal_lambda_energy_j(const SimModel& model, const NodeArray& position) {
+  const std::size_t tets = model.tet_count;
+  double energy = 0.0;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    double weighted = 0.0, volume = 0.0;
+    for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
+      const std::size_t e = static_cast<std::size_t>(model.node_slots[s]) % tets;
+      weighted += model.rest_volume_m3[e] * deformation_gradient(model, position, e).determinant();
+      volume += model.rest_volume_m3[e];
+    }
+    const double averaged = volume > 0.0 ? weighted / volume : 1.0;
+    for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
+      const std::size_t e = static_cast<std::size_t>(model.node_slots[s]) % tets;
+      if (is_viscous(model, e)) continue;
+      energy += 0.25 * model.rest_volume_m3[e] *
+                neo_hookean::lambda_energy_density(averaged, model.lame_lambda_pa[e]);
+    }
+  }
+  return energy;
+}
+
+}  // namespace
+
+double tissue_energy_j(const SimModel& model, const SimState& state) {
+  const bool averaged_pressure = model.effects.average_nodal_pressure;
+  double energy = 0.0;
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const Eigen::Matrix3d F = deformation_gradient(model, state.position_m, e);
+    if (is_viscous(model, e)) {
+      const auto& law = *model.viscous_parameters[static_cast<std::size_t>(model.region[e])];
+      energy += model.rest_volume_m3[e] * viscous_element_energy_density(model, state, law, e, F);
+      continue;
+    }
+    double psi = element_energy_density(model, e, F);
+    if (averaged_pressure)  // its λ part is at the nodes
+      psi -= neo_hookean::lambda_energy_density(F.determinant(), model.lame_lambda_pa[e]);
+    energy += model.rest_volume_m3[e] * psi;
+  }
+  if (averaged_pressure) energy += nodal_lambda_energy_j(model, state.position_m);
+  return energy;
+}
+
+double spring_energy_j(std::span<const NodeSpring> springs, const NodeArray& position) {
+  double energy = 0.0;
+  for (const NodeSpring& s : springs)
+    energy += 0.5 * s.stiffness_n_per_m * (s.anchor_m - position.at(s.node)).squaredNorm();
+  return energy;
+}
+
+EnergyBalance energy_balance(const SimModel& model, const SimState& state,
+                             const StepInputs& inputs) {
+  EnergyBalance balance;
+  balance.kinetic_j = kinetic_energy_j(model, state.velocity_m_per_s);
+  balance.tissue_j = tissue_energy_j(model, state);
+  balance.spring_j = spring_energy_j(inputs.springs, state.position_m);
+  balance.initial_j = state.energy.initial_j;
+  balance.tool_work_j = state.energy.tool_work_j;
+  return balance;
+}
+
+void open_energy_books(const SimModel& model, SimState& state, const StepInputs& inputs) {
+  state.energy = EnergyLedger{};
+  const EnergyBalance now = energy_balance(model, state, inputs);
+  state.energy.initial_j = now.held_j();
+  state.energy.spring_energy_j = now.spring_j;
+}
+
+void open_energy_books(const SimModel& model, SimState& state) {
+  open_energy_books(model, state, StepInputs{});
+}
+
+}  // namespace liversim
