@@ -135,6 +135,7 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   state.max_speed_m_per_s = old.max_speed_m_per_s;  // the node-travel limit of the first step
   if (state.viscous_state.size() == old.viscous_state.size())
     state.viscous_state = old.viscous_state;
+  state.energy = old.energy;  // the books go on (the guard bounds kinetic energy by them)
   state.time_s = old.time_s;
   state.step_count = old.step_count;
   try {
@@ -213,6 +214,10 @@ void MainWindow::updateStatus() {
                 .arg(stats.rollbacks)
                 .arg(stats.rejected_inputs)
                 .arg(healthProblemText(stats.last_problem));
+  if (stats.energy_created)
+    text +=
+        tr(" | energy books: the scheme is creating energy (choose a shorter step or an "
+           "implicit scheme)");
   if (grab_) {
     const Eigen::Vector3d force =
         grab_reaction_force_n(*grab_, handle_m_, simulation_->snapshot().position_m);
@@ -233,6 +238,8 @@ QString MainWindow::healthProblemText(HealthProblem problem) {
       return tr("a node velocity became not a number");
     case HealthProblem::runaway_speed:
       return tr("a node moved implausibly fast");
+    case HealthProblem::runaway_energy:
+      return tr("a node gained more energy than the tools put in");
     case HealthProblem::solver_failed:
       return tr("an implicit step did not converge");
   }

@@ -2,6 +2,7 @@
 
 #include "integrator_internal.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace liversim {
@@ -18,6 +19,8 @@ std::string_view health_problem_text(HealthProblem problem) {
       return "a node velocity became NaN or infinite";
     case HealthProblem::runaway_speed:
       return "a node moved faster than the speed limit";
+    case HealthProblem::runaway_energy:
+      return "a node held more kinetic energy than was ever supplied";
     case HealthProblem::solver_failed:
       return "an implicit step did not converge";
   }
@@ -25,8 +28,12 @@ std::string_view health_problem_text(HealthProblem problem) {
 }
 
 HealthProblem check_health(const SimModel& model, const SimState& state,
-                           double speed_limit_m_per_s) {
-  const double limit_sq = speed_limit_m_per_s * speed_limit_m_per_s;
+                           const GuardOptions& options) {
+  const double limit_sq = options.speed_limit_m_per_s * options.speed_limit_m_per_s;
+  // Twice the kinetic energy a node may hold (1e-12 J above zero: round-off at rest).
+  const double supplied = state.energy.initial_j + state.energy.tool_work_j;
+  const double twice_allowed_j =
+      2.0 * ((1.0 + options.kinetic_energy_slack) * std::max(supplied, 0.0) + 1e-12);
   const auto& x = state.position_m;
   const auto& v = state.velocity_m_per_s;
   for (std::size_t n = 0; n < model.node_count; ++n) {
@@ -35,8 +42,9 @@ HealthProblem check_health(const SimModel& model, const SimState& state,
       return HealthProblem::non_finite_position;
     if (!std::isfinite(v.x[n]) || !std::isfinite(v.y[n]) || !std::isfinite(v.z[n]))
       return HealthProblem::non_finite_velocity;
-    if (v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n] > limit_sq)
-      return HealthProblem::runaway_speed;
+    const double speed_sq = v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n];
+    if (speed_sq > limit_sq) return HealthProblem::runaway_speed;
+    if (model.lumped_mass_kg[n] * speed_sq > twice_allowed_j) return HealthProblem::runaway_energy;
   }
   return HealthProblem::none;
 }
@@ -95,7 +103,7 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
   // The checkpoint is the last good state (saved after every good advance, and here only if the
   // state was stepped or set elsewhere since and is still good): a state that went bad since (a
   // NaN written into it) goes back to it rather than being saved.
-  const HealthProblem on_entry = check_health(model, state, options.speed_limit_m_per_s);
+  const HealthProblem on_entry = check_health(model, state, options);
   const bool saved_already = checkpoint.valid && checkpoint.step_count == state.step_count &&
                              checkpoint.time_s == state.time_s;
   if (on_entry == HealthProblem::none || !checkpoint.valid) {
@@ -111,18 +119,18 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
     report.problem = HealthProblem::non_finite_input;
     effective = StepInputs{};  // step as if the tool let go, never with the bad values
   }
-  double scale = 1.0;
+  double scale = checkpoint.step_scale;
   for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
     state.integrator.step_scale = scale;
     const StepReport steps = advance(model, state, effective, interval_s);
     // An unconverged implicit step is not a solution, however finite it looks.
-    const HealthProblem problem = steps.unconverged_steps > 0
-                                      ? HealthProblem::solver_failed
-                                      : check_health(model, state, options.speed_limit_m_per_s);
+    const HealthProblem problem = steps.unconverged_steps > 0 ? HealthProblem::solver_failed
+                                                              : check_health(model, state, options);
     if (problem == HealthProblem::none) {
       save_checkpoint(state, checkpoint);  // the newest good state
       report.steps = steps;
       report.step_scale = scale;
+      checkpoint.step_scale = std::min(1.0, 2.0 * scale);
       if (options.check_energy) {
         report.energy = energy_balance(model, state, effective);
         report.energy_created = report.energy->created_beyond(options.energy_tolerance);
@@ -136,6 +144,7 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
     scale *= 0.5;
   }
   state.integrator.step_scale = 1.0;
+  checkpoint.step_scale = 1.0;  // what failed at every scale is not a reason to start small
   report.gave_up = true;
   return report;
 }

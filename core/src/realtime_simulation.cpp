@@ -118,6 +118,8 @@ RealtimeStats RealtimeSimulation::stats() const {
   stats.rejected_inputs = rejected_inputs_.load();
   stats.last_problem = last_problem_.load();
   stats.halted = halted_.load();
+  stats.energy_created = energy_created_.load();
+  stats.dissipated_fraction = dissipated_fraction_.load();
   return stats;
 }
 
@@ -142,6 +144,7 @@ void RealtimeSimulation::run() {
   StepReport window_report = empty_window();
   double window_integrating_s = 0.0;
   bool window_capped = false;
+  bool close_books = false;  // close the energy books with the next advance
   double dropped_s = 0.0;
 
   while (!stop_requested_.load(std::memory_order_relaxed)) {
@@ -163,8 +166,16 @@ void RealtimeSimulation::run() {
     if (due.steps > 0 && !halted_.load(std::memory_order_relaxed)) {
       // Guarded: a bad step goes back to the last good state and is retried with shorter steps;
       // a bad input (a NaN from a device) is refused.
+      GuardOptions guard;
+      guard.check_energy = close_books;  // one pass over the elements, once per window
+      close_books = false;
       const GuardedReport guarded =
-          guarded_advance(model, state_, inputs, due.steps * step_s_, checkpoint_);
+          guarded_advance(model, state_, inputs, due.steps * step_s_, checkpoint_, guard);
+      if (guarded.energy) {
+        energy_created_ = guarded.energy_created;
+        const double supplied = guarded.energy->supplied_j();
+        dissipated_fraction_ = supplied > 0.0 ? guarded.energy->dissipated_j() / supplied : 0.0;
+      }
       if (guarded.problem != HealthProblem::none) last_problem_ = guarded.problem;
       rollbacks_ += guarded.rollbacks;
       if (guarded.inputs_rejected) ++rejected_inputs_;
@@ -188,6 +199,7 @@ void RealtimeSimulation::run() {
     const auto now = Clock::now();
     const double window_s = Seconds(now - window_start).count();
     if (window_s >= kWindowS) {
+      close_books = true;
       const double simulated_s = state_.time_s - window_sim_start_s;
       steps_per_second_ = static_cast<double>(state_.step_count - window_start_steps) / window_s;
       real_time_factor_ = simulated_s / window_s;

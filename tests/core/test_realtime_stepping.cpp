@@ -2,6 +2,7 @@
 // and the backlog beyond the cap dropped (simulated time slows down instead of spiralling). The
 // clock is tested with made-up elapsed times; the running loop only for what a tiny cap on a
 // heavy model must give whatever the machine's speed.
+#include "liversim/core/default_scene.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/liver_geometry.h"
 #include "liversim/core/realtime_simulation.h"
@@ -200,7 +201,28 @@ TEST_F(RealtimeSteppingFixture, ANanFromTheToolIsRefusedAndTheLoopGoesOn) {
   EXPECT_EQ(stats.last_problem, HealthProblem::non_finite_input);
   EXPECT_FALSE(stats.halted);
   EXPECT_GT(simulation.state().step_count, steps_when_refused);  // still stepping
-  EXPECT_EQ(check_health(*model, simulation.state(), 50.0), HealthProblem::none);
+  EXPECT_EQ(check_health(*model, simulation.state()), HealthProblem::none);
+}
+
+// The loop closes the energy books once per statistics window: a spring pulling the liver
+// supplies energy, damping takes some out, and a stable scheme creates none.
+TEST_F(RealtimeSteppingFixture, TheLoopKeepsTheEnergyBooks) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  const NodeIndex node = anterior_marked_node(*mesh_);
+  const NodeSpring pull{node, model->rest_position_m.at(node) + Eigen::Vector3d(0.0, 0.0, 0.01),
+                        50.0, 0.0};
+  simulation.set_springs(std::span<const NodeSpring>(&pull, 1));
+  simulation.start();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (simulation.stats().dissipated_fraction <= 0.0 &&
+         std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  simulation.stop();
+  const RealtimeStats stats = simulation.stats();
+  EXPECT_FALSE(stats.energy_created);
+  EXPECT_GT(stats.dissipated_fraction, 0.0) << "damping takes energy out";
+  EXPECT_LE(stats.dissipated_fraction, 1.0) << "no more than was supplied";
 }
 
 }  // namespace

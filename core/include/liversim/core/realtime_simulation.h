@@ -60,6 +60,11 @@ struct RealtimeStats {
   int rejected_inputs = 0;
   HealthProblem last_problem = HealthProblem::none;
   bool halted = false;
+  // Energy books (energy.h), closed once per statistics window: energy created beyond the
+  // guard's tolerance (a scheme going unstable shows here before any NaN), and the share of the
+  // energy supplied that viscosity, plasticity and damping have taken out.
+  bool energy_created = false;
+  double dissipated_fraction = 0.0;
 };
 
 // The fixed-step clock of the real-time loop, without the loop: wall time is added, whole steps
@@ -162,6 +167,8 @@ class RealtimeSimulation {
   std::atomic<int> rollbacks_{0}, rejected_inputs_{0};
   std::atomic<HealthProblem> last_problem_{HealthProblem::none};
   std::atomic<bool> halted_{false};
+  std::atomic<bool> energy_created_{false};
+  std::atomic<double> dissipated_fraction_{0.0};
   std::thread thread_;
 };
 
