@@ -42,9 +42,9 @@ bool is_viscous(const SimModel& model, std::size_t e) {
 
 // Average nodal pressure: the λ part of the volumetric energy sits at the nodes, W_λ(J̄) with J̄
 // the volume-weighted mean of the node's element volume ratios, each element handing a quarter
-// of its volume to each corner. (The forces take p_λ at the element's mean of its corners' J̄,
-// which differs from this potential's gradient at second order in the spread of J̄.) Each
-// element's J is recomputed once per corner rather than stored, so nothing is allocated.
+// of its volume to each corner (elements of viscous regions keep their own J and take no part).
+// The forces are this potential's exact gradient (forces.cpp). Each element's J is recomputed
+// once per corner rather than stored, so nothing is allocated.
 double nodal_lambda_energy_j(const SimModel& model, const NodeArray& position) {
   const std::size_t tets = model.tet_count;
   double energy = 0.0;
@@ -52,6 +52,7 @@ double nodal_lambda_energy_j(const SimModel& model, const NodeArray& position) {
     double weighted = 0.0, volume = 0.0;
     for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
       const std::size_t e = static_cast<std::size_t>(model.node_slots[s]) % tets;
+      if (is_viscous(model, e)) continue;
       weighted += model.rest_volume_m3[e] * deformation_gradient(model, position, e).determinant();
       volume += model.rest_volume_m3[e];
     }

@@ -48,10 +48,10 @@ bool in_viscous_region(const SimModel& model, std::size_t e) {
          model.viscous_parameters[static_cast<std::size_t>(model.region[e])].has_value();
 }
 
-// `averaged_volume_ratio` is used only with average nodal pressure (kAveragedPressure).
+// `averaged_lambda_pressure` is used only with average nodal pressure (kAveragedPressure).
 template <bool kFibres, bool kViscous, bool kAveragedPressure, bool kMooneyRivlin>
 Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Matrix3d& F,
-                          double averaged_volume_ratio, ElasticEvaluation& seen,
+                          double averaged_lambda_pressure, ElasticEvaluation& seen,
                           const ViscousContext& viscous) {
   Eigen::Matrix3d P;
   const auto* step = kViscous ? &(*viscous.step_by_region)[model.region[e]] : nullptr;
@@ -68,8 +68,8 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
   } else if (kAveragedPressure && !in_viscous_region(model, e))
     // A viscous region's law works with its element's own volume ratio, so its instantaneous
     // elastic response (what the stable step is estimated from) must too.
-    P = neo_hookean::first_piola_stress_averaged_pressure(
-        F, model.shear_modulus_pa[e], model.lame_lambda_pa[e], averaged_volume_ratio);
+    P = neo_hookean::first_piola_stress_given_lambda_pressure(
+        F, model.shear_modulus_pa[e], model.lame_lambda_pa[e], averaged_lambda_pressure);
   else
     P = neo_hookean::first_piola_stress(F, model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
   if constexpr (kMooneyRivlin)
@@ -87,20 +87,30 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
   return P;
 }
 
-// Average nodal pressure, first pass: each node's volume-weighted mean of its elements' J.
+// Average nodal pressure, first pass: each node's volume-weighted mean J̄ of its elements' J and
+// the λ part of the pressure there, p_λ̄(J̄) with λ̄ the volume-weighted mean of their λ. Elements
+// of viscous regions keep their own J and take no part. Each element then takes the mean of its
+// corners' p_λ̄(J̄): the exact gradient of the nodal energy Σ_n V_n/4·W_λ̄(J̄) (energy.cpp), also
+// where λ jumps between regions (p_λ(mean of the corners' J̄) with the element's own λ is not, and
+// creates energy at a stiff lesion's boundary).
 void average_nodal_volume_ratios(const SimModel& model, const NodeArray& position,
                                  ForceScratch& scratch) {
   for (std::size_t e = 0; e < model.tet_count; ++e)
     scratch.element_volume_ratio[e] = deformation_gradient(model, position, e).determinant();
   const std::size_t tets = model.tet_count;
   for (std::size_t n = 0; n < model.node_count; ++n) {
-    double weighted = 0.0, volume = 0.0;
+    double weighted = 0.0, volume = 0.0, lambda_volume = 0.0;
     for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
       const std::size_t e = static_cast<std::size_t>(model.node_slots[s]) % tets;
+      if (in_viscous_region(model, e)) continue;
       weighted += model.rest_volume_m3[e] * scratch.element_volume_ratio[e];
       volume += model.rest_volume_m3[e];
+      lambda_volume += model.rest_volume_m3[e] * model.lame_lambda_pa[e];
     }
-    scratch.nodal_volume_ratio[n] = volume > 0.0 ? weighted / volume : 1.0;
+    const double averaged = volume > 0.0 ? weighted / volume : 1.0;
+    scratch.nodal_volume_ratio[n] = averaged;
+    scratch.nodal_lambda_pressure_pa[n] =
+        volume > 0.0 ? neo_hookean::lambda_pressure(averaged, lambda_volume / volume) : 0.0;
   }
 }
 
@@ -118,11 +128,10 @@ ElasticEvaluation element_forces(const SimModel& model, const NodeArray& positio
     const double J = F.determinant();
     seen.min_volume_ratio = std::min(seen.min_volume_ratio, J);
     seen.max_volume_ratio = std::max(seen.max_volume_ratio, J);
-    double averaged = J;
-    if constexpr (kAveragedPressure) {
-      averaged = 0.0;
-      for (int c = 0; c < 4; ++c) averaged += 0.25 * scratch.nodal_volume_ratio[model.corner[c][e]];
-    }
+    double averaged = 0.0;  // the λ part of the pressure, with average nodal pressure
+    if constexpr (kAveragedPressure)
+      for (int c = 0; c < 4; ++c)
+        averaged += 0.25 * scratch.nodal_lambda_pressure_pa[model.corner[c][e]];
     const Eigen::Matrix3d P = stress_of<kFibres, kViscous, kAveragedPressure, kMooneyRivlin>(
         model, e, F, averaged, seen, viscous);
     // Nodal forces of corners 1..3 are the columns of −V·P·Dm⁻ᵀ; corner 0 balances them.

@@ -128,14 +128,23 @@ double lambda_energy_density(double J, double lambda) {
          0.5 * lambda * (1.0 - log_j0) / (j0 * j0) * d * d;
 }
 
-Eigen::Matrix3d first_piola_stress_averaged_pressure(const Eigen::Matrix3d& F, double mu,
-                                                     double lambda, double averaged_volume_ratio) {
+double lambda_pressure(double J, double lambda) {
+  return lambda_pressure_term(J, lambda);
+}
+
+Eigen::Matrix3d first_piola_stress_given_lambda_pressure(const Eigen::Matrix3d& F, double mu,
+                                                         double lambda, double lambda_pressure_pa) {
   const Eigen::Matrix3d cof = cofactor(F);
   const double J = F.col(0).dot(cof.col(0));
   const double pressure_term = volumetric_pressure_term(J, mu, lambda) -
-                               lambda_pressure_term(J, lambda) +
-                               lambda_pressure_term(averaged_volume_ratio, lambda);
+                               lambda_pressure_term(J, lambda) + lambda_pressure_pa;
   return mu * F + pressure_term * cof;
+}
+
+Eigen::Matrix3d first_piola_stress_averaged_pressure(const Eigen::Matrix3d& F, double mu,
+                                                     double lambda, double averaged_volume_ratio) {
+  return first_piola_stress_given_lambda_pressure(
+      F, mu, lambda, lambda_pressure_term(averaged_volume_ratio, lambda));
 }
 
 double volumetric_stiffening(double J, double mu, double lambda) {

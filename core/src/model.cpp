@@ -48,6 +48,12 @@ void validate_regions(const std::vector<RegionMaterial>& regions) {
                                   ": viscoplasticity needs the viscoelastic parameters (E1, E2, "
                                   "eta1) it acts in series with");
     if (const auto& visco = regions[r].viscoelastic) {
+      // The viscous law's elastic base is Neo-Hookean; an I2 term would be ignored by its forces
+      // but not by the model's moduli (and the energy books read those).
+      if (regions[r].tissue.mooney_rivlin_fraction > 0.0)
+        throw std::invalid_argument(region_name(r) +
+                                    ": a Mooney-Rivlin fraction > 0 is not available with "
+                                    "viscoelasticity (its elastic base is Neo-Hookean)");
       if (auto problem = validate(ViscousTissueParameters{*visco, regions[r].tissue.poisson_ratio,
                                                           regions[r].viscoplastic}))
         throw std::invalid_argument(region_name(r) + ": " + *problem);

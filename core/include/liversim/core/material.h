@@ -51,9 +51,17 @@ Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, double mu, double l
 Eigen::Matrix3d first_piola_stress_averaged_pressure(const Eigen::Matrix3d& F, double mu,
                                                      double lambda, double averaged_volume_ratio);
 
+// The same stress with the λ part of the pressure replaced by a given one:
+// P = μF + (U'(J) − p_λ(J) + lambda_pressure_pa) cof F. Average nodal pressure passes the mean of
+// the element's corners' nodal p_λ, which makes its forces the gradient of its nodal energy.
+Eigen::Matrix3d first_piola_stress_given_lambda_pressure(const Eigen::Matrix3d& F, double mu,
+                                                         double lambda, double lambda_pressure_pa);
+
 // W_λ(J) = λ/2·ln²J, the λ part of U(J) (its derivative is p_λ), continued below kMinVolumeRatio
 // as p_λ is. Σ over nodes of V·W_λ(J_avg) is the volumetric energy of average nodal pressure.
 double lambda_energy_density(double J, double lambda);
+// p_λ(J) = dW_λ/dJ = λ ln J / J, continued linearly below kMinVolumeRatio. Linear in λ, as W_λ is.
+double lambda_pressure(double J, double lambda);
 
 // ∂P/∂F as a 9×9 matrix over row-major flattened indices (row 3i+J for P_iJ, column 3k+L for
 // F_kL): μ δik δJL + U''(J) cof_iJ cof_kL + U'(J) ∂cof_iJ/∂F_kL. Needed by implicit integrators.

@@ -21,7 +21,8 @@ namespace liversim {
 struct RegionMaterial {
   TissueMaterial tissue;
   std::optional<FibreParameters> fibres;  // none: isotropic
-  // Seed Eq. 1–3. When given, tissue.youngs_modulus_pa must be the instantaneous modulus E1 + E2.
+  // Seed Eq. 1–3. When given, tissue.youngs_modulus_pa must be the instantaneous modulus E1 + E2
+  // and tissue.mooney_rivlin_fraction 0 (the viscous law's elastic base is Neo-Hookean).
   std::optional<ViscoelasticParameters> viscoelastic;
   // Seed Eq. 4, in series; needs `viscoelastic`.
   std::optional<ViscoplasticParameters> viscoplastic;
