@@ -16,6 +16,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -34,6 +35,19 @@ std::string number(double value) {
   std::ostringstream text;
   text << value;
   return text.str();
+}
+
+std::string format(double value, int precision) {
+  std::ostringstream text;
+  text << std::setprecision(precision) << value;
+  return text.str();
+}
+
+std::string today_utc() {
+  const std::time_t now = std::time(nullptr);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%d", std::gmtime(&now));
+  return text;
 }
 
 IntegratorKind integrator_kind(const std::string& name) {

@@ -84,6 +84,10 @@ int guarded(Body&& body) {
 
 // A number as the user would type it (shortest round trip is not needed: 6 digits).
 std::string number(double value);
+// A number for a report table, to `precision` significant digits.
+std::string format(double value, int precision = 3);
+// Today's date (UTC) as YYYY-MM-DD, for the header of a written report.
+std::string today_utc();
 
 // The integrator of --integrator NAME; throws std::invalid_argument naming it and listing the
 // valid names.

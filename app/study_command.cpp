@@ -1,6 +1,7 @@
 #include "study_command.h"
 
 #include "cli_commands.h"
+#include "stability_command.h"
 
 #include "liversim/core/accuracy_study.h"
 
@@ -51,12 +52,6 @@ void print_progress(int done, int total, const std::string& next) {
   } else {
     std::cerr << "[" << done << "/" << total << "] " << next << "\n";
   }
-}
-
-std::string format(double value, int precision = 3) {
-  std::ostringstream text;
-  text << std::setprecision(precision) << value;
-  return text.str();
 }
 
 std::string setting_of(const AccuracyStudyRow& row) {
@@ -144,13 +139,6 @@ double load_interval_ms(const AccuracyStudyOptions& options) {
              : *std::max_element(options.steps_s.begin(), options.steps_s.end()) * 1e3;
 }
 
-std::string today() {
-  const std::time_t now = std::time(nullptr);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%d", std::gmtime(&now));
-  return text;
-}
-
 int run_study(const StudyCommandOptions& command) {
   AccuracyStudyOptions options = command.study;
   options.integrators.clear();
@@ -193,7 +181,7 @@ int run_study(const StudyCommandOptions& command) {
 
   std::ostringstream md;
   md << "# Accuracy study: what accuracy costs in time\n\n"
-     << "Written by `" << command.command_line << "` on " << today() << " ("
+     << "Written by `" << command.command_line << "` on " << today_utc() << " ("
      << std::thread::hardware_concurrency()
      << " hardware threads; every run on one thread). Every figure below is from that run; "
         "run the command again to regenerate this page, its CSV and its images.\n\n"
@@ -299,7 +287,8 @@ int run_study(const StudyCommandOptions& command) {
 
 std::function<std::optional<int>()> add_study_command(CLI::App& app) {
   auto options = std::make_shared<StudyCommandOptions>();
-  auto* study = app.add_subcommand("study", "Studies of the engine: accuracy (what it costs)");
+  auto* study = app.add_subcommand(
+      "study", "Studies of the engine: accuracy (what it costs), stability (the hard cases)");
   study->require_subcommand(1);
   auto* accuracy = study->add_subcommand(
       "accuracy",
@@ -339,8 +328,11 @@ std::function<std::optional<int>()> add_study_command(CLI::App& app) {
       ->capture_default_str();
   accuracy->add_flag("!--no-plots", o.plots, "Skip the PNG plots (they need X or xvfb-run)");
 
-  return [options, study]() -> std::optional<int> {
-    if (!study->parsed()) return std::nullopt;
+  const auto run_stability = add_stability_study(*study);
+
+  return [options, study, accuracy, run_stability]() -> std::optional<int> {
+    if (auto exit_code = run_stability()) return exit_code;
+    if (!accuracy->parsed()) return std::nullopt;
     // The exact command that produced the report, for the report itself.
     options->command_line = "liversim-cli study accuracy";
     const StudyCommandOptions& o = *options;

@@ -239,6 +239,44 @@ std::vector<StabilityRun> yield_cycles_case(const StabilitySuiteOptions&) {
   return runs;
 }
 
+// Case 8: the device's largest force (3.3 N, haptics.md) as a step on one node of the liver (the
+// seed's coarsest, 3844 tetrahedra), pulling outward, held 0.1 s, then released. A point load on
+// a continuum is singular: the node's elements stretch into a tent far beyond any tissue's tearing
+// stretch and the light node moves at tens of m/s, so this tests the numerics, not the tissue.
+// The bound: the force is carried by the elements around the node, whose rest cross-section is at
+// least h_min² (h_min the smallest element height); a Neo-Hookean column in tension stretches by
+// at most F/(μ·A) more, over a length of at least h_min, and a suddenly applied load overshoots
+// the static stretch at most twice: |u| ≤ 2·F/(μ·h_min). After release, mass damping α leaves
+// e^(−α·t/2) of the motion: the liver must be within 20 × that share of the largest displacement
+// of rest (3 s free; 1 s for backward Euler, whose Newton steps through the tent cost more).
+std::vector<StabilityRun> force_step_case(const StabilitySuiteOptions&) {
+  constexpr double kDeviceMaxForce = 3.3, kHold = 0.1;
+  const TetMesh mesh = generate_liver_mesh(kSeedMeshSizes[0]).mesh;
+  std::vector<StabilityRun> runs;
+  for (IntegratorKind kind : {IntegratorKind::central_difference, IntegratorKind::backward_euler}) {
+    ModelOptions options;
+    options.fixed_nodes = mesh.node_sets.at("ligament");
+    options.integrator.kind = kind;
+    options.integrator.step_s = is_explicit(kind) ? 0.0 : 1e-3;
+    const SimModel model = build_model(mesh, options);
+    BookedRun run(model, std::string(integrator_name(kind)));
+    const std::vector<PointLoad> step{
+        {anterior_marked_node(mesh), Eigen::Vector3d(0.0, 0.0, kDeviceMaxForce)}};
+    run.advance({step, {}}, 0.01, static_cast<int>(std::lround(kHold / 0.01)));
+    const double largest = run.result().max_displacement_m;
+    const double free_s = is_explicit(kind) ? 3.0 : 1.0;
+    run.advance({}, 0.05, static_cast<int>(std::lround(free_s / 0.05)));
+    const double mu = model.shear_modulus_pa[0];
+    run.check(
+        "largest displacement after " + std::to_string(static_cast<int>(free_s)) + " s free (m)",
+        max_displacement_m(model, run.state.position_m),
+        20.0 * largest * std::exp(-0.5 * model.mass_damping_per_s * free_s));
+    runs.push_back(
+        run.finish(2.0 * kDeviceMaxForce / (mu * model.min_element_height_m), kEnergyTolerance));
+  }
+  return runs;
+}
+
 // Case 9: a coarse liver (1000 tetrahedra, so that ten simulated minutes take about a minute)
 // pulled by 0.2 N for 0.3 s, then free for options.long_run_s. Free, the held energy may never
 // grow (beyond round-off), and the liver comes back to rest: mass damping α = 8/s leaves e^(−8·t)

@@ -31,8 +31,11 @@ bool BookedRun::advance(const StepInputs& inputs, double interval_s, int interva
     run_.rollbacks += report.rollbacks;
     run_.rejected_inputs += report.inputs_rejected ? 1 : 0;
     accumulate(run_.steps, report.steps);
+    if (report.problem != HealthProblem::none)
+      run_.last_problem = std::string(health_problem_text(report.problem));
     if (report.gave_up) {
       run_.gave_up = true;
+      run_.gave_up_at_s = state.time_s;
       return false;
     }
     last_balance_ = *report.energy;

@@ -22,6 +22,8 @@ TEST_P(StabilityCaseTest, EveryRunPassesEveryCheck) {
   for (const StabilityRun& run : runs) {
     EXPECT_TRUE(run.error.empty()) << run.variant << ": " << run.error;
     EXPECT_GT(run.intervals, 0) << run.variant;
+    EXPECT_FALSE(run.gave_up) << run.variant << " gave up at t = " << run.gave_up_at_s
+                              << " s: " << run.last_problem;
     for (const StabilityCheck& check : run.checks)
       EXPECT_TRUE(check.passed()) << run.variant << ": " << check.what << " = " << check.value
                                   << ", limit " << (check.at_most ? "≤ " : "≥ ") << check.limit;

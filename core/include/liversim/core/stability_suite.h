@@ -32,7 +32,9 @@ struct StabilityRun {
   StepReport steps;   // accumulated over the run
   int rollbacks = 0;
   int rejected_inputs = 0;
-  bool gave_up = false;  // a guarded advance gave up (the state is its last good one)
+  bool gave_up = false;      // a guarded advance gave up (the state is its last good one)
+  std::string last_problem;  // health_problem_text of the last problem the guard met (if any)
+  double gave_up_at_s = 0.0;
   double max_displacement_m = 0.0;
   // Largest energy created over the run, as a fraction of the energy supplied at that moment
   // (energy books, energy.h; ≤ 0: the books show only dissipation).
