@@ -2,6 +2,7 @@
 
 #include "cli_commands.h"
 
+#include "liversim/core/parameter_ranges.h"
 #include "liversim/core/stability_suite.h"
 
 #include <CLI/CLI.hpp>
@@ -76,7 +77,14 @@ int run_suite(const StabilityStudyOptions& o) {
             << " | " << format(run.steps.smallest_substep_s * 1e3) << " | " << run.rollbacks
             << " | " << format(100.0 * run.energy_error, 2) << " % | "
             << (run.energy_supplied_j > 0.0
-                    ? format(100.0 * (1.0 - run.energy_held_j / run.energy_supplied_j), 3) + " %"
+                    ? format(100.0 * (1.0 - run.energy_held_j / run.energy_supplied_j), 3) + " %" +
+                          (run.viscous_dissipated_j > 0.0
+                               ? " (viscous " +
+                                     format(
+                                         100.0 * run.viscous_dissipated_j / run.energy_supplied_j,
+                                         3) +
+                                     " %)"
+                               : std::string())
                     : std::string("–"))
             << " | " << format(run.max_displacement_m * 1e3) << " | " << format(run.wall_time_s)
             << " | " << verdict(run) << " |\n";
@@ -103,11 +111,18 @@ int run_suite(const StabilityStudyOptions& o) {
         "as "
         "a fraction of the energy supplied (initial + work of loads and tools), 0 when the books "
         "showed only dissipation; dissipated: the share of the energy supplied that viscosity, "
-        "plasticity, damping and the scheme took out by the end. Steps: accepted integrator "
+        "plasticity, damping and the scheme took out by the end (in brackets, the Maxwell arms' "
+        "dashpots alone). Steps: accepted integrator "
         "steps.\n\n"
      << total - failed << " of " << total << " runs passed.\n\n"
      << table.str() << "\n## Checks\n"
-     << checks.str();
+     << checks.str()
+     << "\n## Parameter ranges (case 12 samples them; `core/parameter_ranges.h`)\n\n"
+     << "| parameter | key | from | to | unit | sampled | why |\n|---|---|---:|---:|---|---|---|\n";
+  for (const ParameterRange& range : tissue_parameter_ranges())
+    md << "| " << range.label << " | `" << range.name << "` | " << format(range.min, 4) << " | "
+       << format(range.max, 4) << " | " << range.unit << " | "
+       << (range.log_scale ? "log-uniform" : "uniform") << " | " << range.why << " |\n";
   const std::filesystem::path report = o.output_dir / "stability-report.md";
   std::ofstream out(report);
   out << md.str();

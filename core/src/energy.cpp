@@ -88,6 +88,21 @@ double tissue_energy_j(const SimModel& model, const SimState& state) {
   return energy;
 }
 
+double viscous_dissipation_rate_w(const SimModel& model, const SimState& state) {
+  if (!model.effects.viscous) return 0.0;
+  double rate = 0.0;
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    if (!is_viscous(model, e)) continue;
+    const auto& law =
+        model.viscous_parameters[static_cast<std::size_t>(model.region[e])]->viscoelastic;
+    const double arm_fraction = law.e1_pa / law.instantaneous_modulus_pa();
+    rate += model.rest_volume_m3[e] * 2.0 / law.relaxation_time_s() *
+            arm_energy_density(state.viscous_state[e].maxwell_stress_pa, arm_fraction,
+                               model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
+  }
+  return rate;
+}
+
 double spring_energy_j(std::span<const NodeSpring> springs, const NodeArray& position) {
   double energy = 0.0;
   for (const NodeSpring& s : springs)
@@ -103,6 +118,7 @@ EnergyBalance energy_balance(const SimModel& model, const SimState& state,
   balance.spring_j = spring_energy_j(inputs.springs, state.position_m);
   balance.initial_j = state.energy.initial_j;
   balance.tool_work_j = state.energy.tool_work_j;
+  balance.viscous_dissipated_j = state.energy.viscous_dissipated_j;
   return balance;
 }
 

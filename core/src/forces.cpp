@@ -1,5 +1,8 @@
 #include "liversim/core/forces.h"
 
+#include "liversim/core/energy.h"
+#include "liversim/core/state.h"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -239,9 +242,13 @@ ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state
   for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
     if (model.viscous_parameters[r])
       state.viscous_step[r].emplace(*model.viscous_parameters[r], dt_since_last_s);
+  const double rate_before_w = viscous_dissipation_rate_w(model, state);
   const ElasticEvaluation seen = element_forces_for_effects<true>(
       model, state.position_m, state.force_scratch, {&state.viscous_state, &state.viscous_step});
   gather_corner_forces(model, state.force_scratch, state.force_n);
+  // The history just committed spans the last step: book its dashpots' work (trapezoid).
+  state.energy.viscous_dissipated_j +=
+      0.5 * dt_since_last_s * (rate_before_w + viscous_dissipation_rate_w(model, state));
   return seen;
 }
 

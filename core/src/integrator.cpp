@@ -384,6 +384,7 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
     if (model.viscous_parameters[r])
       state.viscous_step[r] =
           ViscousTissueStep::plastic_flow_only(*model.viscous_parameters[r], dt_s);
+  const double rate_before_w = viscous_dissipation_rate_w(model, state);
   for (std::size_t e = 0; e < model.tet_count; ++e) {
     const auto r = static_cast<std::size_t>(model.region[e]);
     if (!model.viscous_parameters[r]) continue;
@@ -401,6 +402,8 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
     // under a held stress as the seed's Eq. 4.
     if (step.viscoplastic) viscous_tissue_update(F, step, committed);
   }
+  state.energy.viscous_dissipated_j +=
+      0.5 * dt_s * (rate_before_w + viscous_dissipation_rate_w(model, state));
 }
 
 }  // namespace detail

@@ -66,6 +66,7 @@ StabilityRun BookedRun::finish(double displacement_bound_m, double energy_tolera
   check("largest displacement (m)", run_.max_displacement_m, displacement_bound_m);
   run_.energy_supplied_j = last_balance_.supplied_j();
   run_.energy_held_j = last_balance_.held_j();
+  run_.viscous_dissipated_j = last_balance_.viscous_dissipated_j;
   run_.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   return run_;

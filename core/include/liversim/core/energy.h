@@ -23,6 +23,9 @@ struct EnergyLedger {
   double initial_j = 0.0;        // held energy when the books were opened (0 at rest)
   double tool_work_j = 0.0;      // work done on the liver by loads and tools since
   double spring_energy_j = 0.0;  // in the tool springs at the end of the last advance
+  // Dissipated by the Maxwell arms' dashpots since: each step adds the trapezoid of their rate
+  // (viscous_dissipation_rate_w) at its start and end.
+  double viscous_dissipated_j = 0.0;
 };
 
 struct EnergyBalance {
@@ -31,6 +34,7 @@ struct EnergyBalance {
   double spring_j = 0.0;  // stored in the tool springs
   double initial_j = 0.0;
   double tool_work_j = 0.0;
+  double viscous_dissipated_j = 0.0;  // part of dissipated_j(): by the Maxwell arms' dashpots
 
   double held_j() const { return kinetic_j + tissue_j + spring_j; }
   double supplied_j() const { return initial_j + tool_work_j; }
@@ -43,13 +47,18 @@ struct EnergyBalance {
 };
 
 // Energy stored in the tissue. Elastic regions: ψ(F) of their law (with average nodal pressure,
-// of the element's own volume ratio: that formulation has no exact potential). Viscous regions:
+// the λ part at the nodes, whose exact gradient the forces are). Viscous regions:
 // the relaxed spring g0·ψ(Fe) at the elastic part Fe = F·Fp⁻¹, fibres ψ(F), and the Maxwell arm's
 // spring, ½·g1·H : C⁻¹ : H with C the instantaneous isotropic stiffness (exact at small strain, as
 // the seed's 1-D model; the arm's finite-strain law has no closed-form potential). Allocates
 // nothing; one pass over the elements.
 double tissue_energy_j(const SimModel& model, const SimState& state);
 double spring_energy_j(std::span<const NodeSpring> springs, const NodeArray& position);
+
+// Power dissipated by the Maxwell arms' dashpots, Σ V·2ψ_arm/τ over viscous elements (the arm's
+// stress g1·H relaxes through η1 = τ·E1: exact at small strain, as the arm's energy above). Reads
+// the committed history; allocates nothing; 0 without viscous regions.
+double viscous_dissipation_rate_w(const SimModel& model, const SimState& state);
 
 EnergyBalance energy_balance(const SimModel& model, const SimState& state,
                              const StepInputs& inputs);

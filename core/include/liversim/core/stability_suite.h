@@ -39,9 +39,10 @@ struct StabilityRun {
   // Largest energy created over the run, as a fraction of the energy supplied at that moment
   // (energy books, energy.h; ≤ 0: the books show only dissipation).
   double energy_error = 0.0;
-  double energy_supplied_j = 0.0;  // at the end of the run
-  double energy_held_j = 0.0;      // at the end of the run
-  double wall_time_s = 0.0;        // measured, for the report only
+  double energy_supplied_j = 0.0;     // at the end of the run
+  double energy_held_j = 0.0;         // at the end of the run
+  double viscous_dissipated_j = 0.0;  // by the Maxwell arms' dashpots, over the run
+  double wall_time_s = 0.0;           // measured, for the report only
   std::vector<StabilityCheck> checks;
   std::string error;  // an exception the run threw (the run failed)
   bool passed() const;
