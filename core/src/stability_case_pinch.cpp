@@ -28,10 +28,6 @@
 namespace liversim::detail {
 namespace {
 
-// As the other cases: central difference closes the books within a few per cent of the energy
-// supplied; the other schemes dissipate.
-constexpr double kEnergyTolerance = 0.05;
-
 constexpr double kSide = 0.04, kThickness = 0.02;  // the slab: 4 × 4 × 2 cm, 5 mm cubes
 constexpr double kTipRadius = 0.006;  // a tool tip takes the face nodes within 6 mm of its axis
 // N/m per tip node: five nodes give a tip of 10 kN/m, stiff enough to squeeze the tissue between

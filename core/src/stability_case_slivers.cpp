@@ -55,9 +55,6 @@
 namespace liversim::detail {
 namespace {
 
-// As in the other cases: central difference keeps its books within a few per cent.
-constexpr double kEnergyTolerance = 0.05;
-
 constexpr double kLength = 0.04, kCell = 0.01;  // 4 × 2 × 2 cubes of 1 cm
 constexpr double kFlatness = 1e-3;              // δ: the height of the flattened elements / h
 constexpr double kDamping = 30.0;               // α (1/s)

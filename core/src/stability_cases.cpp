@@ -15,11 +15,6 @@
 namespace liversim::detail {
 namespace {
 
-// Central difference conserves a modified energy to O(Δt²) (and its kinetic energy is taken half
-// a step behind); with damping the books close within a few per cent of the energy supplied at
-// the stable step. The other schemes are dissipative or far more accurate.
-constexpr double kEnergyTolerance = 0.05;
-
 // Nothing may move farther than the organ is large: a bound no stable run comes near.
 double extent_m(const SimModel& model) {
   Eigen::Vector3d low = model.rest_position_m.at(0), high = low;
