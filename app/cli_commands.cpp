@@ -50,6 +50,14 @@ std::string today_utc() {
   return text;
 }
 
+int write_report(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream out(file);
+  out << text;
+  if (!out) return fail("cannot write " + file.string());
+  std::cout << "wrote " << file.string() << "\n";
+  return 0;
+}
+
 IntegratorKind integrator_kind(const std::string& name) {
   if (auto kind = integrator_from_name(name)) return *kind;
   std::string valid;

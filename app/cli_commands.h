@@ -88,6 +88,8 @@ std::string number(double value);
 std::string format(double value, int precision = 3);
 // Today's date (UTC) as YYYY-MM-DD, for the header of a written report.
 std::string today_utc();
+// Writes a report file and says so on stdout; 0, or fail()'s exit code naming the file.
+int write_report(const std::filesystem::path& file, const std::string& text);
 
 // The integrator of --integrator NAME; throws std::invalid_argument naming it and listing the
 // valid names.

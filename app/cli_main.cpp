@@ -1,4 +1,5 @@
 // liversim-cli: headless simulation, mesh reports and screenshots.
+#include "bench_command.h"
 #include "cli_commands.h"
 #include "experiment_commands.h"
 #include "study_command.h"
@@ -133,6 +134,7 @@ int main(int argc, char** argv) {
 
   const auto run_experiment = add_experiment_command(app);
   const auto run_study = add_study_command(app);
+  const auto run_bench = add_bench_command(app);
 
   try {
     app.parse(argc, argv);
@@ -143,6 +145,7 @@ int main(int argc, char** argv) {
 
   if (auto exit_code = run_experiment()) return *exit_code;
   if (auto exit_code = run_study()) return *exit_code;
+  if (auto exit_code = run_bench()) return *exit_code;
   if (report->parsed()) return mesh_report(report_mesh);
   if (simulate_cmd->parsed()) return simulate(sim);
   if (screenshot_cmd->parsed()) return screenshot(shot);

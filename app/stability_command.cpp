@@ -123,11 +123,8 @@ int run_suite(const StabilityStudyOptions& o) {
     md << "| " << range.label << " | `" << range.name << "` | " << format(range.min, 4) << " | "
        << format(range.max, 4) << " | " << range.unit << " | "
        << (range.log_scale ? "log-uniform" : "uniform") << " | " << range.why << " |\n";
-  const std::filesystem::path report = o.output_dir / "stability-report.md";
-  std::ofstream out(report);
-  out << md.str();
-  if (!out) return fail("cannot write " + report.string());
-  std::cout << "wrote " << report.string() << "\n";
+  if (const int written = write_report(o.output_dir / "stability-report.md", md.str()))
+    return written;
   return failed == 0 ? 0 : 1;
 }
 

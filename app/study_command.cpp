@@ -275,12 +275,7 @@ int run_study(const StudyCommandOptions& command) {
   md << "\nData: [accuracy-study.csv](accuracy-study.csv), "
         "[accuracy-study-meshes.csv](accuracy-study-meshes.csv).\n";
 
-  const std::filesystem::path report = command.output_dir / "accuracy-study.md";
-  std::ofstream out(report);
-  out << md.str();
-  if (!out) return fail("cannot write " + report.string());
-  std::cout << "wrote " << report.string() << "\n";
-  return 0;
+  return write_report(command.output_dir / "accuracy-study.md", md.str());
 }
 
 }  // namespace

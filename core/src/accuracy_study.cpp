@@ -47,12 +47,10 @@ double observed_order(const AccuracyStudyRow& coarse, const AccuracyStudyRow& fi
   return std::log(e1 / e2) / std::log(h1 / h2);
 }
 
-namespace {
-
 // The study's tissue: the default scene's, with the effect set's additions. Viscous and fibre
 // parameters are ASSUMED (no liver data in the seed): E = 3500 Pa split E1 = 2000, E2 = 1500,
 // τ = 1 s; yield limit 20 Pa, η2 = 500 Pa·sⁿ, n = 0.5; fibres k1 = 1000 Pa, k2 = 2 along x.
-void apply_effects(StudyEffects effects, ModelOptions& options) {
+void apply_study_effects(StudyEffects effects, ModelOptions& options) {
   RegionMaterial& region = options.regions.at(0);
   region.tissue = TissueMaterial{3500.0, 0.49, 1060.0};
   switch (effects) {
@@ -70,6 +68,8 @@ void apply_effects(StudyEffects effects, ModelOptions& options) {
       break;
   }
 }
+
+namespace {
 
 // Smooth rise x²(3 − 2x) of the tension over the run.
 double tension_n(const AccuracyStudyOptions& options, double time_s) {
@@ -225,7 +225,7 @@ AccuracyStudyResult run_accuracy_study(const AccuracyStudyOptions& options,
     const NodeIndex marked = nearest_surface_node(scene.mesh, *material_point);
     for (StudyEffects effects : options.effects) {
       ModelOptions base = scene.model_options;
-      apply_effects(effects, base);
+      apply_study_effects(effects, base);
       std::ostringstream label;
       label << scene.mesh.tet_count() << " tets, " << study_effects_name(effects);
 

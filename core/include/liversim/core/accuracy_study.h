@@ -26,6 +26,9 @@ inline constexpr StudyEffects kAllStudyEffects[] = {
     StudyEffects::fibres};
 std::string_view study_effects_name(StudyEffects effects);
 std::optional<StudyEffects> study_effects_from_name(std::string_view name);
+// Sets region 0's tissue to the study's (E = 3500 Pa, ν = 0.49) and adds the effect set's laws;
+// adds to what `options` already has, so sets can be combined (viscoplastic, then fibres).
+void apply_study_effects(StudyEffects effects, ModelOptions& options);
 
 struct AccuracyStudyOptions {
   std::vector<int> tet_counts{3841};  // built-in liver sizes; the last (largest) is the finest

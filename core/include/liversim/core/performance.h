@@ -1,0 +1,42 @@
+#pragma once
+// Measures of the engine's cost for the benchmarks (liversim-cli bench, docs/performance.md):
+// the time of one internal-force evaluation, the rate of whole steps, and the memory a model and
+// its state hold. Timing is wall-clock on the calling thread; tests never assert it.
+
+#include "liversim/core/integrator.h"
+#include "liversim/core/state.h"
+
+#include <cstddef>
+
+namespace liversim {
+
+// Heap bytes held by the model (every per-element and per-node array, by capacity).
+std::size_t model_bytes(const SimModel& model);
+// Heap bytes held by the state: positions, velocities, forces, scratch, viscous history and the
+// integrator's arrays (the implicit schemes' sparse factorisation not included).
+std::size_t state_bytes(const SimState& state);
+
+struct ForceEvaluationTiming {
+  int evaluations = 0;
+  double wall_s = 0.0;
+  double ns_per_tet = 0.0;  // per evaluation: wall / (evaluations · tets)
+};
+// Evaluates the internal forces at the state's positions (viscous regions advancing their history
+// by step_s each time, as a central-difference step does) for at least min_wall_s, after one
+// warm-up evaluation; the best of `repetitions` such runs (the least disturbed).
+ForceEvaluationTiming time_force_evaluations(const SimModel& model, SimState& state, double step_s,
+                                             double min_wall_s, int repetitions = 3);
+
+struct SteppingTiming {
+  double simulated_s = 0.0;
+  double wall_s = 0.0;
+  StepReport steps;
+  double steps_per_s() const { return wall_s > 0.0 ? steps.substeps / wall_s : 0.0; }
+  double real_time_factor() const { return wall_s > 0.0 ? simulated_s / wall_s : 0.0; }
+};
+// Advances the state by `interval_s` at a time with the given inputs until at least min_wall_s of
+// wall time has passed.
+SteppingTiming time_stepping(const SimModel& model, SimState& state, const StepInputs& inputs,
+                             double interval_s, double min_wall_s);
+
+}  // namespace liversim

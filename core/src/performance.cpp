@@ -1,0 +1,102 @@
+#include "liversim/core/performance.h"
+
+#include "liversim/core/integrator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+namespace liversim {
+namespace {
+
+template <typename T>
+std::size_t bytes(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+std::size_t bytes(const NodeArray& a) {
+  return bytes(a.x) + bytes(a.y) + bytes(a.z);
+}
+template <typename T, std::size_t N>
+std::size_t bytes(const std::array<T, N>& arrays) {
+  std::size_t total = 0;
+  for (const T& a : arrays) total += bytes(a);
+  return total;
+}
+template <typename T>
+std::size_t bytes(const std::vector<std::vector<T>>& v) {
+  std::size_t total = v.capacity() * sizeof(std::vector<T>);
+  for (const auto& inner : v) total += bytes(inner);
+  return total;
+}
+std::size_t bytes(const std::vector<NodeArray>& v) {
+  std::size_t total = v.capacity() * sizeof(NodeArray);
+  for (const NodeArray& a : v) total += bytes(a);
+  return total;
+}
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+std::size_t model_bytes(const SimModel& m) {
+  return bytes(m.corner) + bytes(m.dm_inverse) + bytes(m.rest_volume_m3) +
+         bytes(m.shear_modulus_pa) + bytes(m.lame_lambda_pa) + bytes(m.mooney_rivlin_c2_pa) +
+         bytes(m.region) + bytes(m.regions) + bytes(m.fibre_parameters) + bytes(m.fibre_direction) +
+         bytes(m.viscous_parameters) + bytes(m.rest_position_m) + bytes(m.lumped_mass_kg) +
+         bytes(m.inverse_mass_per_kg) + bytes(m.is_fixed) + bytes(m.node_slot_begin) +
+         bytes(m.node_slots);
+}
+
+std::size_t state_bytes(const SimState& s) {
+  const ForceScratch& f = s.force_scratch;
+  const IntegratorScratch& i = s.integrator;
+  return bytes(s.position_m) + bytes(s.velocity_m_per_s) + bytes(s.force_n) +
+         bytes(f.corner_force_n) + bytes(f.element_volume_ratio) + bytes(f.nodal_volume_ratio) +
+         bytes(f.nodal_lambda_pressure_pa) + bytes(s.spring_damping_per_s) +
+         bytes(s.viscous_state) + bytes(s.viscous_step) + bytes(i.start_position_m) +
+         bytes(i.start_velocity_m_per_s) + bytes(i.stage_position_m) +
+         bytes(i.stage_velocity_m_per_s) + bytes(i.position_rate) + bytes(i.velocity_rate) +
+         bytes(i.start_arm) + bytes(i.stage_arm) + bytes(i.elastic_stress) + bytes(i.arm_rate) +
+         bytes(i.external_force_n) + bytes(i.previous_external_force_n) +
+         bytes(i.velocity_history) + bytes(i.previous_position_m) +
+         bytes(i.previous_velocity_m_per_s) + bytes(i.predicted_position_m) +
+         bytes(i.predicted_velocity_m_per_s) + bytes(i.previous_arm) + bytes(i.predicted_arm) +
+         bytes(i.keep_by_region) + bytes(i.elastic_weight_by_region);
+}
+
+ForceEvaluationTiming time_force_evaluations(const SimModel& model, SimState& state, double step_s,
+                                             double min_wall_s, int repetitions) {
+  compute_internal_forces(model, state, step_s);  // warm-up: caches, first-touch pages
+  ForceEvaluationTiming best;
+  best.ns_per_tet = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < std::max(1, repetitions); ++r) {
+    ForceEvaluationTiming run;
+    const Clock::time_point start = Clock::now();
+    do {
+      compute_internal_forces(model, state, step_s);
+      ++run.evaluations;
+      run.wall_s = seconds_since(start);
+    } while (run.wall_s < min_wall_s);
+    run.ns_per_tet = 1e9 * run.wall_s /
+                     (static_cast<double>(run.evaluations) * static_cast<double>(model.tet_count));
+    if (run.ns_per_tet < best.ns_per_tet) best = run;
+  }
+  return best;
+}
+
+SteppingTiming time_stepping(const SimModel& model, SimState& state, const StepInputs& inputs,
+                             double interval_s, double min_wall_s) {
+  SteppingTiming timing;
+  const Clock::time_point start = Clock::now();
+  do {
+    accumulate(timing.steps, advance(model, state, inputs, interval_s));
+    timing.simulated_s += interval_s;
+    timing.wall_s = seconds_since(start);
+  } while (timing.wall_s < min_wall_s);
+  return timing;
+}
+
+}  // namespace liversim
