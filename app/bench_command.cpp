@@ -155,7 +155,7 @@ std::function<std::optional<int>()> add_bench_command(CLI::App& app) {
       ->check(CLI::Range(100, 2'000'000))
       ->capture_default_str();
   bench->add_option("--min-time", o.min_time_s, "Least wall time of each measurement (s)")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1e-3, 3600.0))
       ->capture_default_str();
   bench->add_option("--output-dir", o.output_dir, "Where performance.md goes")
       ->capture_default_str();

@@ -8,16 +8,6 @@
 namespace liversim {
 namespace {
 
-// ½·g1·H : C⁻¹ : H for the isotropic stiffness C = 2μ·I + λ·1⊗1, whose compliance is
-// (I − λ/(2μ + 3λ)·1⊗1)/(2μ). H in Voigt order (xx, yy, zz, yz, xz, xy).
-double arm_energy_density(const Voigt6& h, double arm_fraction, double mu, double lambda) {
-  const double trace = h[0] + h[1] + h[2];
-  const double contraction =
-      h[0] * h[0] + h[1] * h[1] + h[2] * h[2] + 2.0 * (h[3] * h[3] + h[4] * h[4] + h[5] * h[5]);
-  return arm_fraction / (4.0 * mu) *
-         (contraction - lambda / (2.0 * mu + 3.0 * lambda) * trace * trace);
-}
-
 double viscous_element_energy_density(const SimModel& model, const SimState& state,
                                       const ViscousTissueParameters& law, std::size_t e,
                                       const Eigen::Matrix3d& F) {
@@ -28,7 +18,7 @@ double viscous_element_energy_density(const SimModel& model, const SimState& sta
   const double arm_fraction = law.viscoelastic.e1_pa / instantaneous;
   double psi = relaxed_fraction *
                neo_hookean::energy_density(F * history.inverse_plastic_deformation, mu, lambda);
-  psi += arm_energy_density(history.maxwell_stress_pa, arm_fraction, mu, lambda);
+  psi += maxwell_arm_energy_density(history.maxwell_stress_pa, arm_fraction, mu, lambda);
   if (model.effects.fibres)
     for (const auto& family : model.fibre_direction)
       psi += hgo::energy_density(F, family[e], model.fibre_parameters[e]);
@@ -86,21 +76,6 @@ double tissue_energy_j(const SimModel& model, const SimState& state) {
   }
   if (averaged_pressure) energy += nodal_lambda_energy_j(model, state.position_m);
   return energy;
-}
-
-double viscous_dissipation_rate_w(const SimModel& model, const SimState& state) {
-  if (!model.effects.viscous) return 0.0;
-  double rate = 0.0;
-  for (std::size_t e = 0; e < model.tet_count; ++e) {
-    if (!is_viscous(model, e)) continue;
-    const auto& law =
-        model.viscous_parameters[static_cast<std::size_t>(model.region[e])]->viscoelastic;
-    const double arm_fraction = law.e1_pa / law.instantaneous_modulus_pa();
-    rate += model.rest_volume_m3[e] * 2.0 / law.relaxation_time_s() *
-            arm_energy_density(state.viscous_state[e].maxwell_stress_pa, arm_fraction,
-                               model.shear_modulus_pa[e], model.lame_lambda_pa[e]);
-  }
-  return rate;
 }
 
 double spring_energy_j(std::span<const NodeSpring> springs, const NodeArray& position) {

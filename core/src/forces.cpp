@@ -1,6 +1,5 @@
 #include "liversim/core/forces.h"
 
-#include "liversim/core/energy.h"
 #include "liversim/core/state.h"
 
 #include <Eigen/Dense>
@@ -44,6 +43,7 @@ struct ViscousContext {
   std::vector<ViscousTissueState>* state;
   const std::vector<std::optional<ViscousTissueStep>>* step_by_region;
   const ViscousArmInputs* arm = nullptr;  // set: the arm is carried by the integrator
+  double* dissipated_j = nullptr;         // committing: the dashpots' work of the step is added
 };
 
 bool in_viscous_region(const SimModel& model, std::size_t e) {
@@ -66,7 +66,13 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
                                         arm.q_known[e], arm.keep_by_region[r],
                                         arm.elastic_weight_by_region[r], arm.elastic_stress[e]);
     } else {
-      P = viscous_tissue_update(F, **step, (*viscous.state)[e]);
+      // The history committed here spans the step: book its dashpots' work (trapezoid of 2ψ/τ).
+      const ViscousTissueStep& s = **step;
+      ViscousTissueState& history = (*viscous.state)[e];
+      const double before = maxwell_arm_energy_density(history.maxwell_stress_pa, s);
+      P = viscous_tissue_update(F, s, history);
+      *viscous.dissipated_j += model.rest_volume_m3[e] * s.dt_s / s.relaxation_time_s *
+                               (before + maxwell_arm_energy_density(history.maxwell_stress_pa, s));
     }
   } else if (kAveragedPressure && !in_viscous_region(model, e))
     // A viscous region's law works with its element's own volume ratio, so its instantaneous
@@ -110,10 +116,9 @@ void average_nodal_volume_ratios(const SimModel& model, const NodeArray& positio
       volume += model.rest_volume_m3[e];
       lambda_volume += model.rest_volume_m3[e] * model.lame_lambda_pa[e];
     }
-    const double averaged = volume > 0.0 ? weighted / volume : 1.0;
-    scratch.nodal_volume_ratio[n] = averaged;
     scratch.nodal_lambda_pressure_pa[n] =
-        volume > 0.0 ? neo_hookean::lambda_pressure(averaged, lambda_volume / volume) : 0.0;
+        volume > 0.0 ? neo_hookean::lambda_pressure(weighted / volume, lambda_volume / volume)
+                     : 0.0;
   }
 }
 
@@ -242,13 +247,10 @@ ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state
   for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
     if (model.viscous_parameters[r])
       state.viscous_step[r].emplace(*model.viscous_parameters[r], dt_since_last_s);
-  const double rate_before_w = viscous_dissipation_rate_w(model, state);
   const ElasticEvaluation seen = element_forces_for_effects<true>(
-      model, state.position_m, state.force_scratch, {&state.viscous_state, &state.viscous_step});
+      model, state.position_m, state.force_scratch,
+      {&state.viscous_state, &state.viscous_step, nullptr, &state.energy.viscous_dissipated_j});
   gather_corner_forces(model, state.force_scratch, state.force_n);
-  // The history just committed spans the last step: book its dashpots' work (trapezoid).
-  state.energy.viscous_dissipated_j +=
-      0.5 * dt_since_last_s * (rate_before_w + viscous_dissipation_rate_w(model, state));
   return seen;
 }
 

@@ -384,12 +384,13 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
     if (model.viscous_parameters[r])
       state.viscous_step[r] =
           ViscousTissueStep::plastic_flow_only(*model.viscous_parameters[r], dt_s);
-  const double rate_before_w = viscous_dissipation_rate_w(model, state);
+  double dissipated_j = 0.0;  // the dashpots' work over the step (trapezoid of 2ψ_arm/τ)
   for (std::size_t e = 0; e < model.tet_count; ++e) {
     const auto r = static_cast<std::size_t>(model.region[e]);
     if (!model.viscous_parameters[r]) continue;
     const ViscousTissueStep& step = *state.viscous_step[r];
     ViscousTissueState& committed = state.viscous_state[e];
+    const double arm_before = maxwell_arm_energy_density(committed.maxwell_stress_pa, step);
     const Eigen::Matrix3d F = deformation_gradient(model, position, e);
     Voigt6 elastic;
     viscoelastic_stress_rate_form(F, step, committed.inverse_plastic_deformation, arm[e], 1.0, 0.0,
@@ -401,9 +402,10 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
     // Plastic flow after the step, the arm's Q held (g = h = 1): first order in the flow, exact
     // under a held stress as the seed's Eq. 4.
     if (step.viscoplastic) viscous_tissue_update(F, step, committed);
+    dissipated_j += model.rest_volume_m3[e] / step.relaxation_time_s *
+                    (arm_before + maxwell_arm_energy_density(committed.maxwell_stress_pa, step));
   }
-  state.energy.viscous_dissipated_j +=
-      0.5 * dt_s * (rate_before_w + viscous_dissipation_rate_w(model, state));
+  state.energy.viscous_dissipated_j += dt_s * dissipated_j;
 }
 
 }  // namespace detail

@@ -109,17 +109,6 @@ Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, double mu, 
   return tangent;
 }
 
-namespace {
-
-// p_λ(J) = λ ln J / J, the λ part of U'(J), continued linearly below kMinVolumeRatio.
-double lambda_pressure_term(double J, double lambda) {
-  if (J >= kMinVolumeRatio) return lambda * std::log(J) / J;
-  const double j0 = kMinVolumeRatio, log_j0 = std::log(j0);
-  return lambda * log_j0 / j0 + lambda * (1.0 - log_j0) / (j0 * j0) * (J - j0);
-}
-
-}  // namespace
-
 double lambda_energy_density(double J, double lambda) {
   const double j0 = kMinVolumeRatio, log_j0 = std::log(j0);
   if (J >= j0) return 0.5 * lambda * std::log(J) * std::log(J);
@@ -129,22 +118,18 @@ double lambda_energy_density(double J, double lambda) {
 }
 
 double lambda_pressure(double J, double lambda) {
-  return lambda_pressure_term(J, lambda);
+  if (J >= kMinVolumeRatio) return lambda * std::log(J) / J;
+  const double j0 = kMinVolumeRatio, log_j0 = std::log(j0);
+  return lambda * log_j0 / j0 + lambda * (1.0 - log_j0) / (j0 * j0) * (J - j0);
 }
 
 Eigen::Matrix3d first_piola_stress_given_lambda_pressure(const Eigen::Matrix3d& F, double mu,
                                                          double lambda, double lambda_pressure_pa) {
   const Eigen::Matrix3d cof = cofactor(F);
   const double J = F.col(0).dot(cof.col(0));
-  const double pressure_term = volumetric_pressure_term(J, mu, lambda) -
-                               lambda_pressure_term(J, lambda) + lambda_pressure_pa;
+  const double pressure_term =
+      volumetric_pressure_term(J, mu, lambda) - lambda_pressure(J, lambda) + lambda_pressure_pa;
   return mu * F + pressure_term * cof;
-}
-
-Eigen::Matrix3d first_piola_stress_averaged_pressure(const Eigen::Matrix3d& F, double mu,
-                                                     double lambda, double averaged_volume_ratio) {
-  return first_piola_stress_given_lambda_pressure(
-      F, mu, lambda, lambda_pressure_term(averaged_volume_ratio, lambda));
 }
 
 double volumetric_stiffening(double J, double mu, double lambda) {

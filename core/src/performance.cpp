@@ -54,7 +54,7 @@ std::size_t state_bytes(const SimState& s) {
   const ForceScratch& f = s.force_scratch;
   const IntegratorScratch& i = s.integrator;
   return bytes(s.position_m) + bytes(s.velocity_m_per_s) + bytes(s.force_n) +
-         bytes(f.corner_force_n) + bytes(f.element_volume_ratio) + bytes(f.nodal_volume_ratio) +
+         bytes(f.corner_force_n) + bytes(f.element_volume_ratio) +
          bytes(f.nodal_lambda_pressure_pa) + bytes(s.spring_damping_per_s) +
          bytes(s.viscous_state) + bytes(s.viscous_step) + bytes(i.start_position_m) +
          bytes(i.start_velocity_m_per_s) + bytes(i.stage_position_m) +

@@ -9,7 +9,6 @@ ForceScratch make_force_scratch(const SimModel& model) {
   for (auto& corner : scratch.corner_force_n) corner.resize(model.tet_count);
   if (model.effects.average_nodal_pressure) {
     scratch.element_volume_ratio.resize(model.tet_count);
-    scratch.nodal_volume_ratio.resize(model.node_count);
     scratch.nodal_lambda_pressure_pa.resize(model.node_count);
   }
   return scratch;

@@ -69,6 +69,16 @@ Eigen::Matrix3d elastic_pk2(const Eigen::Matrix3d& fe, const Eigen::Matrix3d& fe
 
 }  // namespace
 
+double maxwell_arm_energy_density(const std::array<double, 6>& h, double arm_fraction, double mu,
+                                  double lambda) {
+  // C⁻¹ = (I − λ/(2μ + 3λ)·1⊗1)/(2μ); H in Voigt order (xx, yy, zz, yz, xz, xy).
+  const double trace = h[0] + h[1] + h[2];
+  const double contraction =
+      h[0] * h[0] + h[1] * h[1] + h[2] * h[2] + 2.0 * (h[3] * h[3] + h[4] * h[4] + h[5] * h[5]);
+  return arm_fraction / (4.0 * mu) *
+         (contraction - lambda / (2.0 * mu + 3.0 * lambda) * trace * trace);
+}
+
 std::optional<std::string> validate(const ViscoelasticParameters& p) {
   if (!positive(p.e1_pa)) return out_of_range("E1 (Pa)", p.e1_pa, "a finite value > 0");
   if (!positive(p.e2_pa)) return out_of_range("E2 (Pa)", p.e2_pa, "a finite value > 0");
@@ -108,7 +118,8 @@ ViscousTissueStep::ViscousTissueStep(const ViscousTissueParameters& parameters, 
   arm_fraction = ve.e1_pa / ve.instantaneous_modulus_pa();
   // Exact for an elastic stress linear in time over the step; g, h ∈ (0, 1] for every Δt, so
   // the update cannot amplify the arm's stress however long the step.
-  const double x = dt / ve.relaxation_time_s();
+  relaxation_time_s = ve.relaxation_time_s();
+  const double x = dt / relaxation_time_s;
   arm_decay = std::exp(-x);
   arm_loading = x > 0.0 ? -std::expm1(-x) / x : 1.0;
   step_shear_modulus_pa = (relaxed_fraction + arm_fraction * arm_loading) * mu_instant_pa;

@@ -23,8 +23,9 @@ struct EnergyLedger {
   double initial_j = 0.0;        // held energy when the books were opened (0 at rest)
   double tool_work_j = 0.0;      // work done on the liver by loads and tools since
   double spring_energy_j = 0.0;  // in the tool springs at the end of the last advance
-  // Dissipated by the Maxwell arms' dashpots since: each step adds the trapezoid of their rate
-  // (viscous_dissipation_rate_w) at its start and end.
+  // Dissipated by the Maxwell arms' dashpots since: each committed step adds the trapezoid of
+  // their rate 2ψ_arm/τ (maxwell_arm_energy_density) at its start and end, booked by the loop
+  // that commits the history (no pass of its own).
   double viscous_dissipated_j = 0.0;
 };
 
@@ -54,11 +55,6 @@ struct EnergyBalance {
 // nothing; one pass over the elements.
 double tissue_energy_j(const SimModel& model, const SimState& state);
 double spring_energy_j(std::span<const NodeSpring> springs, const NodeArray& position);
-
-// Power dissipated by the Maxwell arms' dashpots, Σ V·2ψ_arm/τ over viscous elements (the arm's
-// stress g1·H relaxes through η1 = τ·E1: exact at small strain, as the arm's energy above). Reads
-// the committed history; allocates nothing; 0 without viscous regions.
-double viscous_dissipation_rate_w(const SimModel& model, const SimState& state);
 
 EnergyBalance energy_balance(const SimModel& model, const SimState& state,
                              const StepInputs& inputs);

@@ -45,13 +45,7 @@ double energy_density(const Eigen::Matrix3d& F, double mu, double lambda);
 // First Piola–Kirchhoff stress P = ∂Ψ/∂F in Pa.
 Eigen::Matrix3d first_piola_stress(const Eigen::Matrix3d& F, double mu, double lambda);
 
-// The same stress with the λ part of the pressure, λ ln J / J, taken at an averaged volume ratio
-// (average nodal pressure) instead of the element's J: P = μF + (U'(J) − p_λ(J) + p_λ(J_avg)) cof
-// F. Equal to first_piola_stress when J_avg = J; p_λ is Taylor-continued below kMinVolumeRatio too.
-Eigen::Matrix3d first_piola_stress_averaged_pressure(const Eigen::Matrix3d& F, double mu,
-                                                     double lambda, double averaged_volume_ratio);
-
-// The same stress with the λ part of the pressure replaced by a given one:
+// The same stress with the λ part of the pressure, p_λ(J) = λ ln J / J, replaced by a given one:
 // P = μF + (U'(J) − p_λ(J) + lambda_pressure_pa) cof F. Average nodal pressure passes the mean of
 // the element's corners' nodal p_λ, which makes its forces the gradient of its nodal energy.
 Eigen::Matrix3d first_piola_stress_given_lambda_pressure(const Eigen::Matrix3d& F, double mu,

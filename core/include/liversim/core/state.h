@@ -17,7 +17,6 @@ namespace liversim {
 struct ForceScratch {
   std::array<NodeArray, 4> corner_force_n;       // per element corner, before the gather
   std::vector<double> element_volume_ratio;      // J per element (average nodal pressure only)
-  std::vector<double> nodal_volume_ratio;        // volume-weighted mean J per node (likewise)
   std::vector<double> nodal_lambda_pressure_pa;  // p_λ at that J with the node's mean λ (likewise)
 };
 ForceScratch make_force_scratch(const SimModel& model);

@@ -61,7 +61,8 @@ struct ViscousTissueStep {
   ViscousTissueStep(const ViscousTissueParameters& parameters, double dt_s);
 
   double dt_s;
-  double mu_instant_pa;  // Lamé parameters of the instantaneous modulus E1 + E2
+  double relaxation_time_s;  // τ = η1/E1
+  double mu_instant_pa;      // Lamé parameters of the instantaneous modulus E1 + E2
   double lambda_instant_pa;
   double relaxed_fraction;       // g0 = E2/(E1 + E2)
   double arm_fraction;           // g1 = E1/(E1 + E2)
@@ -79,6 +80,19 @@ struct ViscousTissueStep {
 
 // Symmetric tensor in Voigt order (xx, yy, zz, yz, xz, xy).
 using Voigt6 = std::array<double, 6>;
+
+// Energy density (J/m³) held by the Maxwell arm's spring with arm variable H (its stress is
+// g1·H): ½·g1·H : C⁻¹ : H, C the instantaneous isotropic stiffness (Lamé μ, λ). Exact at small
+// strain, as the seed's 1-D model; the finite-strain arm has no closed-form potential. The
+// dashpot dissipates 2/τ of it per second.
+double maxwell_arm_energy_density(const std::array<double, 6>& h, double arm_fraction, double mu,
+                                  double lambda);
+// The same with a step's material constants.
+inline double maxwell_arm_energy_density(const std::array<double, 6>& h,
+                                         const ViscousTissueStep& step) {
+  return maxwell_arm_energy_density(h, step.arm_fraction, step.mu_instant_pa,
+                                    step.lambda_instant_pa);
+}
 
 // History of one element, committed once per step. Its tensors live in the intermediate
 // configuration of F = Fe·Fp (unloaded, plastically deformed), so a rigid rotation of the
