@@ -36,7 +36,8 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
     : QMainWindow(parent), setup_(std::move(setup)) {
   setWindowTitle(tr("LiverSim — %1").arg(QString::fromStdString(setup_.description)));
   auto model = std::make_shared<const SimModel>(build_model(setup_.mesh, setup_.model_options));
-  simulation_ = std::make_unique<RealtimeSimulation>(model, make_rest_state(*model));
+  simulation_ =
+      std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
   scene_ = std::make_unique<LiverScene>(setup_.mesh, setup_.visual);
 
   viewport_ = new VtkViewport(this);
@@ -129,7 +130,7 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   // its own history (a multistep scheme its first step, an adaptive one its step size).
   simulation_->stop();
   const SimState& old = simulation_->state();
-  SimState state = make_rest_state(*model);
+  SimState state = make_rest_state(*model, shared_worker_pool());
   state.position_m = old.position_m;
   state.velocity_m_per_s = old.velocity_m_per_s;
   state.max_speed_m_per_s = old.max_speed_m_per_s;  // the node-travel limit of the first step

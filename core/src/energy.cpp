@@ -36,19 +36,18 @@ bool is_viscous(const SimModel& model, std::size_t e) {
 // The forces are this potential's exact gradient (forces.cpp). Each element's J is recomputed
 // once per corner rather than stored, so nothing is allocated.
 double nodal_lambda_energy_j(const SimModel& model, const NodeArray& position) {
-  const std::size_t tets = model.tet_count;
   double energy = 0.0;
   for (std::size_t n = 0; n < model.node_count; ++n) {
     double weighted = 0.0, volume = 0.0;
     for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
-      const std::size_t e = static_cast<std::size_t>(model.node_slots[s]) % tets;
+      const auto e = static_cast<std::size_t>(model.node_slot_element[s]);
       if (is_viscous(model, e)) continue;
       weighted += model.rest_volume_m3[e] * deformation_gradient(model, position, e).determinant();
       volume += model.rest_volume_m3[e];
     }
     const double averaged = volume > 0.0 ? weighted / volume : 1.0;
     for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
-      const std::size_t e = static_cast<std::size_t>(model.node_slots[s]) % tets;
+      const auto e = static_cast<std::size_t>(model.node_slot_element[s]);
       if (is_viscous(model, e)) continue;
       energy += 0.25 * model.rest_volume_m3[e] *
                 neo_hookean::lambda_energy_density(averaged, model.lame_lambda_pa[e]);

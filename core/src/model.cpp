@@ -21,10 +21,14 @@ void build_incidence(SimModel& model) {
   for (std::size_t n = 0; n < model.node_count; ++n)
     model.node_slot_begin[n + 1] += model.node_slot_begin[n];
   model.node_slots.resize(4 * tets);
+  model.node_slot_element.resize(4 * tets);
   std::vector<std::int32_t> fill(model.node_slot_begin.begin(), model.node_slot_begin.end() - 1);
   for (int c = 0; c < 4; ++c)
-    for (std::size_t e = 0; e < tets; ++e)
-      model.node_slots[fill[model.corner[c][e]]++] = static_cast<std::int32_t>(c * tets + e);
+    for (std::size_t e = 0; e < tets; ++e) {
+      const std::int32_t s = fill[model.corner[c][e]]++;
+      model.node_slots[s] = static_cast<std::int32_t>(c * tets + e);
+      model.node_slot_element[s] = static_cast<std::int32_t>(e);
+    }
 }
 
 }  // namespace

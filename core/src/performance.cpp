@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <thread>
+#include <vector>
 
 namespace liversim {
 namespace {
@@ -47,7 +49,7 @@ std::size_t model_bytes(const SimModel& m) {
          bytes(m.region) + bytes(m.regions) + bytes(m.fibre_parameters) + bytes(m.fibre_direction) +
          bytes(m.viscous_parameters) + bytes(m.rest_position_m) + bytes(m.lumped_mass_kg) +
          bytes(m.inverse_mass_per_kg) + bytes(m.is_fixed) + bytes(m.node_slot_begin) +
-         bytes(m.node_slots);
+         bytes(m.node_slots) + bytes(m.node_slot_element);
 }
 
 std::size_t state_bytes(const SimState& s) {
@@ -55,7 +57,8 @@ std::size_t state_bytes(const SimState& s) {
   const IntegratorScratch& i = s.integrator;
   return bytes(s.position_m) + bytes(s.velocity_m_per_s) + bytes(s.force_n) +
          bytes(f.corner_force_n) + bytes(f.element_volume_ratio) +
-         bytes(f.nodal_lambda_pressure_pa) + bytes(s.spring_damping_per_s) +
+         bytes(f.nodal_lambda_pressure_pa) + bytes(f.chunk_seen) + bytes(f.chunk_dissipated_j) +
+         bytes(f.region_constants) + bytes(f.needs_general) + bytes(s.spring_damping_per_s) +
          bytes(s.viscous_state) + bytes(s.viscous_step) + bytes(i.start_position_m) +
          bytes(i.start_velocity_m_per_s) + bytes(i.stage_position_m) +
          bytes(i.stage_velocity_m_per_s) + bytes(i.position_rate) + bytes(i.velocity_rate) +
@@ -68,15 +71,16 @@ std::size_t state_bytes(const SimState& s) {
 }
 
 ForceEvaluationTiming time_force_evaluations(const SimModel& model, SimState& state, double step_s,
-                                             double min_wall_s, int repetitions) {
-  compute_internal_forces(model, state, step_s);  // warm-up: caches, first-touch pages
+                                             double min_wall_s, int repetitions,
+                                             InternalForcesFunction compute) {
+  compute(model, state, step_s);  // warm-up: caches, first-touch pages
   ForceEvaluationTiming best;
   best.ns_per_tet = std::numeric_limits<double>::infinity();
   for (int r = 0; r < std::max(1, repetitions); ++r) {
     ForceEvaluationTiming run;
     const Clock::time_point start = Clock::now();
     do {
-      compute_internal_forces(model, state, step_s);
+      compute(model, state, step_s);
       ++run.evaluations;
       run.wall_s = seconds_since(start);
     } while (run.wall_s < min_wall_s);
@@ -85,6 +89,65 @@ ForceEvaluationTiming time_force_evaluations(const SimModel& model, SimState& st
     if (run.ns_per_tet < best.ns_per_tet) best = run;
   }
   return best;
+}
+
+BuildComparison compare_force_builds(const SimModel& model, const SimState& state,
+                                     InternalForcesFunction other, double step_s, double min_wall_s,
+                                     int rounds) {
+  BuildComparison best{std::numeric_limits<double>::infinity(),
+                       std::numeric_limits<double>::infinity()};
+  for (int r = 0; r < std::max(1, rounds); ++r) {
+    SimState a = state, b = state;
+    best.normal_ns_per_tet = std::min(
+        best.normal_ns_per_tet, time_force_evaluations(model, a, step_s, min_wall_s, 1).ns_per_tet);
+    best.other_ns_per_tet =
+        std::min(best.other_ns_per_tet,
+                 time_force_evaluations(model, b, step_s, min_wall_s, 1, other).ns_per_tet);
+  }
+  return best;
+}
+
+namespace {
+
+// 16 independent multiply-add chains: enough in flight that the floating-point units' throughput,
+// not the latency of one chain, bounds them (as in the element loops).
+double multiply_add_chains(long iterations) {
+  double chain[16];
+  for (int k = 0; k < 16; ++k) chain[k] = 0.01 * k;
+  for (long i = 0; i < iterations; ++i)
+    for (double& c : chain) c = c * 0.999999 + 1e-7;
+  double sum = 0.0;
+  for (double c : chain) sum += c;
+  return sum;
+}
+
+double time_chains(int threads, long iterations_per_thread) {
+  std::vector<std::thread> workers;
+  std::vector<double> results(static_cast<std::size_t>(threads));
+  const Clock::time_point start = Clock::now();
+  for (int t = 1; t < threads; ++t)
+    workers.emplace_back([&, t] { results[t] = multiply_add_chains(iterations_per_thread); });
+  results[0] = multiply_add_chains(iterations_per_thread);
+  for (std::thread& worker : workers) worker.join();
+  const double wall_s = seconds_since(start);
+  volatile double sink = results[0];  // keep the work
+  (void)sink;
+  return wall_s;
+}
+
+}  // namespace
+
+ParallelCeiling measure_parallel_ceiling(int threads, int repetitions) {
+  constexpr long kIterations = 20'000'000;  // ~0.2 s on one thread
+  ParallelCeiling ceiling;
+  ceiling.threads = std::max(1, threads);
+  ceiling.one_thread_s = ceiling.all_threads_s = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < std::max(1, repetitions); ++r) {
+    ceiling.one_thread_s = std::min(ceiling.one_thread_s, time_chains(1, kIterations));
+    ceiling.all_threads_s = std::min(ceiling.all_threads_s,
+                                     time_chains(ceiling.threads, kIterations / ceiling.threads));
+  }
+  return ceiling;
 }
 
 SteppingTiming time_stepping(const SimModel& model, SimState& state, const StepInputs& inputs,

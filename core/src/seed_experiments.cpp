@@ -273,7 +273,7 @@ TimingCase run_timing_case(const TetMesh& mesh, const SimModel& model,
   timing.node_count = model.node_count;
   timing.stable_step_at_rest_s = model.stable_time_step_s;
   timing.frames = interval_count(settings.simulated_s, settings.frame_s);
-  SimState state = make_rest_state(model);
+  SimState state = make_rest_state(model, settings.workers);
   const auto wall_start = Clock::now();
   for (int frame = 0; frame < timing.frames; ++frame)
     accumulate(timing.steps, advance(model, state, inputs, settings.frame_s));

@@ -6,7 +6,14 @@ namespace liversim {
 
 ForceScratch make_force_scratch(const SimModel& model) {
   ForceScratch scratch;
-  for (auto& corner : scratch.corner_force_n) corner.resize(model.tet_count);
+  scratch.corner_force_n.resize(4 * model.tet_count);
+  const std::size_t chunks = (model.tet_count + kElementsPerChunk - 1) / kElementsPerChunk;
+  scratch.chunk_seen.resize(chunks);
+  scratch.chunk_dissipated_j.resize(chunks);
+  if (model.effects.viscous) {
+    scratch.region_constants.resize(10 * model.viscous_parameters.size());
+    scratch.needs_general.resize(model.tet_count);
+  }
   if (model.effects.average_nodal_pressure) {
     scratch.element_volume_ratio.resize(model.tet_count);
     scratch.nodal_lambda_pressure_pa.resize(model.node_count);
@@ -14,12 +21,13 @@ ForceScratch make_force_scratch(const SimModel& model) {
   return scratch;
 }
 
-SimState make_rest_state(const SimModel& model) {
+SimState make_rest_state(const SimModel& model, std::shared_ptr<WorkerPool> workers) {
   SimState state;
   state.position_m = model.rest_position_m;
   state.velocity_m_per_s.resize(model.node_count);
   state.force_n.resize(model.node_count);
   state.force_scratch = make_force_scratch(model);
+  state.force_scratch.workers = std::move(workers);
   state.spring_damping_per_s.assign(model.node_count, 0.0);
   if (model.effects.viscous) {
     state.viscous_state.resize(model.tet_count);

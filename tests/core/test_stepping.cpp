@@ -47,12 +47,13 @@ struct SteppingFixture : ::testing::Test {
   }
   static TetMesh* mesh_;
   static std::shared_ptr<const SimModel> model_;
+  std::shared_ptr<WorkerPool> workers_ = make_worker_pool(2);
 };
 TetMesh* SteppingFixture::mesh_ = nullptr;
 std::shared_ptr<const SimModel> SteppingFixture::model_;
 
 TEST_F(SteppingFixture, AdvanceAllocatesNothing) {
-  SimState state = make_rest_state(*model_);
+  SimState state = make_rest_state(*model_, workers_);
   const BoundarySurface surface = extract_surface(*mesh_);
   const Eigen::Vector3d point = mesh_->rest_position_m.at(surface.nodes[10]);
   const Grab grab =
@@ -81,7 +82,8 @@ TEST_F(SteppingFixture, EveryIntegratorAdvancesWithoutAllocating) {
     options.integrator.kind = kind;
     options.integrator.step_s = is_explicit(kind) ? 0.0 : 0.002;
     const SimModel model = build_model(*mesh_, options);
-    SimState state = make_rest_state(model);
+    // On two threads: the workers claim their chunks without allocating either.
+    SimState state = make_rest_state(model, workers_);
     const std::vector<PointLoad> loads{{anterior_marked_node(*mesh_), {0.0, 0.05, 0.0}}};
     const StepInputs inputs{loads, {}};
     advance(model, state, inputs, 0.004);  // warm-up
@@ -100,7 +102,7 @@ TEST_F(SteppingFixture, EveryIntegratorAdvancesWithoutAllocating) {
 }
 
 TEST_F(SteppingFixture, RealtimeLoopFollowsTheDragAndAllocatesNothingWhileRunning) {
-  RealtimeSimulation simulation(model_, make_rest_state(*model_));
+  RealtimeSimulation simulation(model_, make_rest_state(*model_, workers_));
   const BoundarySurface surface = extract_surface(*mesh_);
   const NodeIndex node = anterior_marked_node(*mesh_);
   ASSERT_FALSE(model_->is_fixed[node]);

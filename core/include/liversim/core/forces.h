@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include <span>
+#include <string_view>
 
 namespace liversim {
 
@@ -29,15 +30,6 @@ struct StepInputs {
   std::span<const NodeSpring> springs;
 };
 
-// What a force evaluation saw that bears on the stable explicit step: the extremes of the element
-// volume ratio J = det F (compression stiffens the volumetric response) and the largest fibre
-// tangent stiffness (stretched fibres stiffen exponentially).
-struct ElasticEvaluation {
-  double min_volume_ratio = 1.0;
-  double max_volume_ratio = 1.0;
-  double max_fibre_modulus_pa = 0.0;
-};
-
 // Writes the elastic (internal) nodal forces at `position` into `force`, using `corner_scratch`
 // for per-element values. The element kernel is the one for the model's effect set. Allocates
 // nothing.
@@ -49,6 +41,13 @@ ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray&
 // and commit it; without viscous regions this is compute_elastic_forces. Allocates nothing.
 ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state,
                                           double dt_since_last_s);
+
+// compute_internal_forces' type, for benchmarks that time another build of it (forces_variants.h).
+using InternalForcesFunction = ElasticEvaluation (*)(const SimModel&, SimState&, double);
+
+// The instruction set of the vectorised element loops this process runs ("avx2+fma" or
+// "generic"), chosen once from the processor.
+std::string_view element_kernel_instruction_set();
 
 // The Maxwell arm of viscous elements as carried by an integrator (viscoelastic_stress_rate_form):
 // Q at the evaluation is keep·q_known + elastic_weight·S_e, the weights per region.

@@ -109,6 +109,7 @@ struct SimModel {
   // names corner s / tet_count of element s % tet_count.
   std::vector<std::int32_t> node_slot_begin;  // size node_count + 1
   std::vector<std::int32_t> node_slots;
+  std::vector<std::int32_t> node_slot_element;  // the element of each entry of node_slots
   double mass_damping_per_s = 0.0;
   // Largest eigenfrequency of M⁻¹K at rest (free nodes), from power iteration, and the explicit
   // step used: safety · 2/ω_max (reduced for damping).

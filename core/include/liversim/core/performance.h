@@ -3,6 +3,7 @@
 // the time of one internal-force evaluation, the rate of whole steps, and the memory a model and
 // its state hold. Timing is wall-clock on the calling thread; tests never assert it.
 
+#include "liversim/core/forces.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/state.h"
 
@@ -24,8 +25,31 @@ struct ForceEvaluationTiming {
 // Evaluates the internal forces at the state's positions (viscous regions advancing their history
 // by step_s each time, as a central-difference step does) for at least min_wall_s, after one
 // warm-up evaluation; the best of `repetitions` such runs (the least disturbed).
-ForceEvaluationTiming time_force_evaluations(const SimModel& model, SimState& state, double step_s,
-                                             double min_wall_s, int repetitions = 3);
+// `compute` is the build timed (another one: forces_variants.h).
+ForceEvaluationTiming time_force_evaluations(
+    const SimModel& model, SimState& state, double step_s, double min_wall_s, int repetitions = 3,
+    InternalForcesFunction compute = &compute_internal_forces);
+
+// The normal build against another build of the force loops on the same model and state.
+struct BuildComparison {
+  double normal_ns_per_tet = 0.0, other_ns_per_tet = 0.0;
+  double relative_difference() const { return normal_ns_per_tet / other_ns_per_tet - 1.0; }
+};
+// Alternates runs of the two builds `rounds` times, each on a copy of `state`, and keeps each
+// build's best: a drift of the machine's speed touches both alike.
+BuildComparison compare_force_builds(const SimModel& model, const SimState& state,
+                                     InternalForcesFunction other, double step_s, double min_wall_s,
+                                     int rounds);
+
+// What this machine itself allows on several threads: the same independent multiply-add chains
+// (no memory traffic, nothing shared) on one thread and then split over `threads` threads.
+struct ParallelCeiling {
+  int threads = 1;
+  double one_thread_s = 0.0, all_threads_s = 0.0;
+  double speedup() const { return all_threads_s > 0.0 ? one_thread_s / all_threads_s : 0.0; }
+};
+// Best of `repetitions` of each.
+ParallelCeiling measure_parallel_ceiling(int threads, int repetitions);
 
 struct SteppingTiming {
   double simulated_s = 0.0;

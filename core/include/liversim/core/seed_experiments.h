@@ -151,6 +151,7 @@ struct TimingSettings {
   double simulated_s = 1.0;  // deformation time = wall time to simulate this much
   double load_radius_m = 0.02;
   Eigen::Vector3d direction = kSeedPullDirection;
+  std::shared_ptr<WorkerPool> workers;  // threads of the force loops (null: the calling thread)
 };
 
 struct TimingCase {

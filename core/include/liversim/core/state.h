@@ -4,6 +4,7 @@
 #include "liversim/core/energy.h"
 #include "liversim/core/model.h"
 #include "liversim/core/viscous_tissue.h"
+#include "liversim/core/worker_pool.h"
 
 #include <array>
 #include <cstdint>
@@ -13,12 +14,36 @@
 
 namespace liversim {
 
+// What a force evaluation saw that bears on the stable explicit step: the extremes of the element
+// volume ratio J = det F (compression stiffens the volumetric response) and the largest fibre
+// tangent stiffness (stretched fibres stiffen exponentially).
+struct ElasticEvaluation {
+  double min_volume_ratio = 1.0;
+  double max_volume_ratio = 1.0;
+  double max_fibre_modulus_pa = 0.0;
+};
+
 // Scratch of one force evaluation, sized once for a model.
 struct ForceScratch {
-  std::array<NodeArray, 4> corner_force_n;       // per element corner, before the gather
+  // Per element corner before the gather: corner c of element e at c·tet_count + e (a slot, as in
+  // SimModel::node_slots).
+  NodeArray corner_force_n;
   std::vector<double> element_volume_ratio;      // J per element (average nodal pressure only)
   std::vector<double> nodal_lambda_pressure_pa;  // p_λ at that J with the node's mean λ (likewise)
+  // Element loops run in fixed chunks of kElementsPerChunk, whatever the thread count, and their
+  // results are combined in chunk order, so one thread and two give the same numbers.
+  std::vector<ElasticEvaluation> chunk_seen;
+  std::vector<double> chunk_dissipated_j;
+  // Viscous models: the step's constants per region for the vectorised loop (kRegionConstants
+  // per region), and the elements it leaves to the general update (yield, collapse).
+  std::vector<double> region_constants;
+  std::vector<std::uint8_t> needs_general;
+  // Threads of the loops; null: the calling thread alone. Copies of a state share it (a pool runs
+  // one job at a time; a second caller meanwhile runs on its own thread).
+  std::shared_ptr<WorkerPool> workers;
 };
+inline constexpr std::size_t kElementsPerChunk = 256;
+inline constexpr std::size_t kNodesPerChunk = 512;
 ForceScratch make_force_scratch(const SimModel& model);
 
 class ImplicitSolver;  // sparse tangent and factorisation of the implicit schemes (integrator.cpp)
@@ -98,7 +123,8 @@ struct SimState {
   std::uint64_t step_count = 0;
 };
 
-// A state at rest in the reference configuration, with all scratch allocated.
-SimState make_rest_state(const SimModel& model);
+// A state at rest in the reference configuration, with all scratch allocated; its force loops run
+// on `workers` (null: on the calling thread).
+SimState make_rest_state(const SimModel& model, std::shared_ptr<WorkerPool> workers = nullptr);
 
 }  // namespace liversim
