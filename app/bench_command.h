@@ -1,5 +1,6 @@
 #pragma once
-// liversim-cli bench: the engine's speed and memory (core/performance.h), written to
+// liversim-cli bench: the engine's speed and memory (core/performance.h), the seed's Table 1 beside
+// our deformation time, and the workstation's peak resident memory, written to
 // docs/performance.md.
 
 #include <functional>

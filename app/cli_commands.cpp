@@ -79,6 +79,22 @@ IntegratorSettings integrator_settings(const std::string& name, double dt_s) {
   return settings;
 }
 
+ExperimentScene build_scene(int tet_count, const IntegratorSettings& integrator,
+                            bool viscoelastic) {
+  ExperimentScene built{default_scene(tet_count), {}, 0.0};
+  ModelOptions options = built.scene.model_options;
+  options.integrator = integrator;
+  if (viscoelastic) {
+    // material-test's assumed split of the seed's E = 3500 Pa (docs/viscous-tissue.md).
+    options.regions[0].viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
+  }
+  const auto start = std::chrono::steady_clock::now();
+  built.model = build_model(built.scene.mesh, options);
+  built.build_wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return built;
+}
+
 namespace {
 
 SceneSetup load_scene(const MeshSource& source) {
@@ -178,7 +194,7 @@ int simulate(const SimulateOptions& options) {
       if (!csv) return fail("cannot write " + options.csv_output->string());
       csv << "time_s,ux_m,uy_m,uz_m\n";
     }
-    SimState state = make_rest_state(model);
+    SimState state = make_rest_state(model, shared_worker_pool());
     const Eigen::Vector3d rest = model.rest_position_m.at(node);
     auto write_sample = [&] {
       const Eigen::Vector3d u = state.position_m.at(node) - rest;
@@ -389,7 +405,7 @@ int demo(const ScreenshotOptions& options) {
     const Eigen::Vector3d grabbed = scene.mesh.rest_position_m.at(node);
     const Grab grab = grab_surface(surface, scene.mesh.rest_position_m, model.lumped_mass_kg,
                                    grabbed, 0.02, 300.0);
-    SimState state = make_rest_state(model);
+    SimState state = make_rest_state(model, shared_worker_pool());
     std::vector<NodeSpring> springs;
     const Eigen::Vector3d pull(0.0, -0.02, 0.03);
     constexpr int kFrames = 30;

@@ -2,6 +2,7 @@
 // The headless commands of liversim-cli. Each returns the process exit code and reports problems
 // on stderr as "liversim-cli: error: ...".
 
+#include "liversim/core/default_scene.h"
 #include "liversim/core/model.h"
 
 #include <Eigen/Core>
@@ -96,6 +97,15 @@ int write_report(const std::filesystem::path& file, const std::string& text);
 IntegratorKind integrator_kind(const std::string& name);
 // The integrator settings of --integrator and --dt, checked before the (slow) model build.
 IntegratorSettings integrator_settings(const std::string& name, double dt_s);
+// The built-in liver with the given integrator (and material-test's assumed viscoelastic split of
+// the seed's E = 3500 Pa when asked), and the wall time of the model build.
+struct ExperimentScene {
+  SceneSetup scene;
+  SimModel model;
+  double build_wall_s = 0.0;
+};
+ExperimentScene build_scene(int tet_count, const IntegratorSettings& integrator,
+                            bool viscoelastic = false);
 // A short pull on the liver, released, with a screenshot of the deformed organ while pulled.
 int demo(const ScreenshotOptions& options);
 

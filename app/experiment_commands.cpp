@@ -13,7 +13,6 @@
 #endif
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -24,28 +23,6 @@
 
 namespace liversim::cli {
 namespace {
-
-struct ExperimentScene {
-  SceneSetup scene;
-  SimModel model;
-  double build_wall_s = 0.0;
-};
-
-ExperimentScene build_scene(int tet_count, const IntegratorSettings& integrator,
-                            bool viscoelastic = false) {
-  ExperimentScene built{default_scene(tet_count), {}, 0.0};
-  ModelOptions options = built.scene.model_options;
-  options.integrator = integrator;
-  if (viscoelastic) {
-    // material-test's assumed split of the seed's E = 3500 Pa (docs/viscous-tissue.md).
-    options.regions[0].viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
-  }
-  const auto start = std::chrono::steady_clock::now();
-  built.model = build_model(built.scene.mesh, options);
-  built.build_wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return built;
-}
 
 // One line on what the integrator did, in the words of StepReport.
 std::string step_summary(const SimModel& model, const StepReport& steps) {

@@ -7,15 +7,19 @@
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QMessageBox>
+#include <QTimer>
 
+#include <cmath>
 #include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <optional>
 
 namespace {
 
 struct Options {
   int tet_count = liversim::kDefaultLiverTetCount;
+  std::optional<double> quit_after_s;  // close this long after the window is shown (unattended)
 };
 
 // Parsed under a plain QCoreApplication, so --help, --version and bad options work without a
@@ -35,6 +39,13 @@ Options parse_options(int argc, char** argv) {
       "tets", QCoreApplication::translate("main", "Element count of the liver (100 to 2000000)."),
       "count", QString::number(liversim::kDefaultLiverTetCount));
   parser.addOption(tets);
+  const QCommandLineOption quit_after(
+      "quit-after",
+      QCoreApplication::translate("main",
+                                  "Close the application this many seconds after the main window "
+                                  "is shown (for unattended runs)."),
+      "seconds");
+  parser.addOption(quit_after);
   parser.process(app);
 
   Options options;
@@ -44,6 +55,17 @@ Options parse_options(int argc, char** argv) {
     std::cerr << "liversim: --tets must be a whole number from 100 to 2000000, not '"
               << parser.value(tets).toStdString() << "'\n";
     std::exit(2);
+  }
+  if (parser.isSet(quit_after)) {
+    const double seconds = parser.value(quit_after).toDouble(&ok);
+    // At most a day, so the delay fits QTimer's int milliseconds.
+    if (!ok || !std::isfinite(seconds) || seconds <= 0.0 || seconds > 86'400.0) {
+      std::cerr << "liversim: --quit-after must be a number of seconds above 0 and at most "
+                   "86400, not '"
+                << parser.value(quit_after).toStdString() << "'\n";
+      std::exit(2);
+    }
+    options.quit_after_s = seconds;
   }
   return options;
 }
@@ -73,6 +95,9 @@ int main(int argc, char** argv) {
   try {
     liversim::MainWindow window(liversim::default_scene(options.tet_count));
     window.show();
+    if (options.quit_after_s)
+      QTimer::singleShot(static_cast<int>(std::lround(*options.quit_after_s * 1e3)), &app,
+                         &QApplication::quit);
     return QApplication::exec();
   } catch (const std::exception& e) {
     QMessageBox::critical(nullptr, QApplication::translate("main", "LiverSim cannot start"),
