@@ -95,15 +95,26 @@ BuildComparison compare_force_builds(const SimModel& model, const SimState& stat
                                      InternalForcesFunction other, double step_s, double min_wall_s,
                                      int rounds) {
   BuildComparison best{std::numeric_limits<double>::infinity(),
-                       std::numeric_limits<double>::infinity()};
+                       std::numeric_limits<double>::infinity(), 0.0};
+  std::vector<double> ratios;
   for (int r = 0; r < std::max(1, rounds); ++r) {
     SimState a = state, b = state;
-    best.normal_ns_per_tet = std::min(
-        best.normal_ns_per_tet, time_force_evaluations(model, a, step_s, min_wall_s, 1).ns_per_tet);
-    best.other_ns_per_tet =
-        std::min(best.other_ns_per_tet,
-                 time_force_evaluations(model, b, step_s, min_wall_s, 1, other).ns_per_tet);
+    // Alternate which build goes first, so that neither always runs on a warmer machine.
+    const bool normal_first = r % 2 == 0;
+    double normal = 0.0, variant = 0.0;
+    for (int turn = 0; turn < 2; ++turn) {
+      if ((turn == 0) == normal_first)
+        normal = time_force_evaluations(model, a, step_s, min_wall_s, 1).ns_per_tet;
+      else
+        variant = time_force_evaluations(model, b, step_s, min_wall_s, 1, other).ns_per_tet;
+    }
+    best.normal_ns_per_tet = std::min(best.normal_ns_per_tet, normal);
+    best.other_ns_per_tet = std::min(best.other_ns_per_tet, variant);
+    ratios.push_back(normal / variant - 1.0);
   }
+  std::sort(ratios.begin(), ratios.end());
+  const std::size_t n = ratios.size();
+  best.relative_difference = n % 2 == 1 ? ratios[n / 2] : 0.5 * (ratios[n / 2 - 1] + ratios[n / 2]);
   return best;
 }
 

@@ -32,11 +32,12 @@ ForceEvaluationTiming time_force_evaluations(
 
 // The normal build against another build of the force loops on the same model and state.
 struct BuildComparison {
-  double normal_ns_per_tet = 0.0, other_ns_per_tet = 0.0;
-  double relative_difference() const { return normal_ns_per_tet / other_ns_per_tet - 1.0; }
+  double normal_ns_per_tet = 0.0, other_ns_per_tet = 0.0;  // each build's best run
+  // The median over the rounds of normal / other − 1, each round's two runs back to back: a
+  // drift of the machine's speed touches both runs of a round alike.
+  double relative_difference = 0.0;
 };
-// Alternates runs of the two builds `rounds` times, each on a copy of `state`, and keeps each
-// build's best: a drift of the machine's speed touches both alike.
+// Alternates runs of the two builds `rounds` times, each on a copy of `state`.
 BuildComparison compare_force_builds(const SimModel& model, const SimState& state,
                                      InternalForcesFunction other, double step_s, double min_wall_s,
                                      int rounds);

@@ -52,9 +52,9 @@ class WorkerPool {
   std::vector<std::thread> workers_;
   // The current job, packed as [job number: 24 bits][chunk count: 20][next chunk: 20], so that a
   // claim from a finished job can never succeed against a new one.
-  std::atomic<std::uint64_t> job_{0};
-  std::atomic<std::size_t> done_{0};          // chunks of the current job finished
-  std::atomic<std::uint32_t> generation_{0};  // bumped per job and at shutdown: wakes workers
+  alignas(64) std::atomic<std::uint64_t> job_{0};
+  alignas(64) std::atomic<std::size_t> done_{0};          // chunks of the current job finished
+  alignas(64) std::atomic<std::uint32_t> generation_{0};  // bumped per job and at shutdown: wakes workers
   std::atomic<int> sleepers_{0};              // workers asleep or about to be
   std::mutex sleep_mutex_;
   std::condition_variable wake_;
