@@ -517,8 +517,10 @@ int run_bench(const BenchOptions& o) {
        << format(ceiling.speedup(), 3) << "× faster on " << ceiling.threads
        << " threads than on one (" << fixed(ceiling.one_thread_s * 1e3) << " ms against "
        << fixed(ceiling.all_threads_s * 1e3)
-       << " ms, best of 3). The element loops fall short of that where they wait on memory: the "
-          "vectorised ones gather node positions and stream some 200 bytes per element.\n";
+       << " ms, best of 3). Both figures vary from run to run on this virtual machine; where the "
+          "element loops fall short of the ceiling, memory (the vectorised loops gather node "
+          "positions and stream some 200 bytes per element) and a worker descheduled on the last "
+          "chunk are the suspects, not yet measured apart.\n";
   md << "\n## What an effect that is off costs\n\n"
      << "The force loops are also compiled without one effect each (`forces_variants.h`: the "
         "effect's branches and kernels are not in that build at all). Each row times the same "
