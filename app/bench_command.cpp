@@ -43,7 +43,7 @@ constexpr int kSteppingRepetitions = 3;
 struct BenchOptions {
   std::vector<int> tet_counts{std::begin(kSeedMeshSizes), std::end(kSeedMeshSizes)};
   std::vector<int> stepping_tet_counts{kDefaultLiverTetCount, 10583};
-  int threads = default_engine_threads();  // the second column of the thread tables
+  int threads = 0;  // of the second column of the thread tables; 0: the engine's default
   double min_time_s = 0.3;
   std::filesystem::path output_dir = "docs";
   // The seed's Table 1 beside ours: simulated seconds per case.
@@ -308,11 +308,12 @@ std::string thread_label(int threads) {
 }
 
 int run_bench(const BenchOptions& o) {
+  const int threads = o.threads > 0 ? o.threads : default_engine_threads();
   std::filesystem::create_directories(o.output_dir);
   std::vector<int> thread_counts{1};
-  if (o.threads > 1) thread_counts.push_back(o.threads);
+  if (threads > 1) thread_counts.push_back(threads);
   std::vector<std::shared_ptr<WorkerPool>> pools;
-  for (int threads : thread_counts) pools.push_back(pool_of(threads));
+  for (int count : thread_counts) pools.push_back(pool_of(count));
 
   // ---- Force evaluations per effect set, size and thread count; memory at the largest size.
   std::vector<SceneSetup> scenes;
@@ -361,8 +362,8 @@ int run_bench(const BenchOptions& o) {
     }
     return table.str();
   };
-  const ParallelCeiling ceiling = measure_parallel_ceiling(o.threads, 3);
-  std::cout << "this machine on " << o.threads << " threads: " << format(ceiling.speedup(), 3)
+  const ParallelCeiling ceiling = measure_parallel_ceiling(threads, 3);
+  std::cout << "this machine on " << threads << " threads: " << format(ceiling.speedup(), 3)
             << "x (independent multiply-add chains)" << std::endl;
 
   // ---- What an effect that is off costs: the normal build against one without the effect.
@@ -446,7 +447,7 @@ int run_bench(const BenchOptions& o) {
   line << " --stepping-tets ";
   for (std::size_t i = 0; i < o.stepping_tet_counts.size(); ++i)
     line << (i ? "," : "") << o.stepping_tet_counts[i];
-  line << " --threads " << o.threads << " --min-time " << o.min_time_s << " --table1-seconds "
+  line << " --threads " << threads << " --min-time " << o.min_time_s << " --table1-seconds "
        << number(o.table1_simulated_s) << " --workstation-tets " << o.workstation_tets
        << " --workstation-seconds " << number(o.workstation_seconds);
   if (o.workstation) line << " --workstation " << o.workstation->string();
@@ -600,9 +601,11 @@ std::function<std::optional<int>()> add_bench_command(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::Range(100, 2'000'000))
       ->capture_default_str();
-  bench->add_option("--threads", o.threads, "Threads of the multithreaded runs (besides one)")
-      ->check(CLI::Range(1, 256))
-      ->capture_default_str();
+  bench
+      ->add_option("--threads", o.threads,
+                   "Threads of the multithreaded runs, besides one (default: the engine's, "
+                   "LIVERSIM_THREADS or the hardware's)")
+      ->check(CLI::Range(1, 256));
   bench->add_option("--min-time", o.min_time_s, "Least wall time of each measurement (s)")
       ->check(CLI::Range(1e-3, 3600.0))
       ->capture_default_str();

@@ -201,7 +201,6 @@ void average_nodal_volume_ratios(const SimModel& model, const detail::ElasticKer
   for_each_chunk(
       scratch, model.tet_count, kElementsPerChunk,
       [&](std::size_t begin, std::size_t end, std::size_t) { volume_ratio(data, begin, end); });
-  const bool any_viscous = built(model).viscous;
   for_each_chunk(
       scratch, model.node_count, kNodesPerChunk,
       [&](std::size_t begin, std::size_t end, std::size_t) {
@@ -209,7 +208,7 @@ void average_nodal_volume_ratios(const SimModel& model, const detail::ElasticKer
           double weighted = 0.0, volume = 0.0, lambda_volume = 0.0;
           for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
             const auto e = static_cast<std::size_t>(model.node_slot_element[s]);
-            if (any_viscous && in_viscous_region(model, e)) continue;
+            if (in_viscous_region(model, e)) continue;
             weighted += model.rest_volume_m3[e] * scratch.element_volume_ratio[e];
             volume += model.rest_volume_m3[e];
             lambda_volume += model.rest_volume_m3[e] * model.lame_lambda_pa[e];
@@ -223,6 +222,18 @@ void average_nodal_volume_ratios(const SimModel& model, const detail::ElasticKer
 
 ElasticEvaluation nothing_seen() {
   return {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), 0.0};
+}
+detail::ElasticKernelSeen kernel_nothing_seen() {
+  const ElasticEvaluation none = nothing_seen();
+  return {none.min_volume_ratio, none.max_volume_ratio, none.max_fibre_modulus_pa};
+}
+ElasticEvaluation evaluation_of(const detail::ElasticKernelSeen& seen) {
+  return {seen.min_volume_ratio, seen.max_volume_ratio, seen.max_fibre_modulus_pa};
+}
+
+// Fibre families present in the kernel data (kernel_data puts them first).
+int fibre_families(const detail::ElasticKernelData& data) {
+  return (data.fibre_direction[0] != nullptr) + (data.fibre_direction[1] != nullptr);
 }
 
 // One element of the general loop: its forces into the corner slots, what it saw into `seen`.
@@ -304,15 +315,16 @@ ElasticEvaluation combine_chunks(const ForceScratch& scratch, double* dissipated
   return seen;
 }
 
-// The vectorised loop takes a viscous model whose every region is viscous, committing a step.
-bool vectorised_viscous(const SimModel& model, const EffectSet& on, const ViscousContext& viscous) {
+// The plain viscous loop takes a viscous model whose every region is viscous, committing a step.
+bool plain_viscous_loop_applies(const SimModel& model, const EffectSet& on,
+                                const ViscousContext& viscous) {
   if (on.mooney_rivlin || viscous.arm != nullptr) return false;
   for (const auto& parameters : model.viscous_parameters)
     if (!parameters) return false;
   return true;
 }
 
-// The vectorised viscous loop over every element, then the general update of those it flagged.
+// The plain viscous loop over every element, then the general update of those it flagged.
 template <bool kFibres>
 ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& position,
                                  ForceScratch& scratch, const ViscousContext& viscous,
@@ -356,19 +368,15 @@ ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& positio
                                &data.step_over_relaxation_time};
   for (int k = 0; k < 10; ++k) *fields[k] = constants + k * regions;
   data.needs_general = scratch.needs_general.data();
-  const int families =
-      kFibres ? (elastic.fibre_direction[0] != nullptr) + (elastic.fibre_direction[1] != nullptr)
-              : 0;
-  const detail::ViscousKernel kernel = detail::elastic_kernels().viscous[families];
+  const detail::ViscousKernel kernel =
+      detail::elastic_kernels().viscous[kFibres ? fibre_families(elastic) : 0];
   for_each_chunk(scratch, model.tet_count, kElementsPerChunk,
                  [&](std::size_t begin, std::size_t end, std::size_t chunk) {
-                   detail::ElasticKernelSeen seen{std::numeric_limits<double>::infinity(),
-                                                  -std::numeric_limits<double>::infinity(), 0.0};
+                   detail::ElasticKernelSeen seen = kernel_nothing_seen();
                    double& dissipated = scratch.chunk_dissipated_j[chunk];
                    dissipated = 0.0;
                    kernel(data, begin, end, seen, dissipated);
-                   ElasticEvaluation general{seen.min_volume_ratio, seen.max_volume_ratio,
-                                             seen.max_fibre_modulus_pa};
+                   ElasticEvaluation general = evaluation_of(seen);
                    ViscousContext chunk_viscous = viscous;
                    chunk_viscous.dissipated_j = &dissipated;
                    for (std::size_t e = begin; e < end; ++e)
@@ -387,7 +395,7 @@ ElasticEvaluation element_forces_for_effects(const SimModel& model, const NodeAr
   const EffectSet on = built(model);
   const detail::ElasticKernelData data = kernel_data(model, position, scratch);
   if constexpr (kViscous) {
-    if (vectorised_viscous(model, on, viscous)) {
+    if (plain_viscous_loop_applies(model, on, viscous)) {
       // Every element has its own law: no averaged pressure to gather.
       if constexpr (kBuiltFibres)
         if (on.fibres) return viscous_forces<true>(model, position, scratch, viscous, data);
@@ -398,17 +406,14 @@ ElasticEvaluation element_forces_for_effects(const SimModel& model, const NodeAr
   // The vectorised loops, for models without history or a Mooney–Rivlin term (a viscous model
   // evaluated elastically keeps its viscous regions on their own pressure: the general loop).
   if (!on.viscous && !on.mooney_rivlin) {
-    const int families =
-        on.fibres ? (data.fibre_direction[0] != nullptr) + (data.fibre_direction[1] != nullptr) : 0;
     const detail::ElasticKernel kernel =
-        detail::elastic_kernels().forces[families][on.average_nodal_pressure];
+        detail::elastic_kernels()
+            .forces[on.fibres ? fibre_families(data) : 0][on.average_nodal_pressure];
     for_each_chunk(scratch, model.tet_count, kElementsPerChunk,
                    [&](std::size_t begin, std::size_t end, std::size_t chunk) {
-                     detail::ElasticKernelSeen seen{std::numeric_limits<double>::infinity(),
-                                                    -std::numeric_limits<double>::infinity(), 0.0};
+                     detail::ElasticKernelSeen seen = kernel_nothing_seen();
                      kernel(data, begin, end, seen);
-                     scratch.chunk_seen[chunk] = {seen.min_volume_ratio, seen.max_volume_ratio,
-                                                  seen.max_fibre_modulus_pa};
+                     scratch.chunk_seen[chunk] = evaluation_of(seen);
                    });
     return combine_chunks(scratch, nullptr);
   }

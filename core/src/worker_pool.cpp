@@ -118,8 +118,10 @@ int default_engine_threads() {
   if (const char* value = std::getenv("LIVERSIM_THREADS")) {
     char* end = nullptr;
     const long threads = std::strtol(value, &end, 10);
-    if (end != value && *end == '\0' && threads >= 1 && threads <= 256)
-      return static_cast<int>(threads);
+    if (end == value || *end != '\0' || threads < 1 || threads > 256)
+      throw std::invalid_argument("LIVERSIM_THREADS = '" + std::string(value) +
+                                  "' is invalid: expected a whole number of threads from 1 to 256");
+    return static_cast<int>(threads);
   }
   const unsigned hardware = std::thread::hardware_concurrency();
   return hardware == 0 ? 1 : static_cast<int>(hardware);

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <mutex>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -69,6 +71,25 @@ TEST(WorkerPool, TwoCallersAtOnceBothFinish) {
   caller();
   other.join();
   EXPECT_EQ(total.load(), 2L * 500 * (15 * 16 / 2));
+}
+
+// A bad LIVERSIM_THREADS is named with its value, not silently replaced by the default.
+TEST(WorkerPool, ABadThreadCountInTheEnvironmentIsNamed) {
+  for (const char* bad : {"abc", "0", "-2", "3x", "", "1000"}) {
+    ASSERT_EQ(setenv("LIVERSIM_THREADS", bad, 1), 0);
+    try {
+      default_engine_threads();
+      ADD_FAILURE() << "no error for LIVERSIM_THREADS='" << bad << "'";
+    } catch (const std::invalid_argument& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("LIVERSIM_THREADS = '" + std::string(bad) + "'"), std::string::npos)
+          << message;
+    }
+  }
+  ASSERT_EQ(setenv("LIVERSIM_THREADS", "3", 1), 0);
+  EXPECT_EQ(default_engine_threads(), 3);
+  ASSERT_EQ(unsetenv("LIVERSIM_THREADS"), 0);
+  EXPECT_GE(default_engine_threads(), 1);
 }
 
 TEST(WorkerPool, RefusesAThreadCountOutOfRange) {

@@ -53,9 +53,10 @@ class WorkerPool {
   // The current job, packed as [job number: 24 bits][chunk count: 20][next chunk: 20], so that a
   // claim from a finished job can never succeed against a new one.
   alignas(64) std::atomic<std::uint64_t> job_{0};
-  alignas(64) std::atomic<std::size_t> done_{0};          // chunks of the current job finished
-  alignas(64) std::atomic<std::uint32_t> generation_{0};  // bumped per job and at shutdown: wakes workers
-  std::atomic<int> sleepers_{0};              // workers asleep or about to be
+  alignas(64) std::atomic<std::size_t> done_{0};  // chunks of the current job finished
+  alignas(64) std::atomic<std::uint32_t> generation_{
+      0};                         // bumped per job and at shutdown: wakes workers
+  std::atomic<int> sleepers_{0};  // workers asleep or about to be
   std::mutex sleep_mutex_;
   std::condition_variable wake_;
   std::atomic<bool> busy_{false};  // a job is in flight
@@ -64,14 +65,16 @@ class WorkerPool {
   Call call_ = nullptr;
 };
 
-// The threads the engine uses by default: LIVERSIM_THREADS when set to a whole number ≥ 1, else
-// the hardware's threads (at least 1).
+// The threads the engine uses by default: LIVERSIM_THREADS when set, else the hardware's threads
+// (at least 1). Throws std::invalid_argument naming the variable and its value when it is set to
+// anything but a whole number from 1 to 256.
 int default_engine_threads();
 
 // A pool of `thread_count` threads, or null for one thread (no pool needed).
 std::shared_ptr<WorkerPool> make_worker_pool(int thread_count);
 
-// The process's pool of default_engine_threads() threads, made on first use (null: one thread).
+// The process's pool of default_engine_threads() threads, made on first use (null: one thread);
+// throws as default_engine_threads does.
 // The workstation and the command line step with it; tests make their own.
 std::shared_ptr<WorkerPool> shared_worker_pool();
 
