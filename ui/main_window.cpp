@@ -134,8 +134,8 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   state.position_m = old.position_m;
   state.velocity_m_per_s = old.velocity_m_per_s;
   state.max_speed_m_per_s = old.max_speed_m_per_s;  // the node-travel limit of the first step
-  if (state.viscous_state.size() == old.viscous_state.size())
-    state.viscous_state = old.viscous_state;
+  if (state.viscous_history.size() == old.viscous_history.size())
+    state.viscous_history = old.viscous_history;
   state.energy = old.energy;  // the books go on (the guard bounds kinetic energy by them)
   state.time_s = old.time_s;
   state.step_count = old.step_count;

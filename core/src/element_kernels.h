@@ -35,16 +35,16 @@ struct ElasticKernelSeen {
 };
 
 // The viscous tissue law (viscous_tissue.cpp) of elements whose regions all have one: the
-// element's history as ViscousTissueState in place (Voigt H at [0, 6), S_e at [6, 12), Fp⁻¹
-// column-major at [12, 21), every kViscousStateDoubles doubles), the step's constants per region.
-// GCC 12 does not vectorise this loop (its history is strided, and copying it out to arrays per
-// component cost more than it gained): it runs one element at a time, without the general
-// loop's per-element law lookups.
-inline constexpr std::size_t kViscousStateDoubles = 23;
+// elements' history in blocks of kViscousHistoryBlock (ViscousHistory: component k of element e at
+// history[(e / block · components + k) · block + e % block]; Voigt H in components [0, 6), S_e
+// in [6, 12), Fp⁻¹ column-major in [12, 21)), the step's constants per region. The loops run a
+// block at a time (element ranges start at a block's first element).
+inline constexpr std::size_t kViscousHistoryBlock = 64;
+inline constexpr std::size_t kViscousHistoryComponents = 23;
 struct ViscousKernelData {
   ElasticKernelData elastic;  // geometry, fibres, outputs (its moduli arrays are not read)
   const std::int32_t* region;
-  double* state;
+  double* history;
   // Per region: instantaneous μ and λ; g0, g1; arm decay g and loading h; yield limit (∞: none);
   // the arm's stored energy ψ = a·(H:H − b·(tr H)²) with a = g1/(4μ), b = λ/(2μ + 3λ); Δt/τ.
   const double* mu_pa;

@@ -237,113 +237,201 @@ void volume_ratios(const ElasticKernelData& data, std::size_t begin, std::size_t
   }
 }
 
-// viscous_tissue_stress (viscous_tissue.cpp) without its two rare branches: an element that
-// yields or has collapsed is flagged, keeps its history untouched here, and is updated by the
-// general code afterwards.
-template <int kFibreFamilies>
-void viscous_forces(const ViscousKernelData& data, std::size_t begin, std::size_t end,
-                    ElasticKernelSeen& seen, double& dissipated_j) {
+// The viscous elements run in blocks of kViscousBlock, each block in stages (deformation, elastic
+// deformation, elastic stress and arm, stress and commit, fibres, corner forces) whose loops pass
+// their results through arrays on the stack: one loop over the whole law holds more values than
+// there are vector registers, and spilling them cost more than the stages' loads (measured).
+constexpr std::size_t kViscousBlock = kViscousHistoryBlock;
+
+struct ViscousBlock {
+  alignas(32) double deformation[9][kViscousBlock];          // F, row-major entries
+  alignas(32) double elastic_deformation[9][kViscousBlock];  // Fe = F·Fp⁻¹
+  alignas(32) double elastic_stress[6][kViscousBlock];       // S_e(Fe), Voigt
+  alignas(32) double arm[6][kViscousBlock];                  // H after the step, Voigt
+  alignas(32) double stress[9][kViscousBlock];               // P, row-major entries
+};
+
+template <std::size_t kEntries>
+inline Matrix3 load_matrix(const double (&m)[kEntries][kViscousBlock], std::size_t i) {
+  static_assert(kEntries == 9);
+  Matrix3 a;
+#pragma GCC unroll 9
+  for (int k = 0; k < 9; ++k) a.m[k / 3][k % 3] = m[k][i];
+  return a;
+}
+
+// The law of elements [block, block + count): viscous_tissue_stress (viscous_tissue.cpp) without
+// its two rare branches. An element that yields or has collapsed is flagged, keeps its history
+// untouched here, and is updated by the general code afterwards. kUniform: every element of the
+// block is in the region `uniform_region` (its constants are then loaded once).
+template <bool kUniform>
+void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t count,
+                 std::int32_t uniform_region, ViscousBlock& b, double& min_j_out, double& max_j_out,
+                 double& dissipated_out) {
   const ViscousKernelData v = data;
-  const ElasticKernelData d = data.elastic;
-  double min_j = seen.min_volume_ratio, max_j = seen.max_volume_ratio;
-  double max_fibre = seen.max_fibre_modulus_pa, dissipated = 0.0;
-#pragma omp simd reduction(min : min_j) reduction(max : max_j, max_fibre) reduction(+ : dissipated)
-  for (std::size_t e = begin; e < end; ++e) {
-    const Matrix3 F = deformation_gradient(d, e);
-    double* history = v.state + e * kViscousStateDoubles;
-    const std::int32_t r = v.region[e];
-    const double mu = v.mu_pa[r], lambda = v.lambda_pa[r];
-    // Fe = F·Fp⁻¹ (Fp⁻¹ stored column-major).
-    Matrix3 fe;
+  const double* rest_volume = data.elastic.rest_volume_m3;
+  // Component k of element block + i at history[k·kViscousBlock + i].
+  double* const history =
+      v.history + block / kViscousBlock * kViscousHistoryComponents * kViscousBlock;
+  const std::int32_t ru = uniform_region;
+  // A region's constant, for element block + i.
+  auto constant = [&](const double* per_region, std::size_t i) {
+    return per_region[kUniform ? ru : v.region[block + i]];
+  };
+
+  // Fe = F·Fp⁻¹ (Fp⁻¹ stored column-major).
+#pragma omp simd
+  for (std::size_t i = 0; i < count; ++i) {
+    const Matrix3 F = load_matrix(b.deformation, i);
 #pragma GCC unroll 3
-    for (int i = 0; i < 3; ++i)
+    for (int a = 0; a < 3; ++a)
 #pragma GCC unroll 3
       for (int k = 0; k < 3; ++k)
-        fe.m[i][k] = F.m[i][0] * history[12 + 3 * k] + F.m[i][1] * history[13 + 3 * k] +
-                     F.m[i][2] * history[14 + 3 * k];
+        b.elastic_deformation[3 * a + k][i] =
+            F.m[a][0] * history[(12 + 3 * k) * kViscousBlock + i] +
+            F.m[a][1] * history[(13 + 3 * k) * kViscousBlock + i] +
+            F.m[a][2] * history[(14 + 3 * k) * kViscousBlock + i];
+  }
+
+  // S_e = Fe⁻¹·P(Fe) = μI + U'(J)/J·cofᵀ·cof, with U'(J) = (λ ln J − μ)/J; then the arm
+  // H = g·H_before + h·(S_e − S_e before).
+  double min_j = min_j_out, max_j = max_j_out;
+#pragma omp simd reduction(min : min_j) reduction(max : max_j)
+  for (std::size_t i = 0; i < count; ++i) {
+    const Matrix3 fe = load_matrix(b.elastic_deformation, i);
     const Matrix3 cof = cofactor(fe);
     const double J = fe.m[0][0] * cof.m[0][0] + fe.m[1][0] * cof.m[1][0] + fe.m[2][0] * cof.m[2][0];
     min_j = min_of(min_j, J);
     max_j = max_of(max_j, J);
-    const bool collapsed = !(J >= kMinVolumeRatio);
-    const double safe_j = collapsed ? 1.0 : J;
-    // S_e = Fe⁻¹·P(Fe) = μI + U'(J)/J·cofᵀ·cof, with U'(J) = (λ ln J − μ)/J.
+    // Collapsed (flagged below): any finite value will do.
+    const double safe_j = J >= kMinVolumeRatio ? J : 1.0;
+    const double mu = constant(v.mu_pa, i), lambda = constant(v.lambda_pa, i);
     const double volumetric = (lambda * log_of(safe_j) - mu) / (safe_j * safe_j);
-    // (cofᵀ·cof)_ab = column a of cof · column b of cof. Voigt: xx, yy, zz, yz, xz, xy.
-    auto cc = [&](int a, int b) {
-      return cof.m[0][a] * cof.m[0][b] + cof.m[1][a] * cof.m[1][b] + cof.m[2][a] * cof.m[2][b];
+    // (cofᵀ·cof)_ac = column a of cof · column c of cof. Voigt: xx, yy, zz, yz, xz, xy.
+    auto cc = [&](int a, int c) {
+      return cof.m[0][a] * cof.m[0][c] + cof.m[1][a] * cof.m[1][c] + cof.m[2][a] * cof.m[2][c];
     };
     const double elastic[6] = {mu + volumetric * cc(0, 0), mu + volumetric * cc(1, 1),
                                mu + volumetric * cc(2, 2), volumetric * cc(1, 2),
                                volumetric * cc(0, 2),      volumetric * cc(0, 1)};
-    // H = g·H_before + h·(S_e − S_e before); S = g0·S_e + g1·H.
-    const double decay = v.arm_decay[r], loading = v.arm_loading[r];
-    const double g0 = v.relaxed_fraction[r], g1 = v.arm_fraction[r];
-    double arm[6], pk2[6];
+    const double decay = constant(v.arm_decay, i), loading = constant(v.arm_loading, i);
 #pragma GCC unroll 6
     for (int k = 0; k < 6; ++k) {
-      arm[k] = decay * history[k] + loading * (elastic[k] - history[6 + k]);
-      pk2[k] = g0 * elastic[k] + g1 * arm[k];
+      b.elastic_stress[k][i] = elastic[k];
+      b.arm[k][i] = decay * history[k * kViscousBlock + i] +
+                    loading * (elastic[k] - history[(6 + k) * kViscousBlock + i]);
     }
+  }
+  min_j_out = min_j;
+  max_j_out = max_j;
+
+  // S = g0·S_e + g1·H; the yield check on τ = Fe·S·Feᵀ; P = Fe·S·Fp⁻ᵀ; the dashpots' work; the
+  // commit.
+  double dissipated = dissipated_out;
+#pragma omp simd reduction(+ : dissipated)
+  for (std::size_t i = 0; i < count; ++i) {
+    const Matrix3 fe = load_matrix(b.elastic_deformation, i);
+    const double g0 = constant(v.relaxed_fraction, i), g1 = constant(v.arm_fraction, i);
+    double pk2[6];
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) pk2[k] = g0 * b.elastic_stress[k][i] + g1 * b.arm[k][i];
     const double S[3][3] = {
         {pk2[0], pk2[5], pk2[4]}, {pk2[5], pk2[1], pk2[3]}, {pk2[4], pk2[3], pk2[2]}};
-    // Fe·S, then the Kirchhoff stress τ = Fe·S·Feᵀ for the yield check.
     double feS[3][3];
 #pragma GCC unroll 3
-    for (int i = 0; i < 3; ++i)
+    for (int a = 0; a < 3; ++a)
 #pragma GCC unroll 3
       for (int k = 0; k < 3; ++k)
-        feS[i][k] = fe.m[i][0] * S[0][k] + fe.m[i][1] * S[1][k] + fe.m[i][2] * S[2][k];
-    double tau[3][3];
+        feS[a][k] = fe.m[a][0] * S[0][k] + fe.m[a][1] * S[1][k] + fe.m[a][2] * S[2][k];
+    auto tau = [&](int a, int c) {
+      return feS[a][0] * fe.m[c][0] + feS[a][1] * fe.m[c][1] + feS[a][2] * fe.m[c][2];
+    };
+    const double t00 = tau(0, 0), t11 = tau(1, 1), t22 = tau(2, 2);
+    const double t12 = tau(1, 2), t02 = tau(0, 2), t01 = tau(0, 1);
+    const double mean = (t00 + t11 + t22) / 3.0;
+    const double deviator_sq = (t00 - mean) * (t00 - mean) + (t11 - mean) * (t11 - mean) +
+                               (t22 - mean) * (t22 - mean) +
+                               2.0 * (t12 * t12 + t02 * t02 + t01 * t01);
+    const double yield = constant(v.yield_limit_pa, i);
+    const double J = fe.m[0][0] * (fe.m[1][1] * fe.m[2][2] - fe.m[2][1] * fe.m[1][2]) +
+                     fe.m[1][0] * (fe.m[2][1] * fe.m[0][2] - fe.m[0][1] * fe.m[2][2]) +
+                     fe.m[2][0] * (fe.m[0][1] * fe.m[1][2] - fe.m[1][1] * fe.m[0][2]);
+    const bool general = !(J >= kMinVolumeRatio) || 1.5 * deviator_sq > yield * yield;
+    v.needs_general[block + i] = general ? 1 : 0;
+    // (Fp⁻ᵀ)[k][j] = Fp⁻¹[j][k], stored in component 12 + j + 3k.
 #pragma GCC unroll 3
-    for (int i = 0; i < 3; ++i)
-#pragma GCC unroll 3
-      for (int k = 0; k < 3; ++k)
-        tau[i][k] = feS[i][0] * fe.m[k][0] + feS[i][1] * fe.m[k][1] + feS[i][2] * fe.m[k][2];
-    const double mean = (tau[0][0] + tau[1][1] + tau[2][2]) / 3.0;
-    double deviator_sq = 0.0;
-#pragma GCC unroll 3
-    for (int i = 0; i < 3; ++i)
-#pragma GCC unroll 3
-      for (int k = 0; k < 3; ++k) {
-        const double symmetric = 0.5 * (tau[i][k] + tau[k][i]) - (i == k ? mean : 0.0);
-        deviator_sq += symmetric * symmetric;
-      }
-    const bool yields = 1.5 * deviator_sq > v.yield_limit_pa[r] * v.yield_limit_pa[r];
-    const bool general = collapsed || yields;
-    v.needs_general[e] = general ? 1 : 0;
-    // P = Fe·S·Fp⁻ᵀ: (Fp⁻ᵀ)[k][j] = Fp⁻¹[j][k], stored at 12 + j + 3k.
-    double P[3][3];
-#pragma GCC unroll 3
-    for (int i = 0; i < 3; ++i)
+    for (int a = 0; a < 3; ++a)
 #pragma GCC unroll 3
       for (int j = 0; j < 3; ++j)
-        P[i][j] =
-            feS[i][0] * history[12 + j] + feS[i][1] * history[15 + j] + feS[i][2] * history[18 + j];
-    if constexpr (kFibreFamilies > 0)
-      max_fibre = max_of(max_fibre, add_fibre_stress<kFibreFamilies>(d, e, F, P));
-    store_corner_forces(d, e, P);
-    // The dashpots' work over the step: V·Δt/τ·(ψ(H before) + ψ(H)) (trapezoid of 2ψ/τ).
-    const double trace_before = history[0] + history[1] + history[2];
-    const double trace_after = arm[0] + arm[1] + arm[2];
-    double contraction_before = 0.0, contraction_after = 0.0;
+        b.stress[3 * a + j][i] = feS[a][0] * history[(12 + j) * kViscousBlock + i] +
+                                 feS[a][1] * history[(15 + j) * kViscousBlock + i] +
+                                 feS[a][2] * history[(18 + j) * kViscousBlock + i];
+    // The dashpots' work over the step: V·Δt/τ·(ψ(H before) + ψ(H)) (trapezoid of 2ψ/τ), with
+    // ψ = a·(H:H − b·(tr H)²).
+    double trace_before = 0.0, trace_after = 0.0, contraction_before = 0.0, contraction_after = 0.0;
 #pragma GCC unroll 6
     for (int k = 0; k < 6; ++k) {
       const double weight = k < 3 ? 1.0 : 2.0;
-      contraction_before += weight * history[k] * history[k];
-      contraction_after += weight * arm[k] * arm[k];
+      const double before = history[k * kViscousBlock + i], after = b.arm[k][i];
+      trace_before += k < 3 ? before : 0.0;
+      trace_after += k < 3 ? after : 0.0;
+      contraction_before += weight * before * before;
+      contraction_after += weight * after * after;
     }
-    const double b_vol = v.arm_energy_volumetric[r];
-    const double work = d.rest_volume_m3[e] * v.step_over_relaxation_time[r] *
-                        v.arm_energy_scale[r] *
+    const double b_vol = constant(v.arm_energy_volumetric, i);
+    const double work = rest_volume[block + i] * constant(v.step_over_relaxation_time, i) *
+                        constant(v.arm_energy_scale, i) *
                         (contraction_before - b_vol * trace_before * trace_before +
                          contraction_after - b_vol * trace_after * trace_after);
     dissipated += general ? 0.0 : work;
     // Commit; a flagged element keeps what it had for the general update.
 #pragma GCC unroll 6
     for (int k = 0; k < 6; ++k) {
-      history[k] = general ? history[k] : arm[k];
-      history[6 + k] = general ? history[6 + k] : elastic[k];
+      double& arm = history[k * kViscousBlock + i];
+      double& elastic = history[(6 + k) * kViscousBlock + i];
+      arm = general ? arm : b.arm[k][i];
+      elastic = general ? elastic : b.elastic_stress[k][i];
+    }
+  }
+  dissipated_out = dissipated;
+}
+
+template <int kFibreFamilies>
+void viscous_forces(const ViscousKernelData& data, std::size_t begin, std::size_t end,
+                    ElasticKernelSeen& seen, double& dissipated_j) {
+  const ElasticKernelData d = data.elastic;
+  double min_j = seen.min_volume_ratio, max_j = seen.max_volume_ratio;
+  double max_fibre = seen.max_fibre_modulus_pa, dissipated = 0.0;
+  ViscousBlock b;
+  for (std::size_t block = begin; block < end; block += kViscousBlock) {
+    const std::size_t count = end - block < kViscousBlock ? end - block : kViscousBlock;
+#pragma omp simd
+    for (std::size_t i = 0; i < count; ++i) {
+      const Matrix3 F = deformation_gradient(d, block + i);
+#pragma GCC unroll 9
+      for (int k = 0; k < 9; ++k) b.deformation[k][i] = F.m[k / 3][k % 3];
+    }
+    const std::int32_t first_region = data.region[block];
+    bool uniform = true;
+    for (std::size_t i = 1; i < count; ++i) uniform &= data.region[block + i] == first_region;
+    if (uniform)
+      viscous_law<true>(data, block, count, first_region, b, min_j, max_j, dissipated);
+    else
+      viscous_law<false>(data, block, count, first_region, b, min_j, max_j, dissipated);
+    if constexpr (kFibreFamilies > 0) {
+#pragma omp simd reduction(max : max_fibre)
+      for (std::size_t i = 0; i < count; ++i) {
+        const Matrix3 F = load_matrix(b.deformation, i);
+        double P[3][3] = {};
+        max_fibre = max_of(max_fibre, add_fibre_stress<kFibreFamilies>(d, block + i, F, P));
+#pragma GCC unroll 9
+        for (int k = 0; k < 9; ++k) b.stress[k][i] += P[k / 3][k % 3];
+      }
+    }
+#pragma omp simd
+    for (std::size_t i = 0; i < count; ++i) {
+      const Matrix3 P = load_matrix(b.stress, i);
+      store_corner_forces(d, block + i, P.m);
     }
   }
   seen.min_volume_ratio = min_j;

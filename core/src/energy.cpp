@@ -11,7 +11,7 @@ namespace {
 double viscous_element_energy_density(const SimModel& model, const SimState& state,
                                       const ViscousTissueParameters& law, std::size_t e,
                                       const Eigen::Matrix3d& F) {
-  const ViscousTissueState& history = state.viscous_state[e];
+  const ViscousTissueState history = state.viscous_history.load(e);
   const double mu = model.shear_modulus_pa[e], lambda = model.lame_lambda_pa[e];
   const double instantaneous = law.viscoelastic.instantaneous_modulus_pa();
   const double relaxed_fraction = law.viscoelastic.e2_pa / instantaneous;

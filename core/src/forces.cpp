@@ -92,7 +92,7 @@ namespace {
 // History-dependent materials of one evaluation: the state to advance and commit, and the step
 // constants per region; null when the model has no viscous region.
 struct ViscousContext {
-  std::vector<ViscousTissueState>* state;
+  ViscousHistory* history;
   const std::vector<std::optional<ViscousTissueStep>>* step_by_region;
   const ViscousArmInputs* arm = nullptr;  // set: the arm is carried by the integrator
   double* dissipated_j = nullptr;         // committing: the dashpots' work of the step is added
@@ -114,15 +114,16 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
     if (viscous.arm) {
       const ViscousArmInputs& arm = *viscous.arm;
       const auto r = static_cast<std::size_t>(model.region[e]);
-      P = viscoelastic_stress_rate_form(F, **step, (*viscous.state)[e].inverse_plastic_deformation,
+      P = viscoelastic_stress_rate_form(F, **step, viscous.history->inverse_plastic_deformation(e),
                                         arm.q_known[e], arm.keep_by_region[r],
                                         arm.elastic_weight_by_region[r], arm.elastic_stress[e]);
     } else {
       // The history committed here spans the step: book its dashpots' work (trapezoid of 2ψ/τ).
       const ViscousTissueStep& s = **step;
-      ViscousTissueState& history = (*viscous.state)[e];
+      ViscousTissueState history = viscous.history->load(e);
       const double before = maxwell_arm_energy_density(history.maxwell_stress_pa, s);
       P = viscous_tissue_update(F, s, history);
+      viscous.history->store(e, history);
       *viscous.dissipated_j += model.rest_volume_m3[e] * s.dt_s / s.relaxation_time_s *
                                (before + maxwell_arm_energy_density(history.maxwell_stress_pa, s));
     }
@@ -329,10 +330,12 @@ template <bool kFibres>
 ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& position,
                                  ForceScratch& scratch, const ViscousContext& viscous,
                                  const detail::ElasticKernelData& elastic) {
-  static_assert(sizeof(ViscousTissueState) == detail::kViscousStateDoubles * sizeof(double));
-  static_assert(offsetof(ViscousTissueState, maxwell_stress_pa) == 0);
-  static_assert(offsetof(ViscousTissueState, elastic_stress_pa) == 6 * sizeof(double));
-  static_assert(offsetof(ViscousTissueState, inverse_plastic_deformation) == 12 * sizeof(double));
+  // The components the kernel reads by number (element_kernels.h).
+  static_assert(ViscousHistory::kMaxwellStress == 0 && ViscousHistory::kElasticStress == 6 &&
+                ViscousHistory::kInversePlasticDeformation == 12 &&
+                ViscousHistory::kComponents == detail::kViscousHistoryComponents &&
+                ViscousHistory::kBlock == detail::kViscousHistoryBlock &&
+                kElementsPerChunk % detail::kViscousHistoryBlock == 0);
   const std::size_t regions = model.viscous_parameters.size();
   double* constants = scratch.region_constants.data();
   for (std::size_t r = 0; r < regions; ++r) {
@@ -355,7 +358,7 @@ ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& positio
   detail::ViscousKernelData data{};
   data.elastic = elastic;
   data.region = model.region.data();
-  data.state = viscous.state->data()->maxwell_stress_pa.data();
+  data.history = viscous.history->block(0);
   const double** fields[10] = {&data.mu_pa,
                                &data.lambda_pa,
                                &data.relaxed_fraction,
@@ -505,9 +508,10 @@ ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state
       for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
         if (model.viscous_parameters[r])
           state.viscous_step[r].emplace(*model.viscous_parameters[r], dt_since_last_s);
-      const ElasticEvaluation seen = element_forces_for_effects<true>(
-          model, state.position_m, state.force_scratch,
-          {&state.viscous_state, &state.viscous_step, nullptr, &state.energy.viscous_dissipated_j});
+      const ElasticEvaluation seen =
+          element_forces_for_effects<true>(model, state.position_m, state.force_scratch,
+                                           {&state.viscous_history, &state.viscous_step, nullptr,
+                                            &state.energy.viscous_dissipated_j});
       gather_corner_forces(model, state.force_scratch, state.force_n);
       return seen;
     }
@@ -525,8 +529,9 @@ ElasticEvaluation compute_internal_forces_rate_form(const SimModel& model, SimSt
       for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
         if (model.viscous_parameters[r] && !state.viscous_step[r])
           state.viscous_step[r].emplace(*model.viscous_parameters[r], 0.0);
-      const ElasticEvaluation seen = element_forces_for_effects<true>(
-          model, position, state.force_scratch, {&state.viscous_state, &state.viscous_step, &arm});
+      const ElasticEvaluation seen =
+          element_forces_for_effects<true>(model, position, state.force_scratch,
+                                           {&state.viscous_history, &state.viscous_step, &arm});
       gather_corner_forces(model, state.force_scratch, force);
       return seen;
     }
@@ -540,7 +545,7 @@ Eigen::Matrix<double, 9, 9> element_step_tangent(const SimModel& model, const Si
   const auto r = static_cast<std::size_t>(model.region[e]);
   if (built(model).viscous && model.viscous_parameters[r] && state.viscous_step[r]) {
     Eigen::Matrix<double, 9, 9> tangent = viscoelastic_stress_tangent_rate_form(
-        F, *state.viscous_step[r], state.viscous_state[e].inverse_plastic_deformation,
+        F, *state.viscous_step[r], state.viscous_history.inverse_plastic_deformation(e),
         arm.q_known[e], arm.keep_by_region[r], arm.elastic_weight_by_region[r]);
     if (built(model).fibres)
       for (const auto& family : model.fibre_direction)

@@ -63,14 +63,14 @@ StateCheckpoint make_checkpoint(const SimModel& model) {
   StateCheckpoint checkpoint;
   checkpoint.position_m.resize(model.node_count);
   checkpoint.velocity_m_per_s.resize(model.node_count);
-  if (model.effects.viscous) checkpoint.viscous_state.resize(model.tet_count);
+  if (model.effects.viscous) checkpoint.viscous_history = ViscousHistory(model.tet_count);
   return checkpoint;
 }
 
 void save_checkpoint(const SimState& state, StateCheckpoint& checkpoint) {
   checkpoint.position_m = state.position_m;
   checkpoint.velocity_m_per_s = state.velocity_m_per_s;
-  checkpoint.viscous_state = state.viscous_state;
+  checkpoint.viscous_history = state.viscous_history;
   checkpoint.energy = state.energy;
   checkpoint.time_s = state.time_s;
   checkpoint.step_count = state.step_count;
@@ -80,7 +80,7 @@ void save_checkpoint(const SimState& state, StateCheckpoint& checkpoint) {
 void restore_checkpoint(const StateCheckpoint& checkpoint, SimState& state) {
   state.position_m = checkpoint.position_m;
   state.velocity_m_per_s = checkpoint.velocity_m_per_s;
-  state.viscous_state = checkpoint.viscous_state;
+  state.viscous_history = checkpoint.viscous_history;
   state.energy = checkpoint.energy;
   state.time_s = checkpoint.time_s;
   state.step_count = checkpoint.step_count;

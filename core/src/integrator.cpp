@@ -371,9 +371,10 @@ void arm_of_committed_state(const SimModel& model, const SimState& state,
   if (!model.effects.viscous) return;
   for (std::size_t e = 0; e < model.tet_count; ++e) {
     if (!model.viscous_parameters[static_cast<std::size_t>(model.region[e])]) continue;
-    const ViscousTissueState& committed = state.viscous_state[e];
+    const ViscousHistory& history = state.viscous_history;
     for (int k = 0; k < 6; ++k)
-      arm[e][k] = committed.elastic_stress_pa[k] - committed.maxwell_stress_pa[k];
+      arm[e][k] = history.value(ViscousHistory::kElasticStress + k, e) -
+                  history.value(ViscousHistory::kMaxwellStress + k, e);
   }
 }
 
@@ -389,7 +390,7 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
     const auto r = static_cast<std::size_t>(model.region[e]);
     if (!model.viscous_parameters[r]) continue;
     const ViscousTissueStep& step = *state.viscous_step[r];
-    ViscousTissueState& committed = state.viscous_state[e];
+    ViscousTissueState committed = state.viscous_history.load(e);
     const double arm_before = maxwell_arm_energy_density(committed.maxwell_stress_pa, step);
     const Eigen::Matrix3d F = deformation_gradient(model, position, e);
     Voigt6 elastic;
@@ -404,6 +405,7 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
     if (step.viscoplastic) viscous_tissue_update(F, step, committed);
     dissipated_j += model.rest_volume_m3[e] / step.relaxation_time_s *
                     (arm_before + maxwell_arm_energy_density(committed.maxwell_stress_pa, step));
+    state.viscous_history.store(e, committed);
   }
   state.energy.viscous_dissipated_j += dt_s * dissipated_j;
 }

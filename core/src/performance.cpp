@@ -59,7 +59,7 @@ std::size_t state_bytes(const SimState& s) {
          bytes(f.corner_force_n) + bytes(f.element_volume_ratio) +
          bytes(f.nodal_lambda_pressure_pa) + bytes(f.chunk_seen) + bytes(f.chunk_dissipated_j) +
          bytes(f.region_constants) + bytes(f.needs_general) + bytes(s.spring_damping_per_s) +
-         bytes(s.viscous_state) + bytes(s.viscous_step) + bytes(i.start_position_m) +
+         s.viscous_history.capacity_bytes() + bytes(s.viscous_step) + bytes(i.start_position_m) +
          bytes(i.start_velocity_m_per_s) + bytes(i.stage_position_m) +
          bytes(i.stage_velocity_m_per_s) + bytes(i.position_rate) + bytes(i.velocity_rate) +
          bytes(i.start_arm) + bytes(i.stage_arm) + bytes(i.elastic_stress) + bytes(i.arm_rate) +

@@ -137,9 +137,8 @@ double arm_books_uncertainty_j(const SimModel& model, const SimState& state) {
     const double mu = model.shear_modulus_pa[e], lambda = model.lame_lambda_pa[e];
     const double arm_fraction =
         law->viscoelastic.e1_pa / law->viscoelastic.instantaneous_modulus_pa();
-    const ViscousTissueState& history = state.viscous_state[e];
-    const Eigen::Matrix3d Fe =
-        deformation_gradient(model, state.position_m, e) * history.inverse_plastic_deformation;
+    const Eigen::Matrix3d Fe = deformation_gradient(model, state.position_m, e) *
+                               state.viscous_history.inverse_plastic_deformation(e);
     const double J = Fe.determinant();
     if (!(J > neo_hookean::kMinVolumeRatio)) continue;  // the arm is frozen there
     const Eigen::Matrix3d inverse_c = (Fe.transpose() * Fe).inverse();
@@ -149,7 +148,7 @@ double arm_books_uncertainty_j(const SimModel& model, const SimState& state) {
     if (!(unrelaxed > 0.0)) continue;
     const double relative_error =
         std::abs(unrelaxed - neo_hookean::energy_density(Fe, mu, lambda)) / unrelaxed;
-    const auto& h = history.maxwell_stress_pa;  // Voigt: xx, yy, zz, yz, xz, xy
+    const Voigt6 h = state.viscous_history.maxwell_stress_pa(e);  // Voigt: xx, yy, zz, yz, xz, xy
     Eigen::Matrix3d H;
     H << h[0], h[5], h[4], h[5], h[1], h[3], h[4], h[3], h[2];
     total += model.rest_volume_m3[e] * arm_fraction * small_strain_energy_density(H, mu, lambda) *

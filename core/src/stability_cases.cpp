@@ -221,8 +221,8 @@ std::vector<StabilityRun> yield_cycles_case(const StabilitySuiteOptions&) {
       for (std::size_t i = 0; i < unit.size(); ++i) loads[i].force_n = sigma * unit[i].force_n;
       if (!run.advance({loads, {}}, 0.02)) break;
       double plastic = 0.0;
-      for (const ViscousTissueState& element : run.state.viscous_state)
-        plastic = std::max(plastic, element.equivalent_plastic_strain);
+      for (std::size_t e = 0; e < run.state.viscous_history.size(); ++e)
+        plastic = std::max(plastic, run.state.viscous_history.equivalent_plastic_strain(e));
       if (plastic < plastic_before) ++backwards;
       plastic_before = plastic;
     }

@@ -30,7 +30,7 @@ SimState make_rest_state(const SimModel& model, std::shared_ptr<WorkerPool> work
   state.force_scratch.workers = std::move(workers);
   state.spring_damping_per_s.assign(model.node_count, 0.0);
   if (model.effects.viscous) {
-    state.viscous_state.resize(model.tet_count);
+    state.viscous_history = ViscousHistory(model.tet_count);
     state.viscous_step.resize(model.viscous_parameters.size());
   }
   detail::prepare_integrator_scratch(model, state.integrator);

@@ -256,6 +256,50 @@ Eigen::Matrix3d viscous_tissue_update(const Eigen::Matrix3d& F, const ViscousTis
   return viscous_tissue_stress(F, step, state, state);
 }
 
+// ---------------------------------------------------------------- history of a mesh
+
+ViscousHistory::ViscousHistory(std::size_t elements)
+    : elements_(elements), values_((elements + kBlock - 1) / kBlock * kBlock * kComponents, 0.0) {
+  for (std::size_t e = 0; e < elements; ++e)
+    for (int k : {0, 4, 8})  // the diagonal of Fp⁻¹, column-major
+      value(kInversePlasticDeformation + k, e) = 1.0;
+}
+
+ViscousTissueState ViscousHistory::load(std::size_t e) const {
+  ViscousTissueState history;
+  for (int k = 0; k < 6; ++k) {
+    history.maxwell_stress_pa[k] = value(kMaxwellStress + k, e);
+    history.elastic_stress_pa[k] = value(kElasticStress + k, e);
+  }
+  history.inverse_plastic_deformation = inverse_plastic_deformation(e);
+  history.equivalent_plastic_strain = value(kEquivalentPlasticStrain, e);
+  history.yield_clock_s = value(kYieldClock, e);
+  return history;
+}
+
+void ViscousHistory::store(std::size_t e, const ViscousTissueState& history) {
+  for (int k = 0; k < 6; ++k) {
+    value(kMaxwellStress + k, e) = history.maxwell_stress_pa[k];
+    value(kElasticStress + k, e) = history.elastic_stress_pa[k];
+  }
+  for (int k = 0; k < 9; ++k)
+    value(kInversePlasticDeformation + k, e) = history.inverse_plastic_deformation.data()[k];
+  value(kEquivalentPlasticStrain, e) = history.equivalent_plastic_strain;
+  value(kYieldClock, e) = history.yield_clock_s;
+}
+
+Eigen::Matrix3d ViscousHistory::inverse_plastic_deformation(std::size_t e) const {
+  Eigen::Matrix3d fp_inverse;  // Eigen's default storage is column-major, as the components
+  for (int k = 0; k < 9; ++k) fp_inverse.data()[k] = value(kInversePlasticDeformation + k, e);
+  return fp_inverse;
+}
+
+Voigt6 ViscousHistory::maxwell_stress_pa(std::size_t e) const {
+  Voigt6 h;
+  for (int k = 0; k < 6; ++k) h[k] = value(kMaxwellStress + k, e);
+  return h;
+}
+
 // ---------------------------------------------------------------- uniaxial driver
 
 UniaxialDriver::UniaxialDriver(const ViscousTissueParameters& parameters)

@@ -10,15 +10,17 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 namespace liversim {
 namespace {
 
 // The general kernel: every law looked up per element, nothing specialised, forces scattered
-// element by element. `viscous` is the history the evaluation starts from (advanced here by dt_s).
-NodeArray reference_forces(const SimModel& model, const NodeArray& x,
-                           std::vector<ViscousTissueState> viscous, double dt_s) {
+// element by element. `viscous` is the history the evaluation starts from, advanced by dt_s.
+NodeArray reference_forces(const SimModel& model, const NodeArray& x, ViscousHistory& viscous,
+                           double dt_s) {
   const std::size_t tets = model.tet_count;
   std::vector<double> nodal_pressure(model.node_count, 0.0);
   auto is_viscous = [&](std::size_t e) {
@@ -29,7 +31,7 @@ NodeArray reference_forces(const SimModel& model, const NodeArray& x,
       double weighted = 0.0, volume = 0.0, lambda_volume = 0.0;
       for (std::size_t e = 0; e < tets; ++e) {
         bool corner = false;
-        for (int c = 0; c < 4; ++c) corner |= model.corner[c][e] == n;
+        for (int c = 0; c < 4; ++c) corner |= static_cast<std::size_t>(model.corner[c][e]) == n;
         if (!corner || is_viscous(e)) continue;
         weighted += model.rest_volume_m3[e] * deformation_gradient(model, x, e).determinant();
         volume += model.rest_volume_m3[e];
@@ -45,7 +47,9 @@ NodeArray reference_forces(const SimModel& model, const NodeArray& x,
     Eigen::Matrix3d P;
     if (is_viscous(e)) {
       const ViscousTissueStep step(*model.viscous_parameters[model.region[e]], dt_s);
-      P = viscous_tissue_update(F, step, viscous[e]);
+      ViscousTissueState history = viscous.load(e);
+      P = viscous_tissue_update(F, step, history);
+      viscous.store(e, history);
       if (model.effects.fibres)
         for (const auto& family : model.fibre_direction)
           P += hgo::first_piola_stress(F, family[e], model.fibre_parameters[e]);
@@ -75,7 +79,8 @@ NodeArray reference_forces(const SimModel& model, const NodeArray& x,
 }
 
 TEST(Kernels, EverySpecialisedKernelEqualsTheGeneralOne) {
-  TetMesh mesh = testing::block_mesh(6, 4, 4, {0.03, 0.02, 0.02}, 0.2);
+  // 480 tets: blocks of the viscous loop with one region and with both, and a partial last one.
+  TetMesh mesh = testing::block_mesh(5, 4, 4, {0.03, 0.02, 0.02}, 0.2);
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     double x = 0.0;
     for (int c = 0; c < 4; ++c) x += 0.25 * mesh.rest_position_m.x[mesh.corner[c][e]];
@@ -85,8 +90,12 @@ TEST(Kernels, EverySpecialisedKernelEqualsTheGeneralOne) {
   std::uniform_real_distribution<double> jitter(-1.0, 1.0);
   int combinations = 0;
   const std::shared_ptr<WorkerPool> workers = make_worker_pool(2);
-  for (int mask = 0; mask < 16; ++mask) {
+  for (int mask = 0; mask < 32; ++mask) {
     const bool fibres = mask & 1, viscous = mask & 2, averaged = mask & 4, mooney = mask & 8;
+    // Every region viscous, with different laws: the plain viscous loop (Mooney–Rivlin is not
+    // available in a viscous region).
+    const bool all_viscous = mask & 16;
+    if (all_viscous && (!viscous || mooney)) continue;
     ModelOptions options;
     options.regions.resize(2);
     options.regions[0].tissue = TissueMaterial{3500.0, 0.45, 1060.0};
@@ -95,6 +104,8 @@ TEST(Kernels, EverySpecialisedKernelEqualsTheGeneralOne) {
     if (viscous) {
       options.regions[1].viscoelastic = ViscoelasticParameters{4000.0, 3000.0, 400.0};
       options.regions[1].viscoplastic = ViscoplasticParameters{20.0, 500.0, 0.5};
+      if (all_viscous)
+        options.regions[0].viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 50.0};
     }
     if (fibres) {
       options.regions[0].fibres = FibreParameters{1000.0, 2.0};
@@ -117,7 +128,11 @@ TEST(Kernels, EverySpecialisedKernelEqualsTheGeneralOne) {
         const Eigen::Vector3d noise(jitter(random), jitter(random), jitter(random));
         state.position_m.set(n, rest + stretch + 5e-4 * noise);
       }
-      const std::vector<ViscousTissueState> before = state.viscous_state;
+      // One node pushed through its neighbours: inverted elements (J < J0) in the second stage.
+      if (stage == 1)
+        state.position_m.set(model.node_count / 2, state.position_m.at(model.node_count / 2) +
+                                                       Eigen::Vector3d(0.012, 0.004, 0.0));
+      const ViscousHistory before = state.viscous_history;
       threaded.position_m = state.position_m;
       const ElasticEvaluation seen = compute_internal_forces(model, state, 0.01);
       const ElasticEvaluation seen_threaded = compute_internal_forces(model, threaded, 0.01);
@@ -128,7 +143,8 @@ TEST(Kernels, EverySpecialisedKernelEqualsTheGeneralOne) {
       EXPECT_EQ(seen.max_fibre_modulus_pa, seen_threaded.max_fibre_modulus_pa);
       EXPECT_EQ(state.energy.viscous_dissipated_j, threaded.energy.viscous_dissipated_j);
       if (stage == 0) continue;
-      const NodeArray expected = reference_forces(model, state.position_m, before, 0.01);
+      ViscousHistory expected_history = before;
+      const NodeArray expected = reference_forces(model, state.position_m, expected_history, 0.01);
       double scale = 0.0, difference = 0.0;
       for (std::size_t n = 0; n < model.node_count; ++n) {
         scale = std::max(scale, expected.at(n).norm());
@@ -138,11 +154,30 @@ TEST(Kernels, EverySpecialisedKernelEqualsTheGeneralOne) {
       // Round-off: the same operations in another order, sums of ~20 element terms per node.
       EXPECT_LE(difference, 1e-12 * scale)
           << "fibres " << fibres << ", viscous " << viscous << ", average nodal pressure "
-          << averaged << ", Mooney-Rivlin " << mooney;
+          << averaged << ", Mooney-Rivlin " << mooney << ", all viscous " << all_viscous;
+      ASSERT_EQ(expected_history.size(), state.viscous_history.size());
+      for (int k = 0; k < ViscousHistory::kComponents; ++k) {
+        double component_scale = 0.0, component_difference = 0.0;
+        for (std::size_t e = 0; e < expected_history.size(); ++e) {
+          const double value = expected_history.value(k, e);
+          component_scale = std::max(component_scale, std::abs(value));
+          component_difference =
+              std::max(component_difference, std::abs(state.viscous_history.value(k, e) - value));
+        }
+        EXPECT_LE(component_difference, 1e-12 * component_scale) << "history component " << k;
+      }
+      if (all_viscous) {
+        // Both paths of the plain viscous loop ran: elements it updated, elements it flagged
+        // (yielding or inverted) for the general update.
+        const auto& flagged = state.force_scratch.needs_general;
+        const auto count = std::count(flagged.begin(), flagged.end(), 1);
+        EXPECT_GT(count, 0);
+        EXPECT_LT(count, static_cast<long>(model.tet_count));
+      }
     }
     ++combinations;
   }
-  EXPECT_EQ(combinations, 16);
+  EXPECT_EQ(combinations, 20);
 }
 
 }  // namespace

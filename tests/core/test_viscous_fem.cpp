@@ -80,8 +80,9 @@ double residual_strain_after_pull(const RegionMaterial& material, double sigma_p
   };
   if (mean_plastic_strain) {
     *mean_plastic_strain = 0.0;
-    for (const auto& s : state.viscous_state) *mean_plastic_strain += s.equivalent_plastic_strain;
-    *mean_plastic_strain /= static_cast<double>(state.viscous_state.size());
+    for (std::size_t e = 0; e < state.viscous_history.size(); ++e)
+      *mean_plastic_strain += state.viscous_history.equivalent_plastic_strain(e);
+    *mean_plastic_strain /= static_cast<double>(state.viscous_history.size());
   }
   return (mean_x(length) - mean_x(0.0)) / length - 1.0;
 }

@@ -303,6 +303,47 @@ TEST(ViscousTissue, ZeroStressAtRest) {
   }
 }
 
+// A mesh's history in blocks: every element starts at rest, and what is stored for one element
+// comes back from it alone, whichever block it is in (130 elements: two full blocks and a part).
+TEST(ViscousHistory, StoresEachElementApartAtRestFirst) {
+  ViscousHistory history(130);
+  ASSERT_EQ(history.size(), 130u);
+  const ViscousTissueState rest;
+  for (std::size_t e = 0; e < history.size(); ++e) {
+    const ViscousTissueState loaded = history.load(e);
+    EXPECT_EQ(loaded.maxwell_stress_pa, rest.maxwell_stress_pa);
+    EXPECT_EQ(loaded.elastic_stress_pa, rest.elastic_stress_pa);
+    EXPECT_EQ(loaded.inverse_plastic_deformation, rest.inverse_plastic_deformation);
+    EXPECT_EQ(loaded.equivalent_plastic_strain, 0.0);
+    EXPECT_EQ(loaded.yield_clock_s, 0.0);
+  }
+  auto distinct = [](std::size_t e) {  // every field of every element a different value
+    ViscousTissueState s;
+    for (int k = 0; k < 6; ++k) {
+      s.maxwell_stress_pa[k] = 1000.0 * e + k;
+      s.elastic_stress_pa[k] = 1000.0 * e + 6 + k;
+    }
+    for (int k = 0; k < 9; ++k) s.inverse_plastic_deformation.data()[k] = 1000.0 * e + 12 + k;
+    s.equivalent_plastic_strain = 1000.0 * e + 21;
+    s.yield_clock_s = 1000.0 * e + 22;
+    return s;
+  };
+  for (std::size_t e = 0; e < history.size(); ++e) history.store(e, distinct(e));
+  for (std::size_t e = 0; e < history.size(); ++e) {
+    const ViscousTissueState expected = distinct(e), loaded = history.load(e);
+    EXPECT_EQ(loaded.maxwell_stress_pa, expected.maxwell_stress_pa);
+    EXPECT_EQ(loaded.elastic_stress_pa, expected.elastic_stress_pa);
+    EXPECT_EQ(loaded.inverse_plastic_deformation, expected.inverse_plastic_deformation);
+    EXPECT_EQ(loaded.yield_clock_s, expected.yield_clock_s);
+    EXPECT_EQ(history.equivalent_plastic_strain(e), expected.equivalent_plastic_strain);
+    EXPECT_EQ(history.inverse_plastic_deformation(e), expected.inverse_plastic_deformation);
+    EXPECT_EQ(history.maxwell_stress_pa(e), expected.maxwell_stress_pa);
+    // Components in ViscousTissueState's order, the layout the element loops read.
+    for (int k = 0; k < ViscousHistory::kComponents; ++k)
+      EXPECT_EQ(history.value(k, e), 1000.0 * e + k);
+  }
+}
+
 TEST(ViscousTissue, TrialEvaluationLeavesTheCommittedStateAlone) {
   const auto tissue = viscoplastic_tissue(10.0, 50.0, 0.5);
   const ViscousTissueStep step(tissue, 0.01);

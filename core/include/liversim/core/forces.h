@@ -59,7 +59,7 @@ struct ViscousArmInputs {
 };
 
 // Internal forces at `position` with the viscous arm given by `arm` (plastic deformation as
-// committed in state.viscous_state); scratch from `state`. The committed viscous state is not
+// committed in state.viscous_history); scratch from `state`. The committed viscous state is not
 // changed. Without viscous regions this is compute_elastic_forces. Allocates nothing.
 ElasticEvaluation compute_internal_forces_rate_form(const SimModel& model, SimState& state,
                                                     const NodeArray& position,

@@ -50,7 +50,7 @@ bool inputs_finite(const StepInputs& inputs);
 // What a rollback restores: the evolving state (not scratch). Sized once by make_checkpoint.
 struct StateCheckpoint {
   NodeArray position_m, velocity_m_per_s;
-  std::vector<ViscousTissueState> viscous_state;
+  ViscousHistory viscous_history;
   EnergyLedger energy;
   double time_s = 0.0;
   std::uint64_t step_count = 0;

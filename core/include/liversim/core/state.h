@@ -115,7 +115,7 @@ struct SimState {
   double last_step_s = 0.0;                  // length of the last step (0 before the first)
   // History of viscous elements, committed at every force evaluation of a step (allocated only
   // when the model's effects.viscous), and the per-region step constants (scratch).
-  std::vector<ViscousTissueState> viscous_state;
+  ViscousHistory viscous_history;
   std::vector<std::optional<ViscousTissueStep>> viscous_step;
   IntegratorScratch integrator;
   EnergyLedger energy;  // books of work in and energy held (energy.h)

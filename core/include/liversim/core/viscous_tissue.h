@@ -13,8 +13,10 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cstddef>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace liversim {
 
@@ -105,6 +107,51 @@ struct ViscousTissueState {
   double equivalent_plastic_strain = 0.0;
   // Time spent above the yield limit (time hardening); it holds, not resets, below the limit.
   double yield_clock_s = 0.0;
+};
+
+// The committed history of every element of a mesh, stored component by component in blocks of
+// kBlock elements (component k of element e at block(e)[k·kBlock + e % kBlock]) so that the
+// element loops read and write several elements per vector instruction, each component of a
+// block at a fixed offset from one pointer. The components are ViscousTissueState's fields in
+// order: H [0, 6), S_e [6, 12) in Voigt order, Fp⁻¹ column-major [12, 21), the equivalent plastic
+// strain and the yield clock.
+class ViscousHistory {
+ public:
+  static constexpr std::size_t kBlock = 64;
+  static constexpr int kMaxwellStress = 0;
+  static constexpr int kElasticStress = 6;
+  static constexpr int kInversePlasticDeformation = 12;
+  static constexpr int kEquivalentPlasticStrain = 21;
+  static constexpr int kYieldClock = 22;
+  static constexpr int kComponents = 23;
+
+  ViscousHistory() = default;
+  // `elements` histories at rest: no stress, Fp = I.
+  explicit ViscousHistory(std::size_t elements);
+
+  std::size_t size() const { return elements_; }
+  std::size_t capacity_bytes() const { return values_.capacity() * sizeof(double); }
+
+  ViscousTissueState load(std::size_t e) const;
+  void store(std::size_t e, const ViscousTissueState& history);
+  Eigen::Matrix3d inverse_plastic_deformation(std::size_t e) const;
+  Voigt6 maxwell_stress_pa(std::size_t e) const;
+  double equivalent_plastic_strain(std::size_t e) const {
+    return value(kEquivalentPlasticStrain, e);
+  }
+
+  double& value(int k, std::size_t e) { return block(e)[k * kBlock + e % kBlock]; }
+  double value(int k, std::size_t e) const {
+    return values_[(e / kBlock * kComponents + k) * kBlock + e % kBlock];
+  }
+  // The block holding element e.
+  double* block(std::size_t e) { return values_.data() + e / kBlock * kComponents * kBlock; }
+
+  bool operator==(const ViscousHistory&) const = default;
+
+ private:
+  std::size_t elements_ = 0;
+  std::vector<double> values_;
 };
 
 // First Piola–Kirchhoff stress P (Pa) at deformation gradient F, `step.dt_s` after the state
