@@ -5,6 +5,12 @@
 
 namespace liversim {
 
+double grab_weight(double distance_m, double radius_m, double lumped_mass_kg) {
+  if (!(distance_m < radius_m)) return 0.0;
+  const double s = 1.0 - (distance_m / radius_m) * (distance_m / radius_m);
+  return s * s * lumped_mass_kg;
+}
+
 Grab grab_surface(const BoundarySurface& surface, const NodeArray& position,
                   const std::vector<double>& lumped_mass_kg, const Eigen::Vector3d& point_m,
                   double radius_m, double total_stiffness_n_per_m) {
@@ -20,9 +26,8 @@ Grab grab_surface(const BoundarySurface& surface, const NodeArray& position,
       nearest = n;
     }
     if (d < radius_m) {
-      const double s = 1.0 - (d / radius_m) * (d / radius_m);
       grab.nodes.push_back(n);
-      weight.push_back(s * s * lumped_mass_kg[n]);
+      weight.push_back(grab_weight(d, radius_m, lumped_mass_kg[n]));
     }
   }
   if (grab.nodes.empty() && nearest >= 0) {

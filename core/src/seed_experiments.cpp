@@ -4,6 +4,7 @@
 #include "liversim/core/grab.h"
 #include "liversim/core/state.h"
 #include "liversim/core/surface.h"
+#include "liversim/core/tools.h"
 
 #include <algorithm>
 #include <chrono>
@@ -49,6 +50,31 @@ void require_finite(const SimState& state, NodeIndex node) {
                              " s (non-finite position)");
 }
 
+// The forceps of the pull experiment: shaft along the pull, jaws closed on `point`.
+Tool pull_forceps(const Eigen::Vector3d& point, const Eigen::Vector3d& direction) {
+  Tool forceps;
+  forceps.kind = ToolKind::forceps;
+  forceps.jaw_opening = 0.0;
+  forceps.pose.orientation =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), direction);
+  forceps.pose.origin_m = point - (forceps_grasp_point_m(forceps) - forceps.pose.origin_m);
+  return forceps;
+}
+
+// Moves the tool so that the springs of its hold pull the tissue with `pull_n` at `position`:
+// a translation δ changes their pull by (Σk)·δ.
+void hold_with_force(const ForcepsGrasp& grasp, const Eigen::Vector3d& pull_n,
+                     const NodeArray& position, Tool& forceps) {
+  Eigen::Vector3d current = Eigen::Vector3d::Zero();
+  double total_stiffness = 0.0;
+  for (std::size_t i = 0; i < grasp.nodes.size(); ++i) {
+    const Eigen::Vector3d anchor = forceps.pose.to_scene(grasp.offset_in_tool_m[i]);
+    current += grasp.stiffness_n_per_m[i] * (anchor - position.at(grasp.nodes[i]));
+    total_stiffness += grasp.stiffness_n_per_m[i];
+  }
+  forceps.pose.origin_m += (pull_n - current) / total_stiffness;
+}
+
 // Net force (internal + load) on the free nodes, summed in magnitude, and the feedback force:
 // minus the internal force summed over the patch. `internal_n` and `scratch` are sized for the
 // model; nothing is allocated.
@@ -56,18 +82,13 @@ struct Balance {
   double residual_l1_n = 0.0;
   Eigen::Vector3d feedback_n = Eigen::Vector3d::Zero();
 };
-Balance force_balance(const SimModel& model, const NodeArray& position, const LoadPatch& patch,
-                      const Eigen::Vector3d& total_load_n, ForceScratch& scratch,
-                      NodeArray& internal_n) {
+Balance force_balance(const SimModel& model, const NodeArray& position, const StepInputs& pull,
+                      ForceScratch& scratch, NodeArray& internal_n) {
   compute_elastic_forces(model, position, scratch, internal_n);
   Balance balance;
-  for (std::size_t i = 0; i < patch.nodes.size(); ++i) {
-    const NodeIndex n = patch.nodes[i];
-    balance.feedback_n -= internal_n.at(n);
-    internal_n.x[n] += patch.weight[i] * total_load_n.x();
-    internal_n.y[n] += patch.weight[i] * total_load_n.y();
-    internal_n.z[n] += patch.weight[i] * total_load_n.z();
-  }
+  for (const PointLoad& load : pull.point_loads) balance.feedback_n -= internal_n.at(load.node);
+  for (const NodeSpring& spring : pull.springs) balance.feedback_n -= internal_n.at(spring.node);
+  add_external_forces(pull, position, internal_n);
   for (std::size_t n = 0; n < model.node_count; ++n)
     if (!model.is_fixed[n]) balance.residual_l1_n += internal_n.at(n).norm();
   return balance;
@@ -200,6 +221,12 @@ PullResult run_pull_experiment(const TetMesh& mesh, const SimModel& model,
   ForceScratch scratch = make_force_scratch(model);
   NodeArray internal_n;
   internal_n.resize(model.node_count);
+  require_positive(settings.forceps_stiffness_n_per_m, "forceps stiffness (N/m)");
+  const bool forceps = settings.attachment == PullAttachment::forceps;
+  const BoundarySurface surface = forceps ? extract_surface(mesh) : BoundarySurface{};
+  GraspSettings hold;
+  hold.radius_m = settings.load_radius_m;
+  hold.total_stiffness_n_per_m = settings.forceps_stiffness_n_per_m;
   std::vector<PointLoad> loads;
   for (double force_n : settings.forces_n) {
     PullCase pull;
@@ -213,18 +240,46 @@ PullResult run_pull_experiment(const TetMesh& mesh, const SimModel& model,
     }
     auto load_at = [&](double t_s) { return std::min(1.0, t_s / settings.ramp_time_s); };
     SimState state = make_rest_state(model);
+    std::optional<ToolInteraction> hand;
+    Tool tool;
+    if (forceps) {
+      hand.emplace(model, surface, ContactSettings{}, hold);
+      tool = pull_forceps(rest, direction);
+      hand->update(tool, state.position_m);
+      if (!hand->grasping())
+        throw std::runtime_error("the forceps closed on no tissue at node " + std::to_string(node));
+      pull.held_nodes = hand->grasp()->nodes.size();
+    } else {
+      pull.held_nodes = result.patch.nodes.size();
+    }
+    // The pull at time t, as the step's inputs (the forceps moved to pull with it).
+    auto inputs_at = [&](double t_s) -> StepInputs {
+      const Eigen::Vector3d pull_n = load_at(t_s) * pull.applied_n;
+      if (!forceps) {
+        spread_load(result.patch, pull_n, loads);
+        return {loads, {}};
+      }
+      hold_with_force(*hand->grasp(), pull_n, state.position_m, tool);
+      return {{}, hand->update(tool, state.position_m)};
+    };
     double window_start_s = -1.0;  // first check of the current run of passing checks
     Balance balance;
     const auto wall_start = Clock::now();
     for (int k = 1; k <= max_checks; ++k) {
       const double t0_s = state.time_s;
       const double t1_s = k * settings.check_interval_s;
-      spread_load(result.patch, load_at(0.5 * (t0_s + t1_s)) * pull.applied_n, loads);
-      accumulate(pull.steps, advance(model, state, StepInputs{loads, {}}, t1_s - t0_s));
+      if (forceps) {  // the hand follows the tissue every millisecond
+        const int substeps = interval_count(t1_s - t0_s, 1e-3);
+        for (int s = 0; s < substeps; ++s) {
+          const double a_s = t0_s + (t1_s - t0_s) * s / substeps;
+          const double b_s = t0_s + (t1_s - t0_s) * (s + 1) / substeps;
+          accumulate(pull.steps, advance(model, state, inputs_at(0.5 * (a_s + b_s)), b_s - a_s));
+        }
+      } else {
+        accumulate(pull.steps, advance(model, state, inputs_at(0.5 * (t0_s + t1_s)), t1_s - t0_s));
+      }
       require_finite(state, node);
-      const Eigen::Vector3d load_now_n = load_at(t1_s) * pull.applied_n;
-      balance =
-          force_balance(model, state.position_m, result.patch, load_now_n, scratch, internal_n);
+      balance = force_balance(model, state.position_m, inputs_at(t1_s), scratch, internal_n);
       if (settings.record_history) {
         pull.history_time_s.push_back(t1_s);
         pull.history_feedback_along_load_n.push_back(balance.feedback_n.dot(direction));

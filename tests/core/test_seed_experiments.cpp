@@ -80,6 +80,29 @@ TEST_F(SeedExperimentFixture, PullFeedbackMatchesTheAppliedForceWithinTheSettleB
   EXPECT_EQ(pull.history_time_s.size(), pull.history_feedback_along_load_n.size());
 }
 
+// The seed's fidelity check with the forceps (issue 7): closed on the marked point, pulled by a
+// hand with 0.93, 1.65 and 2.96 N; at equilibrium the tissue's reaction on the held nodes (the
+// feedback force) matches the pull within the settle bound R/F ≤ 1e-3 (the same triangle
+// inequality: feedback − pull = −Σ_held (f_int + f_hold), |·| ≤ R).
+TEST_F(SeedExperimentFixture, ForcepsPullFeedbackMatchesEachSeedForce) {
+  PullSettings settings;
+  settings.attachment = PullAttachment::forceps;
+  settings.residual_tolerance = 1e-3;
+  settings.record_history = false;
+  const PullResult result = run_pull_experiment(scene_->mesh, *model_, settings);
+  ASSERT_EQ(result.cases.size(), std::size(kSeedPullForcesN));
+  double previous_displacement_mm = 0.0;
+  for (const PullCase& pull : result.cases) {
+    ASSERT_TRUE(pull.settled) << pull.applied_force_n << " N: residual " << pull.residual_l1_n
+                              << " N at " << pull.settle_time_s << " s";
+    EXPECT_GT(pull.held_nodes, 1u);
+    EXPECT_LE(pull.bound_relative_error, settings.residual_tolerance);
+    EXPECT_LE(pull.relative_error, pull.bound_relative_error + 1e-12);
+    EXPECT_GT(pull.displacement_mm, previous_displacement_mm);  // a harder pull pulls further
+    previous_displacement_mm = pull.displacement_mm;
+  }
+}
+
 // The criterion is not met trivially: right after the ramp the liver is still moving.
 TEST_F(SeedExperimentFixture, PullIsNotSettledWhileTheTissueStillMoves) {
   PullSettings settings;

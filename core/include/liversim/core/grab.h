@@ -21,6 +21,10 @@ struct Grab {
   bool empty() const { return nodes.empty(); }
 };
 
+// How much of a grab's stiffness a node at distance_m from the grab point takes: its lumped mass
+// times the smooth bump (1 − (d/r)²)² (0 at and beyond the radius).
+double grab_weight(double distance_m, double radius_m, double lumped_mass_kg);
+
 // Surface nodes within radius_m of the point, each weighted by its lumped mass times a smooth bump
 // (1 − (d/r)²)², so that every grabbed node has the same spring frequency and a light corner node
 // is not yanked alone; when no node is that close, the nearest surface node alone.

@@ -83,10 +83,18 @@ CreepResult run_creep_experiment(const TetMesh& mesh, const SimModel& model,
 
 inline constexpr double kSeedPullForcesN[] = {0.93, 1.65, 2.96};
 
+// How the pull reaches the tissue: as point loads spread over the patch, or through the forceps
+// (tools.h): closed on the marked point at rest, shaft along the pull, and held by a hand that
+// pulls with the given force (the tool is moved before every 1 ms interval so that its hold pulls
+// with exactly that force: a massless handle under a constant force).
+enum class PullAttachment { load_patch, forceps };
+
 struct PullSettings {
   std::vector<double> forces_n{std::begin(kSeedPullForcesN), std::end(kSeedPullForcesN)};
   Eigen::Vector3d direction = kSeedPullDirection;  // unit vector
   double load_radius_m = 0.02;                     // the forceps' grabbed patch
+  PullAttachment attachment = PullAttachment::load_patch;
+  double forceps_stiffness_n_per_m = 2000.0;  // the forceps' hold, all nodes together
   // The force rises linearly over this time (less ringing than a step; equilibrium is the same).
   double ramp_time_s = 0.2;
   // Settled: the summed magnitude of the net nodal forces (internal + load) over all free nodes is
@@ -105,6 +113,7 @@ struct PullCase {
   // −Σ over the grabbed nodes of their internal (elastic) force: what the tissue pushes back on
   // the forceps with.
   Eigen::Vector3d feedback_n = Eigen::Vector3d::Zero();
+  std::size_t held_nodes = 0;         // nodes the load or the forceps' hold acts on
   double relative_error = 0.0;        // |feedback − applied| / |applied|
   double residual_l1_n = 0.0;         // Σ_free |internal + load| at the end
   double bound_relative_error = 0.0;  // residual_l1_n / |applied| ≥ relative_error
