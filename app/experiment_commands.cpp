@@ -191,30 +191,37 @@ int pull_experiment(const PullExperimentOptions& o) {
     settings.load_radius_m = o.load_radius_m;
     settings.residual_tolerance = o.residual_tolerance;
     settings.max_time_s = o.max_time_s;
+    const bool forceps = o.attachment == "forceps";
+    settings.attachment = forceps ? PullAttachment::forceps : PullAttachment::load_patch;
     const PullResult result = run_pull_experiment(built.scene.mesh, built.model, settings);
 
     std::cout << std::setprecision(5) << "experiment pull: " << built.scene.description
-              << "; forceps load along +z (anterior) on node " << result.patch.marked_node
-              << " spread over " << result.patch.nodes.size() << " surface nodes within "
-              << o.load_radius_m * 1e3 << " mm, rising over " << settings.ramp_time_s
+              << (forceps ? "; the forceps closed on node " : "; forceps load along +z on node ")
+              << result.patch.marked_node
+              << (forceps ? ", holding the surface nodes within "
+                          : ", spread over the surface "
+                            "nodes within ")
+              << o.load_radius_m * 1e3
+              << " mm, pulled along +z (anterior) with a force rising over " << settings.ramp_time_s
               << " s, then held\n"
               << "settled: sum over free nodes of |internal + load| <= " << o.residual_tolerance
               << " x applied force at every check (every " << settings.check_interval_s
               << " s) for " << settings.settle_window_s
               << " s; this bounds |feedback - applied| / applied by " << o.residual_tolerance
               << "\n\n"
-              << "| applied (N) | feedback along load (N) | relative error | bound | settled at "
-                 "(s) | displacement (mm) | wall (s) |\n"
-              << "|---:|---:|---:|---:|---:|---:|---:|\n";
+              << "| applied (N) | held nodes | feedback along load (N) | relative error | bound | "
+                 "settled at (s) | displacement (mm) | wall (s) |\n"
+              << "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     bool all_settled = true;
     for (const PullCase& c : result.cases) {
       all_settled = all_settled && c.settled;
       std::cout << std::defaultfloat << std::setprecision(6) << "| " << c.applied_force_n << " | "
-                << std::fixed << std::setprecision(6) << c.feedback_n.dot(settings.direction)
-                << " | " << std::scientific << std::setprecision(2) << c.relative_error << " | "
-                << c.bound_relative_error << " | " << std::fixed << std::setprecision(2)
-                << c.settle_time_s << (c.settled ? "" : " (not settled)") << " | "
-                << c.displacement_mm << " | " << c.wall_time_s << " |\n";
+                << c.held_nodes << " | " << std::fixed << std::setprecision(6)
+                << c.feedback_n.dot(settings.direction) << " | " << std::scientific
+                << std::setprecision(2) << c.relative_error << " | " << c.bound_relative_error
+                << " | " << std::fixed << std::setprecision(2) << c.settle_time_s
+                << (c.settled ? "" : " (not settled)") << " | " << c.displacement_mm << " | "
+                << c.wall_time_s << " |\n";
     }
     std::cout << std::defaultfloat << std::setprecision(5) << "\n";
     for (const PullCase& c : result.cases)
@@ -466,6 +473,12 @@ std::function<std::optional<int>()> add_experiment_command(CLI::App& app) {
                    "Settled when the summed |net nodal force| is below this times the force")
       ->capture_default_str();
   pull_cmd->add_option("--max-time", pull.max_time_s, "Give up after this simulated time (s)")
+      ->capture_default_str();
+  pull_cmd
+      ->add_option("--attachment", pull.attachment,
+                   "How the pull reaches the tissue: patch (point loads over the patch) or forceps "
+                   "(the forceps close on the marked point and a hand pulls them with the force)")
+      ->check(CLI::IsMember({"patch", "forceps"}))
       ->capture_default_str();
   pull_cmd->add_option("--csv", pull.csv_output, "Write one row per force");
   pull_cmd->add_option("--history-csv", pull.history_csv_output,

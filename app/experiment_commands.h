@@ -39,6 +39,7 @@ struct PullExperimentOptions {
   double load_radius_m = 0.02;
   double residual_tolerance = 1e-3;
   double max_time_s = 30.0;
+  std::string attachment = "patch";  // "patch": point loads; "forceps": the forceps' hold
   std::optional<std::filesystem::path> csv_output, history_csv_output, plot_output;
 };
 
