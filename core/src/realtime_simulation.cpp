@@ -92,6 +92,21 @@ void RealtimeSimulation::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
+void RealtimeSimulation::enable_tools(const BoundarySurface& surface, ContactSettings contact,
+                                      GraspSettings grasp) {
+  if (running()) throw std::logic_error("enable_tools: stop the simulation first");
+  tools_.emplace(*model_, surface, contact, grasp);
+  // The set springs and at most two per surface node from the tool (hold and contact): no
+  // reallocation in a step.
+  step_springs_.reserve(options_.spring_capacity + 2 * surface.nodes.size());
+}
+
+void RealtimeSimulation::set_tool(const std::optional<Tool>& tool) {
+  std::lock_guard lock(springs_mutex_);
+  pending_tool_ = tool;
+  tool_changed_ = true;
+}
+
 bool RealtimeSimulation::set_springs(std::span<const NodeSpring> springs) {
   const std::size_t count = std::min(springs.size(), options_.spring_capacity);
   std::lock_guard lock(springs_mutex_);
@@ -122,6 +137,24 @@ RealtimeStats RealtimeSimulation::stats() const {
   stats.dissipated_fraction = dissipated_fraction_.load();
   return stats;
 }
+
+namespace {
+
+// The reports of consecutive guarded advances as one.
+void merge_guarded(GuardedReport& total, const GuardedReport& one) {
+  accumulate(total.steps, one.steps);
+  total.rollbacks += one.rollbacks;
+  if (one.problem != HealthProblem::none) total.problem = one.problem;
+  total.step_scale = one.step_scale;
+  total.gave_up = total.gave_up || one.gave_up;
+  total.inputs_rejected = total.inputs_rejected || one.inputs_rejected;
+  if (one.energy) {
+    total.energy = one.energy;
+    total.energy_created = one.energy_created;
+  }
+}
+
+}  // namespace
 
 void RealtimeSimulation::run() {
   using Clock = std::chrono::steady_clock;
@@ -154,7 +187,12 @@ void RealtimeSimulation::run() {
         active_springs_.assign(pending_springs_.begin(), pending_springs_.end());  // no realloc
         springs_changed_ = false;
       }
+      if (tool_changed_) {
+        active_tool_ = pending_tool_;
+        tool_changed_ = false;
+      }
     }
+    const bool tool_acts = tools_ && active_tool_;
     const StepInputs inputs{{}, active_springs_};
     const auto cycle_start = Clock::now();
     const StepAccumulator::Due due = clock.add(Seconds(cycle_start - last_cycle).count());
@@ -169,8 +207,26 @@ void RealtimeSimulation::run() {
       GuardOptions guard;
       guard.check_energy = close_books;  // one pass over the elements, once per window
       close_books = false;
-      const GuardedReport guarded =
-          guarded_advance(model, state_, inputs, due.steps * step_s_, checkpoint_, guard);
+      // A tool's springs follow the surface: recomputed before every step of the cycle.
+      auto tool_inputs = [&] {
+        step_springs_.assign(active_springs_.begin(), active_springs_.end());
+        const auto tool_springs = tools_->update(*active_tool_, state_.position_m);
+        step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
+        return StepInputs{{}, step_springs_};
+      };
+      GuardedReport guarded;
+      if (tool_acts) {
+        for (int s = 0; s < due.steps; ++s) {
+          GuardOptions step_guard = guard;
+          step_guard.check_energy = guard.check_energy && s == 0;
+          const GuardedReport one =
+              guarded_advance(model, state_, tool_inputs(), step_s_, checkpoint_, step_guard);
+          merge_guarded(guarded, one);
+          if (one.gave_up) break;
+        }
+      } else {
+        guarded = guarded_advance(model, state_, inputs, due.steps * step_s_, checkpoint_, guard);
+      }
       if (guarded.energy) {
         energy_created_ = guarded.energy_created;
         const double supplied = guarded.energy->supplied_j();
@@ -189,6 +245,10 @@ void RealtimeSimulation::run() {
       out.position_m.z = state_.position_m.z;
       out.time_s = state_.time_s;
       out.step_count = state_.step_count;
+      out.tool_force_n =
+          tool_acts ? tools_->force_on_tool_n(state_.position_m) : Eigen::Vector3d::Zero();
+      out.tool_grasping = tool_acts && tools_->grasping();
+      out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
       snapshots_.publish();
     } else {
       // Sleep towards the next step, but wake often enough to stop and to pick up springs.

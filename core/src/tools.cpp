@@ -266,7 +266,7 @@ ToolInteraction::ToolInteraction(const SimModel& model, const BoundarySurface& s
     throw std::invalid_argument(
         "grasp settings are invalid: expected radius > 0, stiffness > 0 and the closing opening "
         "below the releasing one");
-  springs_.reserve(surface.nodes.size());
+  springs_.reserve(2 * surface.nodes.size());  // a hold and a contact spring per node at most
 }
 
 void ToolInteraction::try_grasp(const Tool& tool, const NodeArray& position) {

@@ -6,6 +6,7 @@
 #include "liversim/core/integrator.h"
 #include "liversim/core/liver_geometry.h"
 #include "liversim/core/realtime_simulation.h"
+#include "liversim/core/surface.h"
 
 #include <gtest/gtest.h>
 
@@ -223,6 +224,52 @@ TEST_F(RealtimeSteppingFixture, TheLoopKeepsTheEnergyBooks) {
   EXPECT_FALSE(stats.energy_created);
   EXPECT_GT(stats.dissipated_fraction, 0.0) << "damping takes energy out";
   EXPECT_LE(stats.dissipated_fraction, 1.0) << "no more than was supplied";
+}
+
+// A tool in the running loop (issue 7): forceps closed on the anterior surface and lifted 1 cm
+// hold the tissue; the published force on them points back down (the tissue pulls back), and the
+// held point follows the forceps up. Opened, they let go and feel nothing.
+TEST_F(RealtimeSteppingFixture, ForcepsInTheLoopHoldPullAndRelease) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(*mesh_));
+  ASSERT_TRUE(simulation.tools_enabled());
+  const NodeIndex node = anterior_marked_node(*mesh_);
+  const Eigen::Vector3d marked = model->rest_position_m.at(node);
+  Tool forceps;
+  forceps.kind = ToolKind::forceps;
+  forceps.jaw_opening = 0.0;
+  // Shaft along +z, the anterior normal there; the grasp point on the marked node.
+  forceps.pose.origin_m = marked - (forceps_grasp_point_m(forceps) - forceps.pose.origin_m);
+  simulation.set_tool(forceps);
+  simulation.start();
+  auto newest = [&] {
+    simulation.update_snapshot();
+    return simulation.snapshot();
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!newest().tool_grasping && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(newest().tool_grasping) << "the forceps closed on the surface took no hold";
+  forceps.pose.origin_m.z() += 0.01;
+  simulation.set_tool(forceps);
+  // Until the held point has come up by half the lift (a second of simulated time at most).
+  SimulationSnapshot seen = newest();
+  const double start_s = seen.time_s;
+  while (seen.position_m.z[node] - marked.z() < 0.005 && seen.time_s < start_s + 1.0 &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    seen = newest();
+  }
+  EXPECT_GT(seen.position_m.z[node] - marked.z(), 0.005);
+  EXPECT_LT(seen.tool_force_n.z(), 0.0) << "the tissue pulls the forceps back down";
+  forceps.jaw_opening = 1.0;
+  simulation.set_tool(forceps);
+  while (newest().tool_grasping && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  simulation.stop();
+  EXPECT_FALSE(simulation.snapshot().tool_grasping);
+  EXPECT_EQ(check_health(*model, simulation.state()), HealthProblem::none);
 }
 
 }  // namespace

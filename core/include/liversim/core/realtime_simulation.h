@@ -12,6 +12,7 @@
 #include "liversim/core/health.h"
 #include "liversim/core/model.h"
 #include "liversim/core/state.h"
+#include "liversim/core/tools.h"
 #include "liversim/core/triple_buffer.h"
 
 #include <atomic>
@@ -19,6 +20,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string_view>
 #include <thread>
@@ -30,6 +32,11 @@ struct SimulationSnapshot {
   NodeArray position_m;
   double time_s = 0.0;
   std::uint64_t step_count = 0;
+  // The tool (when tools are enabled and one is set): the tissue's force on it after the last
+  // step, whether the forceps hold tissue, and how many nodes its contact pushes.
+  Eigen::Vector3d tool_force_n = Eigen::Vector3d::Zero();
+  bool tool_grasping = false;
+  std::size_t tool_contacts = 0;
 };
 
 struct RealtimeStats {
@@ -126,6 +133,16 @@ class RealtimeSimulation {
   bool set_springs(std::span<const NodeSpring> springs);
   void clear_springs() { set_springs({}); }
 
+  // Tools (tools.h) touch `surface` (the model's boundary); call while stopped. From then on the
+  // tool set by set_tool acts at every step: its contact and grasp springs are recomputed from the
+  // deforming surface before each step, besides the springs above.
+  void enable_tools(const BoundarySurface& surface, ContactSettings contact = {},
+                    GraspSettings grasp = {});
+  bool tools_enabled() const { return tools_.has_value(); }
+  // The tool's kind, pose and jaws from any thread (nothing: no tool in the scene); the newest
+  // is used from the next cycle on.
+  void set_tool(const std::optional<Tool>& tool);
+
   // Consumer side (one thread, e.g. the UI): the newest snapshot, if one was published since.
   bool update_snapshot() { return snapshots_.update(); }
   const SimulationSnapshot& snapshot() const { return snapshots_.front(); }
@@ -154,6 +171,11 @@ class RealtimeSimulation {
   std::vector<NodeSpring> pending_springs_;
   bool springs_changed_ = false;
   std::vector<NodeSpring> active_springs_;  // simulation thread's copy
+  std::optional<Tool> pending_tool_;        // under springs_mutex_
+  bool tool_changed_ = false;
+  std::optional<Tool> active_tool_;       // simulation thread's copy
+  std::optional<ToolInteraction> tools_;  // simulation thread only once started
+  std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tool's
 
   std::atomic<bool> stop_requested_{false};
   // Statistics, written by the simulation thread once per window; each field on its own (a reader
