@@ -2,19 +2,23 @@
 
 #include "accuracy_panel.h"
 #include "render/liver_scene.h"
+#include "tool_panel.h"
 #include "vtk_viewport.h"
 
 #include "liversim/core/integrator.h"
 #include "liversim/core/surface.h"
 
+#include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
 #include <QDockWidget>
+#include <QGuiApplication>
 #include <QLabel>
 #include <QStatusBar>
 
 #include <cmath>
 #include <exception>
+#include <numbers>
 #include <string_view>
 
 namespace liversim {
@@ -38,6 +42,8 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   auto model = std::make_shared<const SimModel>(build_model(setup_.mesh, setup_.model_options));
   simulation_ =
       std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
+  toolSurface_ = extract_surface(setup_.mesh);
+  simulation_->enable_tools(toolSurface_);
   scene_ = std::make_unique<LiverScene>(setup_.mesh, setup_.visual);
 
   viewport_ = new VtkViewport(this);
@@ -49,9 +55,11 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
       });
   connect(viewport_, &VtkViewport::mouseMovedTo, this, [this](QPoint pos, Qt::MouseButtons) {
     if (grab_) moveGrab(pos);
+    if (tool_) moveTool(pos);
   });
   connect(viewport_, &VtkViewport::mouseReleasedAt, this, [this](QPoint, Qt::MouseButton button) {
     if (grab_ && button == Qt::LeftButton) endGrab();
+    if (tool_ && button == Qt::LeftButton) endTool();
   });
   connect(viewport_, &QOpenGLWidget::frameSwapped, this, [this] { ++framesInWindow_; });
   setCentralWidget(viewport_);
@@ -66,6 +74,14 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   accuracyDock->setWidget(accuracyPanel_);
   accuracyDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
   addDockWidget(Qt::RightDockWidgetArea, accuracyDock);
+
+  toolPanel_ = new ToolPanel(this);
+  toolPanel_->setObjectName("toolPanel");
+  auto* toolDock = new QDockWidget(tr("Tool"), this);
+  toolDock->setObjectName("toolDock");
+  toolDock->setWidget(toolPanel_);
+  toolDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
+  addDockWidget(Qt::RightDockWidgetArea, toolDock);
 
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("simulationStatus");
@@ -149,6 +165,8 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
     return;
   }
   if (grab_) simulation_->set_springs(springs_);
+  simulation_->enable_tools(toolSurface_);
+  if (tool_) simulation_->set_tool(tool_);
   simulation_->start();
   setup_.model_options.integrator = settings;
   accuracyPanel_->setSettings(settings);
@@ -157,8 +175,9 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
 
 bool MainWindow::beginGrab(QPoint pos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers) {
   // While the tissue is held, other buttons must not move the camera under the handle.
-  if (grab_) return true;
+  if (grab_ || tool_) return true;
   if (button != Qt::LeftButton || modifiers != Qt::NoModifier) return false;
+  if (const auto kind = toolPanel_->tool()) return beginTool(*kind, pos);
   const auto hit = scene_->pick(pos.x(), pos.y());
   if (!hit) return false;  // background: the camera takes the drag
   grab_ = grab_surface(scene_->surface(), simulation_->snapshot().position_m,
@@ -184,9 +203,87 @@ void MainWindow::endGrab() {
   scene_->show_grab_marker(std::nullopt);
 }
 
+// The tool is put on the liver where the mouse presses, its shaft toward the viewer and tilted up
+// by 35° (as a laparoscopic instrument comes in through a port, and so that it shows): the probe's
+// ball on the surface, the forceps' jaws closed on it, the blade's tip touching it.
+bool MainWindow::beginTool(ToolKind kind, QPoint pos) {
+  const auto hit = scene_->pick(pos.x(), pos.y());
+  if (!hit) return false;  // background: the camera takes the drag
+  double direction[3], up[3];
+  vtkCamera* camera = scene_->renderer()->GetActiveCamera();
+  camera->GetDirectionOfProjection(direction);
+  camera->GetViewUp(up);
+  const Eigen::Vector3d toward_viewer =
+      -Eigen::Vector3d(direction[0], direction[1], direction[2]).normalized();
+  const Eigen::Vector3d view_up = Eigen::Vector3d(up[0], up[1], up[2]).normalized();
+  constexpr double kTiltRad = 35.0 * std::numbers::pi / 180.0;
+  const Eigen::Vector3d shaft_direction =
+      (std::cos(kTiltRad) * toward_viewer + std::sin(kTiltRad) * view_up).normalized();
+  Tool tool;
+  tool.kind = kind;
+  tool.jaw_opening = 0.0;
+  tool.pose.orientation =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), shaft_direction);
+  const Eigen::Vector3d shaft = tool.pose.orientation * Eigen::Vector3d::UnitZ();
+  switch (kind) {
+    case ToolKind::probe:
+      tool.pose.origin_m = hit->point_m + tool.geometry.probe_tip_radius_m * shaft;
+      break;
+    case ToolKind::forceps:
+      tool.pose.origin_m = hit->point_m - (forceps_grasp_point_m(tool) - tool.pose.origin_m);
+      break;
+    case ToolKind::scalpel:
+      tool.pose.origin_m = hit->point_m + tool.geometry.blade_length_m * shaft;
+      break;
+  }
+  tool_ = tool;
+  toolPoint_m_ = hit->point_m;
+  simulation_->set_tool(tool_);
+  showTool();
+  return true;
+}
+
+// Dragging moves the tool in the view plane; with Shift, up and down the screen move it along its
+// shaft (down pushes it in).
+void MainWindow::moveTool(QPoint pos) {
+  const Eigen::Vector3d point = scene_->display_to_world(pos.x(), pos.y(), toolPoint_m_);
+  Eigen::Vector3d move = point - toolPoint_m_;
+  if (QGuiApplication::keyboardModifiers() & Qt::ShiftModifier) {
+    const Eigen::Vector2d from = scene_->world_to_display(toolPoint_m_);
+    const double up = pos.y() > from.y() ? 1.0 : -1.0;  // display y grows upward
+    const Eigen::Vector3d shaft = tool_->pose.orientation * Eigen::Vector3d::UnitZ();
+    move = up * move.norm() * shaft;
+  }
+  tool_->pose.origin_m += move;
+  toolPoint_m_ += move;
+  simulation_->set_tool(tool_);
+  showTool();
+}
+
+void MainWindow::endTool() {
+  tool_.reset();
+  simulation_->set_tool(std::nullopt);  // the forceps let go as they leave
+  showTool();
+}
+
+void MainWindow::showTool() {
+  std::array<Capsule, 3> parts;
+  const int count = tool_ ? tool_capsules(*tool_, parts) : 0;
+  scene_->show_tool(std::span<const Capsule>(parts.data(), static_cast<std::size_t>(count)));
+  viewport_->scheduleRender();
+}
+
 void MainWindow::showNewestSnapshot() {
   if (simulation_->update_snapshot()) {
-    scene_->update_positions(simulation_->snapshot().position_m);
+    const SimulationSnapshot& snapshot = simulation_->snapshot();
+    scene_->update_positions(snapshot.position_m);
+    if (tool_)
+      toolPanel_->showForce(snapshot.time_s, snapshot.tool_force_n, snapshot.tool_grasping);
+    else if (grab_)
+      toolPanel_->showForce(snapshot.time_s,
+                            grab_reaction_force_n(*grab_, handle_m_, snapshot.position_m), true);
+    else
+      toolPanel_->showForce(snapshot.time_s, Eigen::Vector3d::Zero(), false);
     viewport_->scheduleRender();
   }
 }

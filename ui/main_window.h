@@ -21,6 +21,7 @@ namespace liversim {
 
 class AccuracyPanel;
 class LiverScene;
+class ToolPanel;
 class VtkViewport;
 
 class MainWindow : public QMainWindow {
@@ -35,6 +36,9 @@ class MainWindow : public QMainWindow {
   RealtimeSimulation& simulation() { return *simulation_; }
   const Grab* activeGrab() const { return grab_ ? &*grab_ : nullptr; }
   AccuracyPanel* accuracyPanel() const { return accuracyPanel_; }
+  ToolPanel* toolPanel() const { return toolPanel_; }
+  // The tool the mouse holds in the scene, if any (tools other than the hand).
+  const std::optional<Tool>& heldTool() const { return tool_; }
 
   // Rebuilds the model with these integrator settings on a worker thread (the simulation runs on
   // meanwhile; a large mesh takes seconds), then restarts the simulation from the liver's current
@@ -55,6 +59,10 @@ class MainWindow : public QMainWindow {
   bool beginGrab(QPoint vtkDisplayPos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers);
   void moveGrab(QPoint vtkDisplayPos);
   void endGrab();
+  bool beginTool(ToolKind kind, QPoint vtkDisplayPos);
+  void moveTool(QPoint vtkDisplayPos);
+  void endTool();
+  void showTool();
   void finishIntegratorChange(const IntegratorSettings& settings,
                               std::shared_ptr<const SimModel> model, const QString& error);
   void showNewestSnapshot();
@@ -68,6 +76,7 @@ class MainWindow : public QMainWindow {
   std::unique_ptr<LiverScene> scene_;
   VtkViewport* viewport_ = nullptr;
   AccuracyPanel* accuracyPanel_ = nullptr;
+  ToolPanel* toolPanel_ = nullptr;
   QLabel* statusLabel_ = nullptr;
   QTimer frameTimer_;
   QTimer statusTimer_;
@@ -75,6 +84,10 @@ class MainWindow : public QMainWindow {
   std::optional<Grab> grab_;
   Eigen::Vector3d handle_m_ = Eigen::Vector3d::Zero();
   std::vector<NodeSpring> springs_;
+
+  std::optional<Tool> tool_;
+  Eigen::Vector3d toolPoint_m_ = Eigen::Vector3d::Zero();  // where the mouse holds the tool
+  BoundarySurface toolSurface_;                            // the physics surface tools touch
 
   int framesInWindow_ = 0;
   QElapsedTimer frameWindow_;

@@ -190,6 +190,7 @@ void RealtimeSimulation::run() {
       if (tool_changed_) {
         active_tool_ = pending_tool_;
         tool_changed_ = false;
+        if (!active_tool_ && tools_) tools_->release();
       }
     }
     const bool tool_acts = tools_ && active_tool_;

@@ -16,6 +16,7 @@
 #include <QLabel>
 #include <QMouseEvent>
 #include <QPushButton>
+#include <QRadioButton>
 #include <QSignalSpy>
 #include <QTest>
 #include <algorithm>
@@ -33,6 +34,7 @@
 #include "liversim/core/integrator.h"
 #include "main_window.h"
 #include "render/liver_scene.h"
+#include "tool_panel.h"
 #include "vtk_viewport.h"
 
 namespace liversim {
@@ -314,6 +316,44 @@ TEST_F(MainWindowTest, DraggingTheLiverPullsItAndItSpringsBackAfterTheRelease) {
   std::cout << "largest displacement 2 s after the release " << residual_m * 1e3 << " mm\n";
   EXPECT_LT(residual_m, 1e-3) << "the liver did not spring back: largest displacement "
                               << residual_m * 1e3 << " mm, 2 s after the release";
+}
+
+// The forceps chosen in the Tool panel (issue 7): pressing on the liver closes them on it, the
+// drag pulls the tissue, the panel shows the force on them and its trace; releasing lets go. The
+// rendered picture shows the tool while it is held.
+TEST_F(MainWindowTest, ForcepsFromTheToolPanelHoldPullAndLetGo) {
+  const std::optional<QPoint> start = pointOnTheLiver();
+  ASSERT_TRUE(start);
+  auto* forceps = window_->toolPanel()->findChild<QRadioButton*>("toolForceps");
+  ASSERT_NE(forceps, nullptr);
+  forceps->click();
+  ASSERT_EQ(window_->toolPanel()->tool(), ToolKind::forceps);
+
+  const QImage before = window_->viewport()->grabRendering();
+  pictures_.emplace_back("before", before);
+  bool heldThroughout = true;
+  pressAndMove(*start, *start + kDrag, [&] { heldThroughout &= window_->heldTool().has_value(); });
+  EXPECT_TRUE(heldThroughout);
+  EXPECT_EQ(window_->activeGrab(), nullptr) << "a tool is not the hand's grab";
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().tool_grasping; },
+                              kSimulatedTimeTimeoutMs))
+      << "the forceps closed on the liver took no hold";
+  ASSERT_TRUE(waitSimulated(0.3));
+  const SimulationSnapshot held = window_->simulation().snapshot();
+  EXPECT_GT(held.tool_force_n.norm(), 0.0) << "the held tissue pulls on the forceps";
+  EXPECT_TRUE(window_->toolPanel()->forceText().contains("holding tissue"));
+  EXPECT_GT(window_->toolPanel()->trace()->sampleCount(), 1u);
+  EXPECT_GT(maxDisplacementFromRest(), 0.002) << "the pull moved the liver";
+  const QImage holding = window_->viewport()->grabRendering();
+  pictures_.emplace_back("holding", holding);
+  EXPECT_GT(countDifferentPixels(before, holding), 100) << "neither the tool nor the pull shows";
+
+  release(*start + kDrag);
+  EXPECT_FALSE(window_->heldTool().has_value());
+  ASSERT_TRUE(QTest::qWaitFor([&] { return !window_->simulation().snapshot().tool_grasping; },
+                              kSimulatedTimeTimeoutMs));
+  ASSERT_TRUE(waitSimulated(0.05));
+  EXPECT_EQ(window_->simulation().snapshot().tool_force_n.norm(), 0.0);
 }
 
 TEST_F(MainWindowTest, DraggingTheBackgroundTurnsTheCameraAndGrabsNothing) {

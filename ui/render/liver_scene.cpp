@@ -8,6 +8,7 @@
 #include <vtkCellPicker.h>
 #include <vtkFloatArray.h>
 #include <vtkLight.h>
+#include <vtkLineSource.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -16,6 +17,7 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkSphereSource.h>
+#include <vtkTubeFilter.h>
 
 #include <stdexcept>
 
@@ -25,6 +27,7 @@ namespace {
 // Liver parenchyma: a dark red-brown with a moist sheen.
 constexpr double kTissueColour[3] = {0.52, 0.17, 0.13};
 constexpr double kBackgroundTop[3] = {0.16, 0.18, 0.22};
+constexpr double kSteel[3] = {0.7, 0.72, 0.75};
 constexpr double kBackgroundBottom[3] = {0.05, 0.05, 0.07};
 
 }  // namespace
@@ -72,6 +75,33 @@ LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual) : visual_(std:
   grab_marker_->VisibilityOff();
   grab_marker_->PickableOff();
   renderer_->AddActor(grab_marker_);
+
+  for (ToolPart& part : tool_parts_) {
+    part.line = vtkSmartPointer<vtkLineSource>::New();
+    part.tube = vtkSmartPointer<vtkTubeFilter>::New();
+    part.tube->SetInputConnection(part.line->GetOutputPort());
+    part.tube->SetNumberOfSides(20);
+    auto add_actor = [&](vtkAlgorithmOutput* output) {
+      auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+      mapper->SetInputConnection(output);
+      auto actor = vtkSmartPointer<vtkActor>::New();
+      actor->SetMapper(mapper);
+      actor->GetProperty()->SetColor(kSteel[0], kSteel[1], kSteel[2]);
+      actor->GetProperty()->SetSpecular(0.8);
+      actor->GetProperty()->SetSpecularPower(40.0);
+      actor->VisibilityOff();
+      actor->PickableOff();  // picks hit the liver through the tool
+      renderer_->AddActor(actor);
+      return actor;
+    };
+    part.actors[0] = add_actor(part.tube->GetOutputPort());
+    for (int k = 0; k < 2; ++k) {
+      part.end[k] = vtkSmartPointer<vtkSphereSource>::New();
+      part.end[k]->SetThetaResolution(20);
+      part.end[k]->SetPhiResolution(12);
+      part.actors[1 + k] = add_actor(part.end[k]->GetOutputPort());
+    }
+  }
 
   renderer_->GradientBackgroundOn();
   renderer_->SetBackground(kBackgroundBottom[0], kBackgroundBottom[1], kBackgroundBottom[2]);
@@ -126,6 +156,26 @@ void LiverScene::reset_camera() {
 void LiverScene::show_grab_marker(const std::optional<Eigen::Vector3d>& point_m) {
   if (point_m) grab_marker_->SetPosition(point_m->x(), point_m->y(), point_m->z());
   grab_marker_->SetVisibility(point_m.has_value());
+}
+
+void LiverScene::show_tool(std::span<const Capsule> parts) {
+  for (std::size_t i = 0; i < tool_parts_.size(); ++i) {
+    ToolPart& part = tool_parts_[i];
+    const bool shown = i < parts.size();
+    for (auto& actor : part.actors) actor->SetVisibility(shown);
+    if (!shown) continue;
+    const Capsule& c = parts[i];
+    part.line->SetPoint1(c.a_m.x(), c.a_m.y(), c.a_m.z());
+    part.line->SetPoint2(c.b_m.x(), c.b_m.y(), c.b_m.z());
+    part.tube->SetRadius(c.radius_m);
+    // A ball (the probe's) has no length: its ends alone show it.
+    part.actors[0]->SetVisibility((c.b_m - c.a_m).norm() > 0.0);
+    const Eigen::Vector3d* ends[2] = {&c.a_m, &c.b_m};
+    for (int k = 0; k < 2; ++k) {
+      part.end[k]->SetCenter(ends[k]->x(), ends[k]->y(), ends[k]->z());
+      part.end[k]->SetRadius(c.radius_m);
+    }
+  }
 }
 
 std::optional<ScenePick> LiverScene::pick(int display_x, int display_y) const {

@@ -5,13 +5,16 @@
 
 #include "liversim/core/surface.h"
 #include "liversim/core/tet_mesh.h"
+#include "liversim/core/tools.h"
 
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
 #include <Eigen/Core>
 
+#include <array>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <vector>
 
 class vtkActor;
@@ -20,6 +23,9 @@ class vtkFloatArray;
 class vtkPoints;
 class vtkPolyData;
 class vtkRenderer;
+class vtkLineSource;
+class vtkSphereSource;
+class vtkTubeFilter;
 
 namespace liversim {
 
@@ -45,6 +51,8 @@ class LiverScene {
   void reset_camera();
   // A small sphere at the grabbed point, or none.
   void show_grab_marker(const std::optional<Eigen::Vector3d>& point_m);
+  // The tool's parts (tools.h: tool_capsules) as steel-grey rods with rounded ends; none hides it.
+  void show_tool(std::span<const Capsule> parts);
 
   // Display coordinates are VTK's: pixels from the bottom-left corner of the render window.
   std::optional<ScenePick> pick(int display_x, int display_y) const;
@@ -62,6 +70,14 @@ class LiverScene {
   vtkNew<vtkActor> liver_actor_;
   vtkNew<vtkActor> grab_marker_;
   vtkNew<vtkCellPicker> picker_;
+  // One rod per tool part: a tube along the segment and spheres on its ends.
+  struct ToolPart {
+    vtkSmartPointer<vtkLineSource> line;
+    vtkSmartPointer<vtkTubeFilter> tube;
+    std::array<vtkSmartPointer<vtkSphereSource>, 2> end;
+    std::array<vtkSmartPointer<vtkActor>, 3> actors;  // tube, two ends
+  };
+  std::array<ToolPart, 3> tool_parts_;
   std::vector<double> vertex_xyz_;
   std::vector<float> normal_scratch_;
 };

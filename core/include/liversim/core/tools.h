@@ -152,6 +152,12 @@ class ToolInteraction {
     return spring_reaction_force_n(springs_, position);
   }
   bool grasping() const { return grasp_.has_value(); }
+  // The tool has left the scene: let go of any hold, no springs.
+  void release() {
+    grasp_.reset();
+    springs_.clear();
+    contact_count_ = 0;
+  }
   const ForcepsGrasp* grasp() const { return grasp_ ? &*grasp_ : nullptr; }
   std::size_t contact_count() const { return contact_count_; }
   const SurfaceBvh& bvh() const { return bvh_; }
