@@ -42,8 +42,8 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   auto model = std::make_shared<const SimModel>(build_model(setup_.mesh, setup_.model_options));
   simulation_ =
       std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
-  toolSurface_ = extract_surface(setup_.mesh);
-  simulation_->enable_tools(toolSurface_);
+  // The visual surface's triangles are the physics boundary's (its vertex i is node nodes[i]).
+  simulation_->enable_tools(setup_.visual.surface);
   scene_ = std::make_unique<LiverScene>(setup_.mesh, setup_.visual);
 
   viewport_ = new VtkViewport(this);
@@ -69,19 +69,11 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   accuracyPanel_->setSettings(setup_.model_options.integrator);
   connect(accuracyPanel_, &AccuracyPanel::applyRequested, this,
           [this](const IntegratorSettings& settings) { applyIntegratorSettings(settings); });
-  auto* accuracyDock = new QDockWidget(tr("Accuracy"), this);
-  accuracyDock->setObjectName("accuracyDock");
-  accuracyDock->setWidget(accuracyPanel_);
-  accuracyDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
-  addDockWidget(Qt::RightDockWidgetArea, accuracyDock);
+  addPanelDock(tr("Accuracy"), "accuracyDock", accuracyPanel_);
 
   toolPanel_ = new ToolPanel(this);
   toolPanel_->setObjectName("toolPanel");
-  auto* toolDock = new QDockWidget(tr("Tool"), this);
-  toolDock->setObjectName("toolDock");
-  toolDock->setWidget(toolPanel_);
-  toolDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
-  addDockWidget(Qt::RightDockWidgetArea, toolDock);
+  addPanelDock(tr("Tool"), "toolDock", toolPanel_);
 
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("simulationStatus");
@@ -98,6 +90,14 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   statusTimer_.start(500);
   frameWindow_.start();
   simulation_->start();
+}
+
+void MainWindow::addPanelDock(const QString& title, const char* name, QWidget* panel) {
+  auto* dock = new QDockWidget(title, this);
+  dock->setObjectName(name);
+  dock->setWidget(panel);
+  dock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
+  addDockWidget(Qt::RightDockWidgetArea, dock);
 }
 
 MainWindow::~MainWindow() {
@@ -165,7 +165,7 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
     return;
   }
   if (grab_) simulation_->set_springs(springs_);
-  simulation_->enable_tools(toolSurface_);
+  simulation_->enable_tools(setup_.visual.surface);
   if (tool_) simulation_->set_tool(tool_);
   simulation_->start();
   setup_.model_options.integrator = settings;

@@ -56,6 +56,8 @@ class MainWindow : public QMainWindow {
   void integratorChangeFinished(bool applied);
 
  private:
+  // A panel docked on the right, movable and floatable.
+  void addPanelDock(const QString& title, const char* name, QWidget* panel);
   bool beginGrab(QPoint vtkDisplayPos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers);
   void moveGrab(QPoint vtkDisplayPos);
   void endGrab();
@@ -87,7 +89,6 @@ class MainWindow : public QMainWindow {
 
   std::optional<Tool> tool_;
   Eigen::Vector3d toolPoint_m_ = Eigen::Vector3d::Zero();  // where the mouse holds the tool
-  BoundarySurface toolSurface_;                            // the physics surface tools touch
 
   int framesInWindow_ = 0;
   QElapsedTimer frameWindow_;

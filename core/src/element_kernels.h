@@ -1,6 +1,7 @@
 #pragma once
-// The vectorised element kernels of elastic (history-free) elements: Neo-Hookean, with or without
-// average nodal pressure, with or without HGO fibres. Their loops run over elements in structure
+// The vectorised element kernels: Neo-Hookean, with or without average nodal pressure, with or
+// without HGO fibres, and the viscous tissue law of models whose regions are all viscous. Their
+// loops run over elements in structure
 // of arrays so the compiler puts several elements in one vector register; they are compiled twice
 // (element_kernels_generic.cpp for any x86-64, element_kernels_avx2.cpp with AVX2 + FMA) and the
 // build for the running processor is picked once. This header is all the two translation units

@@ -251,9 +251,7 @@ struct ViscousBlock {
   alignas(32) double stress[9][kViscousBlock];               // P, row-major entries
 };
 
-template <std::size_t kEntries>
-inline Matrix3 load_matrix(const double (&m)[kEntries][kViscousBlock], std::size_t i) {
-  static_assert(kEntries == 9);
+inline Matrix3 load_matrix(const double (&m)[9][kViscousBlock], std::size_t i) {
   Matrix3 a;
 #pragma GCC unroll 9
   for (int k = 0; k < 9; ++k) a.m[k / 3][k % 3] = m[k][i];

@@ -555,6 +555,18 @@ Eigen::Matrix<double, 9, 9> element_step_tangent(const SimModel& model, const Si
   return here::element_stress_tangent(model, e, F);
 }
 
+double critical_damping_n_s_per_m(double stiffness_n_per_m, double mass_kg) {
+  return 2.0 * std::sqrt(stiffness_n_per_m * mass_kg);
+}
+
+Eigen::Vector3d spring_reaction_force_n(std::span<const NodeSpring> springs,
+                                        const NodeArray& position) {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  for (const NodeSpring& s : springs)
+    force += s.stiffness_n_per_m * (position.at(s.node) - s.anchor_m);
+  return force;
+}
+
 void add_external_forces(const StepInputs& inputs, const NodeArray& position, NodeArray& force) {
   for (const auto& load : inputs.point_loads) {
     force.x[load.node] += load.force_n.x();

@@ -40,7 +40,7 @@ Grab grab_surface(const BoundarySurface& surface, const NodeArray& position,
     grab.node_position_at_grab_m.push_back(position.at(grab.nodes[i]));
     const double k = total_stiffness_n_per_m * weight[i] / weight_sum;
     grab.stiffness_n_per_m.push_back(k);
-    grab.damping_n_s_per_m.push_back(2.0 * std::sqrt(k * lumped_mass_kg[grab.nodes[i]]));
+    grab.damping_n_s_per_m.push_back(critical_damping_n_s_per_m(k, lumped_mass_kg[grab.nodes[i]]));
   }
   return grab;
 }

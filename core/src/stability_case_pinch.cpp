@@ -83,7 +83,7 @@ StabilityRun pinch_run(const TetMesh& mesh, IntegratorKind kind) {
     for (NodeIndex n : nodes_on_plane(mesh, 2, face)) {
       const Eigen::Vector3d rest = mesh.rest_position_m.at(n);
       if (std::hypot(rest.x() - 0.5 * kSide, rest.y() - 0.5 * kSide) > kTipRadius) continue;
-      const double damping = 2.0 * std::sqrt(kTipStiffness * model.lumped_mass_kg[n]);
+      const double damping = critical_damping_n_s_per_m(kTipStiffness, model.lumped_mass_kg[n]);
       springs.push_back({n, rest, kTipStiffness, damping});
       direction.push_back(face == 0.0 ? 1.0 : -1.0);
     }

@@ -186,53 +186,48 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
   const double omega_sq = std::pow(2.0 * std::numbers::pi * settings.frequency_hz, 2);
   scratch.resize(model.node_count);
   for (const Capsule& part : parts) {
-    Aabb box;
-    box.grow(part.a_m);
-    box.grow(part.b_m);
-    box.min_m.array() -= part.radius_m;
-    box.max_m.array() += part.radius_m;
-    bvh.for_each_triangle_overlapping(box, [&](std::size_t t) {
-      const SurfaceBvh::Triangle& triangle = bvh.triangles()[t];
-      const Eigen::Vector3d p0 = position.at(triangle[0]), p1 = position.at(triangle[1]),
-                            p2 = position.at(triangle[2]);
-      const Eigen::Vector3d outward = (p1 - p0).cross(p2 - p0);
-      const double area2 = outward.norm();
-      if (!(area2 > 0.0)) return;  // a collapsed face has no side to push from
-      const Eigen::Vector3d normal = outward / area2;
-      const SegmentTriangleClosest closest =
-          segment_triangle_closest(part.a_m, part.b_m, p0, p1, p2);
-      const Eigen::Vector3d axis_to_surface = closest.on_triangle - closest.on_segment;
-      const double height = -axis_to_surface.dot(normal);  // of the axis above the face
-      Eigen::Vector3d push;  // how far the face's point must move to clear the part
-      if (height > 0.0 && closest.distance > 0.0) {
-        if (closest.distance >= part.radius_m) return;
-        push = (part.radius_m - closest.distance) / closest.distance * axis_to_surface;
-      } else {  // the axis has gone through the face: back out along the inward normal
-        push = -(part.radius_m + std::max(0.0, -height)) * normal;
-      }
-      // A spring at the face's point, of the frequency of the mass there, shared among the corners
-      // by the barycentric weights: corner i feels w_i·k·push and stiffness w_i²·k.
-      double point_mass = 0.0;
-      for (int i = 0; i < 3; ++i)
-        point_mass +=
-            closest.weight[i] * model.lumped_mass_kg[static_cast<std::size_t>(triangle[i])];
-      const double stiffness = omega_sq * point_mass;
-      for (int i = 0; i < 3; ++i) {
-        const auto node = static_cast<std::size_t>(triangle[i]);
-        if (model.inverse_mass_per_kg[node] == 0.0 || closest.weight[i] == 0.0) continue;
-        if (scratch.stiffness_n_per_m[node] == 0.0) scratch.touched.push_back(triangle[i]);
-        scratch.stiffness_n_per_m[node] += closest.weight[i] * closest.weight[i] * stiffness;
-        scratch.force_n[node] += closest.weight[i] * stiffness * push;
-      }
-    });
+    bvh.for_each_triangle_overlapping(
+        Aabb::around(part.a_m, part.b_m, part.radius_m), [&](std::size_t t) {
+          const SurfaceBvh::Triangle& triangle = bvh.triangles()[t];
+          const Eigen::Vector3d p0 = position.at(triangle[0]), p1 = position.at(triangle[1]),
+                                p2 = position.at(triangle[2]);
+          const Eigen::Vector3d outward = (p1 - p0).cross(p2 - p0);
+          const double area2 = outward.norm();
+          if (!(area2 > 0.0)) return;  // a collapsed face has no side to push from
+          const Eigen::Vector3d normal = outward / area2;
+          const SegmentTriangleClosest closest =
+              segment_triangle_closest(part.a_m, part.b_m, p0, p1, p2);
+          const Eigen::Vector3d axis_to_surface = closest.on_triangle - closest.on_segment;
+          const double height = -axis_to_surface.dot(normal);  // of the axis above the face
+          Eigen::Vector3d push;  // how far the face's point must move to clear the part
+          if (height > 0.0 && closest.distance > 0.0) {
+            if (closest.distance >= part.radius_m) return;
+            push = (part.radius_m - closest.distance) / closest.distance * axis_to_surface;
+          } else {  // the axis has gone through the face: back out along the inward normal
+            push = -(part.radius_m + std::max(0.0, -height)) * normal;
+          }
+          // A spring at the face's point, of the frequency of the mass there, shared among the
+          // corners by the barycentric weights: corner i feels w_i·k·push and stiffness w_i²·k.
+          double point_mass = 0.0;
+          for (int i = 0; i < 3; ++i)
+            point_mass +=
+                closest.weight[i] * model.lumped_mass_kg[static_cast<std::size_t>(triangle[i])];
+          const double stiffness = omega_sq * point_mass;
+          for (int i = 0; i < 3; ++i) {
+            const auto node = static_cast<std::size_t>(triangle[i]);
+            if (model.inverse_mass_per_kg[node] == 0.0 || closest.weight[i] == 0.0) continue;
+            if (scratch.stiffness_n_per_m[node] == 0.0) scratch.touched.push_back(triangle[i]);
+            scratch.stiffness_n_per_m[node] += closest.weight[i] * closest.weight[i] * stiffness;
+            scratch.force_n[node] += closest.weight[i] * stiffness * push;
+          }
+        });
   }
   // One spring per node, giving its summed force at `position` with its summed stiffness.
   for (NodeIndex n : scratch.touched) {
     const auto node = static_cast<std::size_t>(n);
     const double k = scratch.stiffness_n_per_m[node];
-    const double mass = model.lumped_mass_kg[node];
-    springs.push_back(
-        {n, position.at(n) + scratch.force_n[node] / k, k, 2.0 * std::sqrt(k * mass)});
+    springs.push_back({n, position.at(n) + scratch.force_n[node] / k, k,
+                       critical_damping_n_s_per_m(k, model.lumped_mass_kg[node])});
     scratch.stiffness_n_per_m[node] = 0.0;
     scratch.force_n[node].setZero();
   }
@@ -241,18 +236,9 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
   return added;
 }
 
-Eigen::Vector3d spring_reaction_force_n(std::span<const NodeSpring> springs,
-                                        const NodeArray& position) {
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();
-  for (const NodeSpring& s : springs)
-    force += s.stiffness_n_per_m * (position.at(s.node) - s.anchor_m);
-  return force;
-}
-
 ToolInteraction::ToolInteraction(const SimModel& model, const BoundarySurface& surface,
                                  ContactSettings contact, GraspSettings grasp)
     : model_(&model),
-      surface_(surface),
       bvh_(surface, model.rest_position_m),
       contact_(contact),
       grasp_settings_(grasp),
@@ -266,62 +252,63 @@ ToolInteraction::ToolInteraction(const SimModel& model, const BoundarySurface& s
     throw std::invalid_argument(
         "grasp settings are invalid: expected radius > 0, stiffness > 0 and the closing opening "
         "below the releasing one");
-  springs_.reserve(2 * surface.nodes.size());  // a hold and a contact spring per node at most
+  const std::size_t nodes = surface.nodes.size();
+  springs_.reserve(2 * nodes);  // a hold and a contact spring per node at most
+  grasp_.nodes.reserve(nodes);
+  grasp_.offset_in_tool_m.reserve(nodes);
+  grasp_.stiffness_n_per_m.reserve(nodes);
+  grasp_.damping_n_s_per_m.reserve(nodes);
+  grasp_weight_.reserve(nodes);
 }
 
 void ToolInteraction::try_grasp(const Tool& tool, const NodeArray& position) {
   const Eigen::Vector3d point = forceps_grasp_point_m(tool);
-  Aabb box;
-  box.grow(point);
-  box.min_m.array() -= grasp_settings_.radius_m;
-  box.max_m.array() += grasp_settings_.radius_m;
-  ForcepsGrasp grasp;
-  std::vector<double> weight;
-  bvh_.for_each_triangle_overlapping(box, [&](std::size_t t) {
+  const double radius = grasp_settings_.radius_m;
+  grasp_.clear();
+  grasp_weight_.clear();
+  bvh_.for_each_triangle_overlapping(Aabb::around(point, point, radius), [&](std::size_t t) {
     for (NodeIndex n : bvh_.triangles()[t]) {
       const auto node = static_cast<std::size_t>(n);
       if (node_mark_[node] || model_->inverse_mass_per_kg[node] == 0.0) continue;
       const double d = (position.at(n) - point).norm();
-      if (d >= grasp_settings_.radius_m) continue;
+      if (d >= radius) continue;
       node_mark_[node] = 1;
       // The grab's weighting: every held node has the same spring frequency, and the hold fades
       // out at its rim.
-      grasp.nodes.push_back(n);
-      weight.push_back(grab_weight(d, grasp_settings_.radius_m, model_->lumped_mass_kg[node]));
+      grasp_.nodes.push_back(n);
+      grasp_weight_.push_back(grab_weight(d, radius, model_->lumped_mass_kg[node]));
     }
   });
-  for (NodeIndex n : grasp.nodes) node_mark_[static_cast<std::size_t>(n)] = 0;
-  if (grasp.nodes.empty()) return;  // nothing between the jaws: they close on air
+  for (NodeIndex n : grasp_.nodes) node_mark_[static_cast<std::size_t>(n)] = 0;
+  if (grasp_.empty()) return;  // nothing between the jaws: they close on air
   double weight_sum = 0.0;
-  for (double w : weight) weight_sum += w;
+  for (double w : grasp_weight_) weight_sum += w;
   const Eigen::Quaterniond to_tool = tool.pose.orientation.conjugate();
-  for (std::size_t i = 0; i < grasp.nodes.size(); ++i) {
-    const NodeIndex n = grasp.nodes[i];
-    grasp.offset_in_tool_m.push_back(to_tool * (position.at(n) - tool.pose.origin_m));
-    const double k = grasp_settings_.total_stiffness_n_per_m * weight[i] / weight_sum;
-    grasp.stiffness_n_per_m.push_back(k);
-    grasp.damping_n_s_per_m.push_back(
-        2.0 * std::sqrt(k * model_->lumped_mass_kg[static_cast<std::size_t>(n)]));
+  for (std::size_t i = 0; i < grasp_.nodes.size(); ++i) {
+    const auto node = static_cast<std::size_t>(grasp_.nodes[i]);
+    grasp_.offset_in_tool_m.push_back(to_tool * (position.at(node) - tool.pose.origin_m));
+    const double k = grasp_settings_.total_stiffness_n_per_m * grasp_weight_[i] / weight_sum;
+    grasp_.stiffness_n_per_m.push_back(k);
+    grasp_.damping_n_s_per_m.push_back(critical_damping_n_s_per_m(k, model_->lumped_mass_kg[node]));
   }
-  grasp_ = std::move(grasp);
 }
 
 std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const NodeArray& position) {
   bvh_.refit(position);
   springs_.clear();
   if (tool.kind == ToolKind::forceps) {
-    if (grasp_ && tool.jaw_opening > grasp_settings_.release_above) grasp_.reset();
-    if (!grasp_ && tool.jaw_opening < grasp_settings_.close_below) try_grasp(tool, position);
+    if (grasping() && tool.jaw_opening > grasp_settings_.release_above) grasp_.clear();
+    if (!grasping() && tool.jaw_opening < grasp_settings_.close_below) try_grasp(tool, position);
   } else {
-    grasp_.reset();
+    grasp_.clear();
   }
   std::array<Capsule, 3> parts;
   int count = tool_capsules(tool, parts);
   // A hold carries its nodes with the jaws: the jaws themselves do not push the tissue.
-  if (grasp_) {
-    for (std::size_t i = 0; i < grasp_->nodes.size(); ++i)
-      springs_.push_back({grasp_->nodes[i], tool.pose.to_scene(grasp_->offset_in_tool_m[i]),
-                          grasp_->stiffness_n_per_m[i], grasp_->damping_n_s_per_m[i]});
+  if (grasping()) {
+    for (std::size_t i = 0; i < grasp_.nodes.size(); ++i)
+      springs_.push_back({grasp_.nodes[i], tool.pose.to_scene(grasp_.offset_in_tool_m[i]),
+                          grasp_.stiffness_n_per_m[i], grasp_.damping_n_s_per_m[i]});
     count = 1;  // the shaft only (parts[0] of the forceps)
   }
   contact_count_ =

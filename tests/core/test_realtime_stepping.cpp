@@ -263,6 +263,16 @@ TEST_F(RealtimeSteppingFixture, ForcepsInTheLoopHoldPullAndRelease) {
   }
   EXPECT_GT(seen.position_m.z[node] - marked.z(), 0.005);
   EXPECT_LT(seen.tool_force_n.z(), 0.0) << "the tissue pulls the forceps back down";
+  // A device that sends a NaN pose while holding: the step refuses the input, the loop goes on.
+  Tool broken = forceps;
+  broken.pose.origin_m.x() = std::nan("");
+  simulation.set_tool(broken);
+  while (simulation.stats().rejected_inputs == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_GT(simulation.stats().rejected_inputs, 0);
+  EXPECT_FALSE(simulation.stats().halted);
+  EXPECT_THROW(simulation.enable_tools(extract_surface(*mesh_)), std::logic_error)
+      << "tools are enabled while the simulation is stopped";
   forceps.jaw_opening = 1.0;
   simulation.set_tool(forceps);
   while (newest().tool_grasping && std::chrono::steady_clock::now() < deadline)

@@ -91,6 +91,9 @@ TEST_F(SeedExperimentFixture, ForcepsPullFeedbackMatchesEachSeedForce) {
   settings.record_history = false;
   const PullResult result = run_pull_experiment(scene_->mesh, *model_, settings);
   ASSERT_EQ(result.cases.size(), std::size(kSeedPullForcesN));
+  PullSettings bad = settings;
+  bad.forceps_stiffness_n_per_m = 0.0;
+  EXPECT_THROW(run_pull_experiment(scene_->mesh, *model_, bad), std::invalid_argument);
   double previous_displacement_mm = 0.0;
   for (const PullCase& pull : result.cases) {
     ASSERT_TRUE(pull.settled) << pull.applied_force_n << " N: residual " << pull.residual_l1_n

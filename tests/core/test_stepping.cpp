@@ -5,6 +5,7 @@
 #include "liversim/core/integrator.h"
 #include "liversim/core/liver_geometry.h"
 #include "liversim/core/realtime_simulation.h"
+#include "liversim/core/tools.h"
 
 #include <gtest/gtest.h>
 
@@ -140,6 +141,28 @@ TEST_F(SteppingFixture, RealtimeLoopFollowsTheDragAndAllocatesNothingWhileRunnin
   simulation.stop();
   // Springs back: the mass damping (α = 8/s) leaves e^(−8) of the amplitude after 2 s.
   EXPECT_LT((simulation.snapshot().position_m.at(node) - rest).norm(), 0.001);
+}
+
+// A tool's interval allocates nothing either (issue 7): contact, the forceps closing on the tissue
+// (the hold's buffers are sized for the whole surface), holding, and letting go.
+TEST_F(SteppingFixture, ToolIntervalsAllocateNothingEvenWhenTheJawsClose) {
+  SimState state = make_rest_state(*model_, workers_);
+  ToolInteraction hand(*model_, extract_surface(*mesh_));
+  const NodeIndex node = anterior_marked_node(*mesh_);
+  Tool forceps;
+  forceps.kind = ToolKind::forceps;
+  forceps.jaw_opening = 1.0;
+  forceps.pose.origin_m =
+      mesh_->rest_position_m.at(node) - (forceps_grasp_point_m(forceps) - forceps.pose.origin_m);
+  advance(*model_, state, {{}, hand.update(forceps, state.position_m)}, 1e-3);  // warm-up
+  const long before = g_allocations.load();
+  for (int interval = 0; interval < 40; ++interval) {
+    forceps.jaw_opening = interval < 10 ? 1.0 : interval < 30 ? 0.0 : 1.0;
+    advance(*model_, state, {{}, hand.update(forceps, state.position_m)}, 1e-3);
+    if (interval == 10) EXPECT_TRUE(hand.grasping());
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_FALSE(hand.grasping());
 }
 
 }  // namespace

@@ -25,6 +25,14 @@ struct NodeSpring {
   double damping_n_s_per_m = 0.0;
 };
 
+// The damping that makes a spring of stiffness k on a node of mass m critically damped: 2√(k·m).
+double critical_damping_n_s_per_m(double stiffness_n_per_m, double mass_kg);
+
+// The force the springs' nodes exert on whatever holds the anchors (a tool, a handle), in newtons:
+// Σ k·(x − anchor). Damping is left out: it vanishes at rest.
+Eigen::Vector3d spring_reaction_force_n(std::span<const NodeSpring> springs,
+                                        const NodeArray& position);
+
 struct StepInputs {
   std::span<const PointLoad> point_loads;
   std::span<const NodeSpring> springs;

@@ -28,6 +28,13 @@ struct Aabb {
     min_m = min_m.cwiseMin(box.min_m);
     max_m = max_m.cwiseMax(box.max_m);
   }
+  // The box around segment [a, b] swept by a sphere of `radius_m` (a point: a = b).
+  static Aabb around(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m, double radius_m) {
+    Aabb box;
+    box.min_m = a_m.cwiseMin(b_m).array() - radius_m;
+    box.max_m = a_m.cwiseMax(b_m).array() + radius_m;
+    return box;
+  }
   bool overlaps(const Aabb& other) const {
     return (min_m.array() <= other.max_m.array()).all() &&
            (other.min_m.array() <= max_m.array()).all();

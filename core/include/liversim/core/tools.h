@@ -114,19 +114,21 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
                                 const ContactSettings& settings, ContactScratch& scratch,
                                 std::vector<NodeSpring>& springs);
 
-// The force the tissue exerts on whatever holds the springs' anchors (the tool), in newtons:
-// Σ k·(x − anchor). Damping is left out: it vanishes at rest, and the haptic force model
-// (issue 8) damps on its own.
-Eigen::Vector3d spring_reaction_force_n(std::span<const NodeSpring> springs,
-                                        const NodeArray& position);
-
 // The forceps' hold on the tissue: the surface nodes near the grasp point when the jaws closed,
-// carried rigidly with the tool from then on.
+// carried rigidly with the tool from then on. Empty: no hold.
 struct ForcepsGrasp {
   std::vector<NodeIndex> nodes;
   std::vector<Eigen::Vector3d> offset_in_tool_m;  // node position at the grasp, in the tool frame
   std::vector<double> stiffness_n_per_m;
   std::vector<double> damping_n_s_per_m;
+
+  bool empty() const { return nodes.empty(); }
+  void clear() {
+    nodes.clear();
+    offset_in_tool_m.clear();
+    stiffness_n_per_m.clear();
+    damping_n_s_per_m.clear();
+  }
 };
 
 struct GraspSettings {
@@ -144,21 +146,21 @@ class ToolInteraction {
                   ContactSettings contact = {}, GraspSettings grasp = {});
 
   // The springs for the next interval at the tool's pose and the tissue's `position`. Allocates
-  // nothing after the first calls (capacities are kept).
+  // nothing (every buffer is sized for the whole surface at construction).
   std::span<const NodeSpring> update(const Tool& tool, const NodeArray& position);
 
   // The force of the tissue on the tool at `position` with the springs of the last update (N).
   Eigen::Vector3d force_on_tool_n(const NodeArray& position) const {
     return spring_reaction_force_n(springs_, position);
   }
-  bool grasping() const { return grasp_.has_value(); }
+  bool grasping() const { return !grasp_.empty(); }
   // The tool has left the scene: let go of any hold, no springs.
   void release() {
-    grasp_.reset();
+    grasp_.clear();
     springs_.clear();
     contact_count_ = 0;
   }
-  const ForcepsGrasp* grasp() const { return grasp_ ? &*grasp_ : nullptr; }
+  const ForcepsGrasp* grasp() const { return grasping() ? &grasp_ : nullptr; }
   std::size_t contact_count() const { return contact_count_; }
   const SurfaceBvh& bvh() const { return bvh_; }
 
@@ -166,11 +168,12 @@ class ToolInteraction {
   void try_grasp(const Tool& tool, const NodeArray& position);
 
   const SimModel* model_;
-  BoundarySurface surface_;
   SurfaceBvh bvh_;
   ContactSettings contact_;
   GraspSettings grasp_settings_;
-  std::optional<ForcepsGrasp> grasp_;
+  // Sized for every surface node once, so that closing the jaws in a step allocates nothing.
+  ForcepsGrasp grasp_;
+  std::vector<double> grasp_weight_;
   std::vector<std::uint8_t> node_mark_;
   ContactScratch contact_scratch_;
   std::vector<NodeSpring> springs_;
