@@ -17,13 +17,12 @@ TetShape tet_shape(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eig
                    const Eigen::Vector3d& d) {
   const std::array<Eigen::Vector3d, 4> p{a, b, c, d};
   // Face i is opposite vertex i; its outward normal (area-weighted) is n[i].
-  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
   TetShape shape;
   shape.volume_m3 = (b - a).dot((c - a).cross(d - a)) / 6.0;
   std::array<Eigen::Vector3d, 4> normal;
   double area_sum = 0.0, max_area = 0.0;
   for (int i = 0; i < 4; ++i) {
-    const auto& f = kFace[i];
+    const auto& f = kTetFace[i];
     normal[i] = 0.5 * (p[f[1]] - p[f[0]]).cross(p[f[2]] - p[f[0]]);
     const double area = normal[i].norm();
     area_sum += area;

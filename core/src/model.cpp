@@ -11,9 +11,8 @@
 #include <string>
 
 namespace liversim {
-namespace {
 
-void build_incidence(SimModel& model) {
+void build_node_incidence(SimModel& model) {
   const std::size_t tets = model.tet_count;
   model.node_slot_begin.assign(model.node_count + 1, 0);
   for (int c = 0; c < 4; ++c)
@@ -30,8 +29,6 @@ void build_incidence(SimModel& model) {
       model.node_slot_element[s] = static_cast<std::int32_t>(e);
     }
 }
-
-}  // namespace
 
 namespace {
 
@@ -225,7 +222,7 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   }
 
   model.min_element_height_m = assess_quality(mesh).min_height_m;
-  build_incidence(model);
+  build_node_incidence(model);
   model.max_frequency_rad_per_s = estimate_max_frequency_rad_per_s(model, model.rest_position_m);
   model.stable_time_step_s = stable_time_step_s(model, StepInputs{});
   return model;

@@ -13,9 +13,6 @@
 namespace liversim {
 namespace {
 
-// Face opposite vertex i, ordered so that its normal points out of a positively oriented element.
-constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
 struct FaceKey {
   NodeIndex a, b, c;  // sorted
   bool operator==(const FaceKey&) const = default;
@@ -43,7 +40,7 @@ BoundarySurface extract_surface(const TetMesh& mesh) {
   faces.reserve(mesh.tet_count() * 2 + 16);
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     const auto tet = mesh.tet(e);
-    for (const auto& f : kFace) {
+    for (const auto& f : kTetFace) {
       std::array<NodeIndex, 3> oriented{tet[f[0]], tet[f[1]], tet[f[2]]};
       auto sorted = oriented;
       std::sort(sorted.begin(), sorted.end());

@@ -32,40 +32,6 @@ Eigen::Vector3d jaw_tip_local_m(const Tool& tool, int jaw) {
   return g.jaw_length_m * Eigen::Vector3d(side * std::sin(angle), 0.0, -std::cos(angle));
 }
 
-// Closest point of triangle (p0, p1, p2) to p, with its barycentric weights (Ericson, Real-Time
-// Collision Detection, 5.1.5: by the Voronoi regions of the corners and edges).
-Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& p0,
-                                          const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
-                                          std::array<double, 3>& w) {
-  const Eigen::Vector3d ab = p1 - p0, ac = p2 - p0, ap = p - p0;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return w = {1.0, 0.0, 0.0}, p0;
-  const Eigen::Vector3d bp = p - p1;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return w = {0.0, 1.0, 0.0}, p1;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    const double v = d1 / (d1 - d3);
-    return w = {1.0 - v, v, 0.0}, p0 + v * ab;
-  }
-  const Eigen::Vector3d cp = p - p2;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return w = {0.0, 0.0, 1.0}, p2;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    const double v = d2 / (d2 - d6);
-    return w = {1.0 - v, 0.0, v}, p0 + v * ac;
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    const double v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return w = {0.0, 1.0 - v, v}, p1 + v * (p2 - p1);
-  }
-  const double denominator = 1.0 / (va + vb + vc);
-  const double v = vb * denominator, u = vc * denominator;
-  return w = {1.0 - v - u, v, u}, p0 + v * ab + u * ac;
-}
-
 // Parameters s, t in [0, 1] of the closest points of segments [p1, q1] and [p2, q2]
 // (Ericson 5.1.9).
 void closest_parameters_of_segments(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1,
@@ -101,6 +67,39 @@ void closest_parameters_of_segments(const Eigen::Vector3d& p1, const Eigen::Vect
 }
 
 }  // namespace
+
+// Ericson, Real-Time Collision Detection, 5.1.5: by the Voronoi regions of the corners and edges.
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& p0,
+                                          const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                                          std::array<double, 3>& w) {
+  const Eigen::Vector3d ab = p1 - p0, ac = p2 - p0, ap = p - p0;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return w = {1.0, 0.0, 0.0}, p0;
+  const Eigen::Vector3d bp = p - p1;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return w = {0.0, 1.0, 0.0}, p1;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double v = d1 / (d1 - d3);
+    return w = {1.0 - v, v, 0.0}, p0 + v * ab;
+  }
+  const Eigen::Vector3d cp = p - p2;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return w = {0.0, 0.0, 1.0}, p2;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double v = d2 / (d2 - d6);
+    return w = {1.0 - v, 0.0, v}, p0 + v * ac;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return w = {0.0, 1.0 - v, v}, p1 + v * (p2 - p1);
+  }
+  const double denominator = 1.0 / (va + vb + vc);
+  const double v = vb * denominator, u = vc * denominator;
+  return w = {1.0 - v - u, v, u}, p0 + v * ab + u * ac;
+}
 
 int tool_capsules(const Tool& tool, std::array<Capsule, 3>& parts) {
   const ToolGeometry& g = tool.geometry;

@@ -120,6 +120,13 @@ struct SimModel {
   // Smallest element height at rest: no node may travel more than a tenth of it in one step, which
   // keeps fast, large distortions (a yank, an inversion) from jumping past the stiffening.
   double min_element_height_m = 0.0;
+  // Faces made by cuts (cutting.h), per element: bit c for the face opposite corner c. Empty until
+  // the first cut.
+  std::vector<std::uint8_t> cut_face_mask;
+  // Mass of each element, kept through cuts (a node snapped onto a cut on a curved surface
+  // changes its elements' volumes a little, never the mass). Empty until the first cut: density
+  // times rest volume.
+  std::vector<double> element_mass_kg;
 };
 
 // Builds the model. Throws std::invalid_argument naming the problem for an invalid material, a
@@ -127,5 +134,8 @@ struct SimModel {
 // an inverted or zero-volume element, a fixed node index out of range, or integrator settings out
 // of range.
 SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
+
+// Fills the model's node → element-corner incidence (node_slot_*) from its corners.
+void build_node_incidence(SimModel& model);
 
 }  // namespace liversim

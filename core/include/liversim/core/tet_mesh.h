@@ -39,6 +39,10 @@ struct NodeArray {
   }
 };
 
+// Corners of the face opposite corner i, ordered so that its normal points out of a positively
+// oriented element.
+inline constexpr int kTetFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
 struct TetMesh {
   NodeArray rest_position_m;                     // reference (material) coordinates
   std::array<std::vector<NodeIndex>, 4> corner;  // corner[c][e]: node of corner c of element e

@@ -68,6 +68,11 @@ Eigen::Vector3d forceps_grasp_point_m(const Tool& tool);
 Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                          const Eigen::Vector3d& p);
 
+// Closest point of triangle (p0, p1, p2) to p, with its barycentric weights.
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& p0,
+                                          const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                                          std::array<double, 3>& weight);
+
 // Closest points of segment [a, b] and triangle (p0, p1, p2): the point on the triangle with its
 // barycentric weights. Distance 0 when the segment passes through the triangle.
 struct SegmentTriangleClosest {

@@ -1,0 +1,473 @@
+// Cutting (issue 7): the scalpel separates tissue along the surface its edge sweeps, where the
+// stress passes the cutting threshold; cuts are clean where nodes can be snapped, keep every
+// element's data, make no bad element, conserve mass, keep the surface manifold, and take out the
+// pieces that come free.
+#include "block_mesh.h"
+
+#include "liversim/core/cutting.h"
+#include "liversim/core/default_scene.h"
+#include "liversim/core/forces.h"
+#include "liversim/core/integrator.h"
+#include "liversim/core/mesh_quality.h"
+#include "liversim/core/model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+
+namespace liversim {
+namespace {
+
+// Block [0, 0.06] × [0, 0.05] × [0, 0.04] m of 1 cm cubes, fixed at its base.
+constexpr double kSpacing = 0.01;
+SimModel block_model(double jitter = 0.0, ModelOptions options = {}) {
+  const TetMesh mesh = testing::block_mesh(6, 5, 4, {0.06, 0.05, 0.04}, jitter);
+  for (std::size_t n = 0; n < mesh.node_count(); ++n)
+    if (mesh.rest_position_m.z[n] < 1e-9) options.fixed_nodes.push_back(static_cast<NodeIndex>(n));
+  return build_model(mesh, options);
+}
+
+CuttingSettings cut_anything() {
+  CuttingSettings settings;
+  settings.cutting_stress_pa = 0.0;
+  return settings;
+}
+
+// A planar sweep: the edge from `heel` to `tip` moved by `motion`.
+BladeStroke sweep_of(const Eigen::Vector3d& heel, const Eigen::Vector3d& tip,
+                     const Eigen::Vector3d& motion) {
+  BladeStroke stroke;
+  stroke.add({heel, tip});
+  stroke.add({heel + motion, tip + motion});
+  return stroke;
+}
+
+// Vertical sweep in the plane x = `x`, reaching from above the block down to `bottom_z`, across
+// the whole width.
+BladeStroke vertical_cut(double x, double bottom_z) {
+  return sweep_of({x, -0.01, 0.06}, {x, -0.01, bottom_z}, {0.0, 0.07, 0.0});
+}
+
+double total_mass_kg(const SimModel& model) {
+  return std::accumulate(model.lumped_mass_kg.begin(), model.lumped_mass_kg.end(), 0.0);
+}
+double total_volume_m3(const SimModel& model) {
+  return std::accumulate(model.rest_volume_m3.begin(), model.rest_volume_m3.end(), 0.0);
+}
+
+// Every edge of the boundary is shared by exactly two boundary triangles, and the triangles around
+// every boundary vertex form one fan (each vertex's link is a single cycle).
+::testing::AssertionResult boundary_is_manifold(const SimModel& model) {
+  const BoundarySurface surface = extract_surface(model_mesh(model));
+  std::map<std::pair<NodeIndex, NodeIndex>, int> edge_uses;
+  std::map<NodeIndex, std::vector<std::pair<NodeIndex, NodeIndex>>> link;
+  for (const auto& t : surface.triangles) {
+    for (int i = 0; i < 3; ++i) {
+      const NodeIndex a = surface.nodes[t[i]], b = surface.nodes[t[(i + 1) % 3]],
+                      c = surface.nodes[t[(i + 2) % 3]];
+      ++edge_uses[{std::min(a, b), std::max(a, b)}];
+      link[a].push_back({b, c});
+    }
+  }
+  for (const auto& [edge, uses] : edge_uses)
+    if (uses != 2)
+      return ::testing::AssertionFailure() << "edge " << edge.first << "-" << edge.second
+                                           << " is used by " << uses << " boundary triangles";
+  for (const auto& [vertex, arcs] : link) {
+    // Walk the cycle of link arcs b → c from the first; it must visit every arc.
+    std::map<NodeIndex, NodeIndex> next;
+    for (const auto& [b, c] : arcs) next[b] = c;
+    std::size_t steps = 0;
+    NodeIndex at = arcs.front().first;
+    do {
+      at = next[at];
+      ++steps;
+    } while (at != arcs.front().first && steps <= arcs.size());
+    if (steps != arcs.size())
+      return ::testing::AssertionFailure()
+             << "the boundary around node " << vertex << " is pinched (" << arcs.size()
+             << " triangles, one fan of " << steps << ")";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// No element inverted or degenerate, at rest or deformed, and nothing that is not a number.
+::testing::AssertionResult elements_are_sound(const SimModel& model, const SimState& state) {
+  const TetMesh mesh = model_mesh(model);
+  for (const NodeArray* x : {&model.rest_position_m, &state.position_m}) {
+    const MeshQualityReport quality = assess_quality(mesh, *x);
+    if (quality.inverted_count != 0 || quality.degenerate_count != 0)
+      return ::testing::AssertionFailure() << quality.inverted_count << " inverted and "
+                                           << quality.degenerate_count << " degenerate elements";
+  }
+  for (std::size_t n = 0; n < model.node_count; ++n)
+    if (!state.position_m.at(n).allFinite() || !state.velocity_m_per_s.at(n).allFinite() ||
+        !std::isfinite(model.lumped_mass_kg[n]) || !(model.lumped_mass_kg[n] > 0.0))
+      return ::testing::AssertionFailure() << "node " << n << " is not finite or has no mass";
+  return ::testing::AssertionSuccess();
+}
+
+// The faces made by cuts, as triangles at rest.
+std::vector<std::array<Eigen::Vector3d, 3>> cut_faces_at_rest(const SimModel& model) {
+  const BoundarySurface surface = extract_surface(model_mesh(model));
+  const auto flags = cut_face_flags(model, surface);
+  std::vector<std::array<Eigen::Vector3d, 3>> faces;
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    if (!flags[t]) continue;
+    std::array<Eigen::Vector3d, 3> p;
+    for (int i = 0; i < 3; ++i)
+      p[i] = model.rest_position_m.at(surface.nodes[surface.triangles[t][i]]);
+    faces.push_back(p);
+  }
+  return faces;
+}
+
+double cut_area_m2(const SimModel& model) {
+  double area = 0.0;
+  for (const auto& p : cut_faces_at_rest(model))
+    area += 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+  return area;
+}
+
+// Pieces of a model: components of elements joined through shared nodes.
+std::size_t piece_count(const SimModel& model) {
+  std::vector<std::int32_t> parent(model.node_count);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](std::int32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    for (int c = 1; c < 4; ++c) parent[find(model.corner[c][e])] = find(model.corner[0][e]);
+  std::set<std::int32_t> roots;
+  for (std::size_t e = 0; e < model.tet_count; ++e) roots.insert(find(model.corner[0][e]));
+  return roots.size();
+}
+
+TEST(Cutting, PartialCutIsCleanOnTheSweptPlaneAndLeavesTheCrackFrontJoined) {
+  const SimModel model = block_model();
+  const SimState state = make_rest_state(model);
+  // 0.2 of a cube from the grid plane x = 0.03: its nodes are the nearer ends of the edges the
+  // cut crosses, and snap onto it.
+  const double x = 0.032;
+  // The blade reaches down to z = 0.005, inside the bottom layer of cubes: those it is still
+  // inside are not cut, so the nodes at z = 0.01 keep their elements together and the cut's
+  // front is the row of nodes at z = 0.02, whose elements it has all passed.
+  const CutResult cut = cut_tissue(model, state, vertical_cut(x, 0.005), cut_anything());
+  ASSERT_TRUE(cut.cut());
+  const SimModel& after = *cut.model;
+  EXPECT_GT(cut.report.separated_faces, 0u);
+  EXPECT_EQ(cut.report.removed_elements, 0u);
+  EXPECT_EQ(after.tet_count, model.tet_count);  // separated, not split or deleted
+  EXPECT_EQ(piece_count(after), 1u);            // below the cut the block is whole
+  EXPECT_TRUE(boundary_is_manifold(after));
+  EXPECT_TRUE(elements_are_sound(after, cut.state));
+  // Clean: every cut face lies on the plane (the snapped nodes are exactly on it), and they
+  // cover both lips of the cut, 0.05 m wide from the top (0.04) to the front (0.02).
+  for (const auto& face : cut_faces_at_rest(after))
+    for (const Eigen::Vector3d& p : face) {
+      EXPECT_NEAR(p.x(), x, 1e-12);
+      EXPECT_GE(p.z(), 0.02 - 1e-12);
+    }
+  EXPECT_NEAR(cut_area_m2(after), 2 * 0.05 * 0.02, 1e-12);
+  // The six nodes of each row above the front got a copy (rows z = 0.03 and 0.04).
+  EXPECT_EQ(cut.report.duplicated_nodes, 2u * 6u);
+  // Mass and volume unchanged (nothing came off).
+  EXPECT_NEAR(total_mass_kg(after), total_mass_kg(model), 1e-12 * total_mass_kg(model));
+  EXPECT_NEAR(total_volume_m3(after), total_volume_m3(model), 1e-12 * total_volume_m3(model));
+}
+
+TEST(Cutting, CuttingAPieceFreeTakesItOutAndMeasuresTheResectedVolume) {
+  const SimModel model = block_model();
+  const SimState state = make_rest_state(model);
+  // Horizontal sweep at z = 0.032 through the whole block: the top 8 mm come off.
+  const double z = 0.032;
+  const CutResult cut =
+      cut_tissue(model, state, sweep_of({-0.01, -0.01, z}, {-0.01, 0.06, z}, {0.08, 0.0, 0.0}),
+                 cut_anything());
+  ASSERT_TRUE(cut.cut());
+  const double expected_volume = 0.06 * 0.05 * (0.04 - z);
+  EXPECT_NEAR(cut.report.resected_volume_m3, expected_volume, 1e-9 * expected_volume);
+  EXPECT_NEAR(cut.report.resected_mass_kg, 1060.0 * expected_volume, 1e-9 * expected_volume);
+  EXPECT_GT(cut.report.removed_elements, 0u);
+  const SimModel& after = *cut.model;
+  EXPECT_EQ(piece_count(after), 1u);
+  // Lost mass is exactly what came off.
+  EXPECT_NEAR(total_mass_kg(after), total_mass_kg(model) - cut.report.resected_mass_kg,
+              1e-12 * total_mass_kg(model));
+  for (std::size_t n = 0; n < after.node_count; ++n)
+    EXPECT_LE(after.rest_position_m.z[n], z + 1e-12);
+  EXPECT_TRUE(boundary_is_manifold(after));
+  EXPECT_TRUE(elements_are_sound(after, cut.state));
+}
+
+TEST(Cutting, ABladeBelowTheCuttingStressOnlyDeforms) {
+  const SimModel model = block_model();
+  const SimState state = make_rest_state(model);
+  CuttingSettings settings;
+  settings.cutting_stress_pa = 1000.0;  // the block is at rest: no stress anywhere
+  const CutResult cut = cut_tissue(model, state, vertical_cut(0.032, 0.015), settings);
+  EXPECT_FALSE(cut.cut());
+  EXPECT_GT(cut.report.elements_swept, 0u);
+  EXPECT_EQ(cut.report.elements_over_threshold, 0u);
+}
+
+TEST(Cutting, ABladeThatDoesNotMoveSweepsNothing) {
+  const SimModel model = block_model();
+  const SimState state = make_rest_state(model);
+  const BladeStroke still = sweep_of({0.03, 0.02, 0.05}, {0.03, 0.02, 0.01}, {0, 0, 0});
+  const CutResult cut = cut_tissue(model, state, still, cut_anything());
+  EXPECT_FALSE(cut.cut());
+  EXPECT_EQ(cut.report.elements_swept, 0u);
+}
+
+TEST(Cutting, CuttingAlongAnExistingCutChangesNothing) {
+  const SimModel model = block_model();
+  const SimState state = make_rest_state(model);
+  const CutResult first = cut_tissue(model, state, vertical_cut(0.032, 0.005), cut_anything());
+  ASSERT_TRUE(first.cut());
+  const CutResult again =
+      cut_tissue(*first.model, first.state, vertical_cut(0.032, 0.005), cut_anything());
+  EXPECT_FALSE(again.cut());
+  EXPECT_EQ(again.report.separated_faces, 0u);
+}
+
+}  // namespace
+}  // namespace liversim
+
+namespace liversim {
+namespace {
+
+// A random planar cut path through (or into) the organ: an edge of random length and direction
+// about a random point of its box, moved a random distance across itself.
+BladeStroke random_cut(std::mt19937& rng, const Eigen::AlignedBox3d& box) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0), signed_unit(-1.0, 1.0);
+  auto random_direction = [&] {
+    Eigen::Vector3d d;
+    do d = Eigen::Vector3d(signed_unit(rng), signed_unit(rng), signed_unit(rng));
+    while (d.norm() < 0.1 || d.norm() > 1.0);
+    return d.normalized();
+  };
+  const Eigen::Vector3d centre =
+      box.min() + box.sizes().cwiseProduct(Eigen::Vector3d(unit(rng), unit(rng), unit(rng)));
+  const double size = box.sizes().maxCoeff();
+  const Eigen::Vector3d edge = random_direction();
+  Eigen::Vector3d motion = random_direction();
+  motion = (motion - motion.dot(edge) * edge).normalized();  // across the edge
+  const double length = size * (0.1 + 0.9 * unit(rng)), travel = size * (0.05 + 0.6 * unit(rng));
+  const Eigen::Vector3d heel = centre - 0.5 * length * edge - 0.5 * travel * motion;
+  return sweep_of(heel, heel + length * edge, travel * motion);
+}
+
+TEST(CuttingRobustness, ThousandsOfRandomCutsThroughTheLiverKeepItSound) {
+  const SceneSetup scene = default_scene(1500);
+  const SimModel liver = build_model(scene.mesh, scene.model_options);
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < liver.node_count; ++n) box.extend(liver.rest_position_m.at(n));
+  // Deformed as by a smooth, moderate displacement field, so cuts meet a deformed liver.
+  SimState deformed = make_rest_state(liver);
+  for (std::size_t n = 0; n < liver.node_count; ++n) {
+    if (liver.is_fixed[n]) continue;
+    const Eigen::Vector3d X = liver.rest_position_m.at(n);
+    deformed.position_m.set(n,
+                            X + 0.004 * Eigen::Vector3d(std::sin(30 * X.y()), std::sin(30 * X.z()),
+                                                        std::sin(30 * X.x())));
+  }
+
+  std::mt19937 rng(2026);
+  constexpr int kSequences = 250, kCutsPerSequence = 8;  // 2000 cut paths
+  int cuts_made = 0, pieces_removed = 0;
+  for (int sequence = 0; sequence < kSequences; ++sequence) {
+    std::shared_ptr<const SimModel> model = std::make_shared<SimModel>(liver);
+    SimState state = deformed;
+    double removed_mass = 0.0;
+    for (int k = 0; k < kCutsPerSequence; ++k) {
+      const BladeStroke sweep = random_cut(rng, box);
+      CutResult cut = cut_tissue(*model, state, sweep, cut_anything());
+      if (!cut.cut()) continue;
+      ++cuts_made;
+      pieces_removed += cut.report.removed_elements > 0;
+      removed_mass += cut.report.resected_mass_kg;
+      model = cut.model;
+      state = std::move(cut.state);
+      const std::string where =
+          "sequence " + std::to_string(sequence) + ", cut " + std::to_string(k);
+      ASSERT_TRUE(elements_are_sound(*model, state)) << where;
+      ASSERT_TRUE(boundary_is_manifold(*model)) << where;
+      // No mass lost: what is left and what came off add up to the liver.
+      ASSERT_NEAR(total_mass_kg(*model) + removed_mass, total_mass_kg(liver),
+                  1e-9 * total_mass_kg(liver))
+          << where;
+    }
+  }
+  std::cout << kSequences * kCutsPerSequence << " cut paths: " << cuts_made << " cut, "
+            << pieces_removed << " freed a piece\n";
+  // The paths did cut (a path that ends inside elements it has not passed cuts nothing there),
+  // and some cut pieces free.
+  EXPECT_GT(cuts_made, kSequences * kCutsPerSequence / 4);
+  EXPECT_GT(pieces_removed, 50);
+}
+
+}  // namespace
+}  // namespace liversim
+
+namespace liversim {
+namespace {
+
+TEST(Cutting, AStrokeDrawnInSmallStepsCutsWhatOneSweepCuts) {
+  const SimModel model = block_model();
+  std::shared_ptr<const SimModel> current = std::make_shared<SimModel>(model);
+  SimState state = make_rest_state(model);
+  // The blade across the block in 1 mm steps, the cut updated after each.
+  const double x = 0.032;
+  BladeStroke stroke;
+  for (int k = 0; k <= 70; ++k) {
+    const double y = -0.01 + 0.001 * k;
+    stroke.add({Eigen::Vector3d(x, y, 0.06), Eigen::Vector3d(x, y, 0.005)});
+    CutResult cut = cut_tissue(*current, state, stroke, cut_anything());
+    if (k == 5) EXPECT_FALSE(cut.cut());  // 5 mm in: no element passed yet
+    if (!cut.cut()) continue;
+    current = cut.model;
+    state = std::move(cut.state);
+    ASSERT_TRUE(boundary_is_manifold(*current)) << "after step " << k;
+  }
+  const CutResult once =
+      cut_tissue(model, make_rest_state(model), vertical_cut(x, 0.005), cut_anything());
+  ASSERT_TRUE(once.cut());
+  EXPECT_EQ(current->node_count, once.model->node_count);
+  EXPECT_NEAR(cut_area_m2(*current), cut_area_m2(*once.model), 1e-12);
+}
+
+TEST(Cutting, CuttingThroughALesionBoundaryKeepsEachElementsRegionAndHistory) {
+  // A stiffer viscoplastic lesion in the block's upper middle, the parenchyma viscoelastic.
+  TetMesh mesh = testing::block_mesh(6, 5, 4, {0.06, 0.05, 0.04}, 0.15);
+  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (NodeIndex n : mesh.tet(e)) centroid += 0.25 * mesh.rest_position_m.at(n);
+    mesh.region[e] = (centroid - Eigen::Vector3d(0.03, 0.025, 0.03)).norm() < 0.012 ? 1 : 0;
+  }
+  ModelOptions options;
+  RegionMaterial parenchyma, lesion;
+  parenchyma.viscoelastic = ViscoelasticParameters{2500.0, 1000.0, 400.0};
+  parenchyma.tissue.youngs_modulus_pa = 3500.0;
+  lesion.viscoelastic = ViscoelasticParameters{8000.0, 2000.0, 900.0};
+  lesion.tissue.youngs_modulus_pa = 10000.0;
+  lesion.viscoplastic = ViscoplasticParameters{200.0, 5000.0, 0.5};
+  options.regions = {parenchyma, lesion};
+  for (std::size_t n = 0; n < mesh.node_count(); ++n)
+    if (mesh.rest_position_m.z[n] < 1e-9) options.fixed_nodes.push_back(static_cast<NodeIndex>(n));
+  const SimModel model = build_model(mesh, options);
+  SimState state = make_rest_state(model);
+  // A history to carry: a different plastic strain and Maxwell stress in every element.
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    state.viscous_history.value(ViscousHistory::kEquivalentPlasticStrain, e) = 1e-3 * e;
+    state.viscous_history.value(ViscousHistory::kMaxwellStress + 2, e) = 0.5 * e;
+  }
+  // Through the lesion's middle, down past it.
+  const CutResult cut = cut_tissue(model, state, vertical_cut(0.031, 0.005), cut_anything());
+  ASSERT_TRUE(cut.cut());
+  const SimModel& after = *cut.model;
+  std::set<std::pair<int, int>> regions_across_cut;  // regions on either side of cut faces
+  for (std::size_t i = 0; i < after.tet_count; ++i) {
+    const auto old = static_cast<std::size_t>(cut.element_origin[i]);
+    ASSERT_EQ(after.region[i], model.region[old]);
+    EXPECT_EQ(cut.state.viscous_history.equivalent_plastic_strain(i),
+              state.viscous_history.equivalent_plastic_strain(old));
+    EXPECT_EQ(cut.state.viscous_history.value(ViscousHistory::kMaxwellStress + 2, i),
+              state.viscous_history.value(ViscousHistory::kMaxwellStress + 2, old));
+    if (after.cut_face_mask[i]) regions_across_cut.insert({after.region[i], 0});
+  }
+  // The cut ran through both tissues.
+  EXPECT_TRUE(regions_across_cut.count({0, 0}) && regions_across_cut.count({1, 0}));
+  EXPECT_TRUE(boundary_is_manifold(after));
+  EXPECT_TRUE(elements_are_sound(after, cut.state));
+  EXPECT_NEAR(total_mass_kg(after), total_mass_kg(model), 1e-12 * total_mass_kg(model));
+}
+
+TEST(Cutting, TheCuttingStressIsTheVonMisesStressOfTheTissue) {
+  // Uniaxial stress at small strain ε: σ_xx = E ε, the rest ≈ 0, so von Mises ≈ E ε, to O(ε²).
+  ModelOptions options;
+  options.regions[0].tissue.poisson_ratio = 0.3;
+  const SimModel model = block_model(0.0, options);
+  SimState state = make_rest_state(model);
+  const double strain = 1e-4, nu = 0.3, E = options.regions[0].tissue.youngs_modulus_pa;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    const Eigen::Vector3d X = model.rest_position_m.at(n);
+    state.position_m.set(n, Eigen::Vector3d((1 + strain) * X.x(), (1 - nu * strain) * X.y(),
+                                            (1 - nu * strain) * X.z()));
+  }
+  for (std::size_t e = 0; e < model.tet_count; e += 17)
+    EXPECT_NEAR(element_cutting_stress_pa(model, state, e), E * strain, 10 * strain * E * strain);
+
+  // Past the threshold the blade cuts, below it the tissue only deforms.
+  CuttingSettings settings;
+  settings.cutting_stress_pa = 0.9 * E * strain;
+  EXPECT_TRUE(cut_tissue(model, state, vertical_cut(0.032, 0.005), settings).cut());
+  settings.cutting_stress_pa = 1.1 * E * strain;
+  const CutResult below = cut_tissue(model, state, vertical_cut(0.032, 0.005), settings);
+  EXPECT_FALSE(below.cut());
+  EXPECT_EQ(below.report.elements_over_threshold, 0u);
+}
+
+TEST(Cutting, TheLocalFrequencyOfTheWholeMeshIsItsLargestFrequency) {
+  // Over every node, the local estimate is the model's own power iteration on the whole mesh
+  // (with the average nodal pressure the default liver uses), to the iterations' convergence.
+  const SceneSetup scene = default_scene(1500);
+  const SimModel liver = build_model(scene.mesh, scene.model_options);
+  std::vector<NodeIndex> all(liver.node_count);
+  std::iota(all.begin(), all.end(), 0);
+  EXPECT_NEAR(local_max_frequency_rad_per_s(liver, all), liver.max_frequency_rad_per_s,
+              0.01 * liver.max_frequency_rad_per_s);
+}
+
+TEST(Cutting, AfterACutTheStableStepCoversTheNewMesh) {
+  const SceneSetup scene = default_scene(1500);
+  const SimModel liver = build_model(scene.mesh, scene.model_options);
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < liver.node_count; ++n) box.extend(liver.rest_position_m.at(n));
+  const Eigen::Vector3d c = box.center();
+  const CutResult cut =
+      cut_tissue(liver, make_rest_state(liver),
+                 sweep_of({c.x() - 0.06, c.y(), box.max().z() + 0.01},
+                          {c.x() - 0.06, c.y(), box.min().z() - 0.01}, {0.12, 0.0, 0.0}),
+                 cut_anything());
+  ASSERT_TRUE(cut.cut());
+  EXPECT_GT(cut.report.duplicated_nodes, 0u);
+  // The whole cut mesh's power iteration finds no frequency above the one the cut set (both
+  // estimates are from below; 2 %: their convergence).
+  const double whole = estimate_max_frequency_rad_per_s(*cut.model, cut.model->rest_position_m);
+  EXPECT_LE(whole, 1.02 * cut.model->max_frequency_rad_per_s);
+  EXPECT_GE(cut.model->max_frequency_rad_per_s, liver.max_frequency_rad_per_s);
+  EXPECT_LE(cut.model->stable_time_step_s, liver.stable_time_step_s);
+}
+
+TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
+  const SimModel model = block_model();
+  const SimState state = make_rest_state(model);
+  BladeStroke stroke = vertical_cut(0.032, 0.005);
+  stroke.edges_m[1][0].x() = std::nan("");
+  EXPECT_THROW(cut_tissue(model, state, stroke, cut_anything()), std::invalid_argument);
+  CuttingSettings settings;
+  settings.cutting_stress_pa = -1.0;
+  try {
+    cut_tissue(model, state, vertical_cut(0.032, 0.005), settings);
+    FAIL() << "a negative cutting stress was taken";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("cutting stress"), std::string::npos);
+  }
+  settings = {};
+  settings.snap_fraction = 0.7;
+  EXPECT_TRUE(validate(settings).has_value());
+  settings = {};
+  settings.snap_min_shape_fraction = std::nan("");
+  EXPECT_TRUE(validate(settings).has_value());
+  EXPECT_FALSE(validate(CuttingSettings{}).has_value());
+}
+
+}  // namespace
+}  // namespace liversim
