@@ -1,6 +1,7 @@
 // liversim-cli: headless simulation, mesh reports and screenshots.
 #include "bench_command.h"
 #include "cli_commands.h"
+#include "cut_bench_command.h"
 #include "experiment_commands.h"
 #include "study_command.h"
 
@@ -135,6 +136,7 @@ int main(int argc, char** argv) {
   const auto run_experiment = add_experiment_command(app);
   const auto run_study = add_study_command(app);
   const auto run_bench = add_bench_command(app);
+  const auto run_cut_bench = add_cut_bench_command(app);
 
   try {
     app.parse(argc, argv);
@@ -146,6 +148,7 @@ int main(int argc, char** argv) {
   if (auto exit_code = run_experiment()) return *exit_code;
   if (auto exit_code = run_study()) return *exit_code;
   if (auto exit_code = run_bench()) return *exit_code;
+  if (auto exit_code = run_cut_bench()) return *exit_code;
   if (report->parsed()) return mesh_report(report_mesh);
   if (simulate_cmd->parsed()) return simulate(sim);
   if (screenshot_cmd->parsed()) return screenshot(shot);
