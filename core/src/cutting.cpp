@@ -700,11 +700,9 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
         plus && minus ? (surface.side_distance_m(centroid) >= 0.0 ? 1 : -1) : (plus ? 1 : -1);
   }
 
-  // 4. The faces to separate: between elements on opposite sides, one of them past the
-  // threshold, where every element around the face's nodes has its side settled: the sweep
-  // passed all the way through it, or it lies wholly on one side. Around such a node the
-  // separated faces are the whole interface of two sides, so they part it cleanly into pieces;
-  // an element the blade is still inside holds its nodes back until the stroke has passed it.
+  // 4. The faces to separate: between elements on opposite sides, both settled (the sweep
+  // passed all the way through it, or it lies wholly on one side), one of them past the
+  // threshold. An element the blade is still inside holds its faces until the stroke has passed.
   auto settled_side = [&](std::size_t e) -> int {
     if (swept[e]) return cut_through[e] ? element_side[e] : 0;
     int side = 0;
@@ -714,16 +712,6 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
       side = label;
     }
     return side;
-  };
-  std::vector<std::int8_t> node_settled(model.node_count, 2);  // 2: not yet known
-  auto settled = [&](NodeIndex n) {
-    if (node_settled[n] == 2) {
-      node_settled[n] = 1;
-      for_each_element_of(model, n, [&](std::size_t e) {
-        if (settled_side(e) == 0) node_settled[n] = 0;
-      });
-    }
-    return node_settled[n] == 1;
   };
   std::vector<FaceKey> separated;
   for (std::size_t a : zone) {
@@ -735,8 +723,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
       const int side_b = settled_side(*b);
       if (side_b == 0 || side_b == side_a) continue;
       if (!over_threshold[a] && !(swept[*b] && over_threshold[*b])) continue;
-      const FaceKey key = face_key(model, a, f);
-      if (settled(key[0]) && settled(key[1]) && settled(key[2])) separated.push_back(key);
+      separated.push_back(face_key(model, a, f));
     }
   }
   if (separated.empty()) return result;

@@ -156,8 +156,7 @@ TEST(Cutting, PartialCutIsCleanOnTheSweptPlaneAndLeavesTheCrackFrontJoined) {
   // cut crosses, and snap onto it.
   const double x = 0.032;
   // The blade reaches down to z = 0.005, inside the bottom layer of cubes: those it is still
-  // inside are not cut, so the nodes at z = 0.01 keep their elements together and the cut's
-  // front is the row of nodes at z = 0.02, whose elements it has all passed.
+  // inside are not cut, so the cut's front is the row of nodes at z = 0.01 on top of them.
   const CutResult cut = cut_tissue(model, state, vertical_cut(x, 0.005), cut_anything());
   ASSERT_TRUE(cut.cut());
   const SimModel& after = *cut.model;
@@ -168,15 +167,15 @@ TEST(Cutting, PartialCutIsCleanOnTheSweptPlaneAndLeavesTheCrackFrontJoined) {
   EXPECT_TRUE(boundary_is_manifold(after));
   EXPECT_TRUE(elements_are_sound(after, cut.state));
   // Clean: every cut face lies on the plane (the snapped nodes are exactly on it), and they
-  // cover both lips of the cut, 0.05 m wide from the top (0.04) to the front (0.02).
+  // cover both lips of the cut, 0.05 m wide from the top (0.04) to the front (0.01).
   for (const auto& face : cut_faces_at_rest(after))
     for (const Eigen::Vector3d& p : face) {
       EXPECT_NEAR(p.x(), x, 1e-12);
-      EXPECT_GE(p.z(), 0.02 - 1e-12);
+      EXPECT_GE(p.z(), 0.01 - 1e-12);
     }
-  EXPECT_NEAR(cut_area_m2(after), 2 * 0.05 * 0.02, 1e-12);
-  // The six nodes of each row above the front got a copy (rows z = 0.03 and 0.04).
-  EXPECT_EQ(cut.report.duplicated_nodes, 2u * 6u);
+  EXPECT_NEAR(cut_area_m2(after), 2 * 0.05 * 0.03, 1e-12);
+  // The six nodes of each row above the front got a copy (rows z = 0.02, 0.03 and 0.04).
+  EXPECT_EQ(cut.report.duplicated_nodes, 3u * 6u);
   // Mass and volume unchanged (nothing came off).
   EXPECT_NEAR(total_mass_kg(after), total_mass_kg(model), 1e-12 * total_mass_kg(model));
   EXPECT_NEAR(total_volume_m3(after), total_volume_m3(model), 1e-12 * total_volume_m3(model));

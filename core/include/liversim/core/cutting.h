@@ -51,8 +51,7 @@ std::optional<std::string> validate(const CuttingSettings& settings);
 // The surface a blade edge sweeps over a stroke: the edge (heel, tip) at successive instants
 // (scene, m); between instants i and i + 1 it covers the triangles (heel_i, tip_i, tip_i+1) and
 // (heel_i, tip_i+1, heel_i+1). An element is cut once the stroke has passed all the way through
-// it, however many instants that took, and a node parts once every element around it is settled
-// on a side; so a stroke keeps all its edges until it ends (the blade is lifted).
+// it, however many instants that took, so a stroke keeps all its edges until it ends.
 struct BladeStroke {
   std::vector<std::array<Eigen::Vector3d, 2>> edges_m;
 
