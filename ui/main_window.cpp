@@ -5,6 +5,7 @@
 #include "tool_panel.h"
 #include "vtk_viewport.h"
 
+#include "liversim/core/cutting.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/surface.h"
 
@@ -44,7 +45,15 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
       std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
   // The visual surface's triangles are the physics boundary's (its vertex i is node nodes[i]).
   simulation_->enable_tools(setup_.visual.surface);
+  simulation_->enable_cutting();
   scene_ = std::make_unique<LiverScene>(setup_.mesh, setup_.visual);
+  std::vector<double> smooth_xyz;
+  map_visual_positions(setup_.visual, setup_.mesh.rest_position_m, smooth_xyz);
+  for (std::size_t v = 0; v < setup_.visual.vertex_count(); ++v) {
+    const Eigen::Vector3d node = setup_.mesh.rest_position_m.at(setup_.visual.surface.nodes[v]);
+    smoothVertexAt_[{node.x(), node.y(), node.z()}] =
+        Eigen::Vector3d(smooth_xyz[3 * v], smooth_xyz[3 * v + 1], smooth_xyz[3 * v + 2]);
+  }
 
   viewport_ = new VtkViewport(this);
   viewport_->setObjectName("liverViewport");
@@ -112,12 +121,23 @@ bool MainWindow::applyIntegratorSettings(const IntegratorSettings& settings) {
   accuracyPanel_->setBusy(true);
   ModelOptions options = setup_.model_options;
   options.integrator = settings;
-  modelBuilder_ = std::thread([this, options = std::move(options), settings] {
+  // A cut liver is not the scene's mesh any more: its model is taken as it is.
+  std::shared_ptr<const SimModel> cut =
+      shownTopology_ > 0 ? simulation_->snapshot().model : nullptr;
+  modelBuilder_ = std::thread([this, options = std::move(options), settings, cut] {
     std::shared_ptr<const SimModel> model;
     QString error;
     try {
-      // build_model checks the settings first, so a bad entry is refused at once.
-      model = std::make_shared<const SimModel>(build_model(setup_.mesh, options));
+      if (cut) {
+        validate_integrator(settings);
+        auto changed = std::make_shared<SimModel>(*cut);
+        changed->integrator = settings;
+        changed->stable_time_step_s = stable_time_step_s(*changed, StepInputs{});
+        model = std::move(changed);
+      } else {
+        // build_model checks the settings first, so a bad entry is refused at once.
+        model = std::make_shared<const SimModel>(build_model(setup_.mesh, options));
+      }
     } catch (const std::exception& e) {
       error = QString::fromUtf8(e.what());
     }
@@ -146,6 +166,13 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   // its own history (a multistep scheme its first step, an adaptive one its step size).
   simulation_->stop();
   const SimState& old = simulation_->state();
+  if (old.position_m.size() != model->node_count) {  // a cut came in while the model was built
+    simulation_->start();
+    accuracyPanel_->showError(
+        tr("The liver was cut while the integrator changed; apply it again."));
+    emit integratorChangeFinished(false);
+    return;
+  }
   SimState state = make_rest_state(*model, shared_worker_pool());
   state.position_m = old.position_m;
   state.velocity_m_per_s = old.velocity_m_per_s;
@@ -165,7 +192,8 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
     return;
   }
   if (grab_) simulation_->set_springs(springs_);
-  simulation_->enable_tools(setup_.visual.surface);
+  simulation_->enable_tools(scene_->surface());
+  simulation_->enable_cutting();
   if (tool_) simulation_->set_tool(tool_);
   simulation_->start();
   setup_.model_options.integrator = settings;
@@ -181,7 +209,7 @@ bool MainWindow::beginGrab(QPoint pos, Qt::MouseButton button, Qt::KeyboardModif
   const auto hit = scene_->pick(pos.x(), pos.y());
   if (!hit) return false;  // background: the camera takes the drag
   grab_ = grab_surface(scene_->surface(), simulation_->snapshot().position_m,
-                       simulation_->model().lumped_mass_kg, hit->point_m, kGrabRadiusM,
+                       simulation_->snapshot().model->lumped_mass_kg, hit->point_m, kGrabRadiusM,
                        kGrabStiffnessNPerM);
   handle_m_ = hit->point_m;
   scene_->show_grab_marker(handle_m_);
@@ -233,7 +261,9 @@ bool MainWindow::beginTool(ToolKind kind, QPoint pos) {
       tool.pose.origin_m = hit->point_m - (forceps_grasp_point_m(tool) - tool.pose.origin_m);
       break;
     case ToolKind::scalpel:
-      tool.pose.origin_m = hit->point_m + tool.geometry.blade_length_m * shaft;
+      // The blade goes in where you press, its heel just above the surface so that drawing it
+      // along keeps the edge through the tissue's top: it cuts once the tissue gives way.
+      tool.pose.origin_m = hit->point_m + 0.004 * shaft;
       break;
   }
   tool_ = tool;
@@ -276,6 +306,23 @@ void MainWindow::showTool() {
 void MainWindow::showNewestSnapshot() {
   if (simulation_->update_snapshot()) {
     const SimulationSnapshot& snapshot = simulation_->snapshot();
+    if (snapshot.topology_version != shownTopology_ && snapshot.model) {
+      // Cut: the surface is the cut mesh's boundary now, its cut faces in the interior colour.
+      // A node still where a node of the organ's surface was (the same node, or its copy) keeps
+      // that node's smooth visual vertex; the others show where they are.
+      const TetMesh mesh = model_mesh(*snapshot.model);
+      BoundarySurface surface = extract_surface(mesh);
+      std::vector<Eigen::Vector3d> vertex_rest(surface.nodes.size());
+      for (std::size_t v = 0; v < surface.nodes.size(); ++v) {
+        const Eigen::Vector3d rest = mesh.rest_position_m.at(surface.nodes[v]);
+        const auto smooth = smoothVertexAt_.find({rest.x(), rest.y(), rest.z()});
+        vertex_rest[v] = smooth != smoothVertexAt_.end() ? smooth->second : rest;
+      }
+      VisualSurface visual = embed_visual_surface(mesh, surface, vertex_rest);
+      const auto cut_faces = cut_face_flags(*snapshot.model, visual.surface);
+      scene_->set_surface(std::move(visual), cut_faces, snapshot.position_m);
+      shownTopology_ = snapshot.topology_version;
+    }
     scene_->update_positions(snapshot.position_m);
     if (tool_)
       toolPanel_->showForce(snapshot.time_s, snapshot.tool_force_n, snapshot.tool_grasping);
@@ -321,6 +368,8 @@ void MainWindow::updateStatus() {
         grab_reaction_force_n(*grab_, handle_m_, simulation_->snapshot().position_m);
     text += tr(" | pulling %1 N").arg(force.norm(), 0, 'f', 2);
   }
+  if (const double resected_m3 = simulation_->snapshot().resected_volume_m3; resected_m3 > 0.0)
+    text += tr(" | resected %1 mL").arg(resected_m3 * 1e6, 0, 'f', 1);
   statusLabel_->setText(text);
 }
 

@@ -11,6 +11,9 @@
 #include <QMainWindow>
 #include <QTimer>
 
+#include <array>
+#include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <thread>
@@ -89,6 +92,11 @@ class MainWindow : public QMainWindow {
 
   std::optional<Tool> tool_;
   Eigen::Vector3d toolPoint_m_ = Eigen::Vector3d::Zero();  // where the mouse holds the tool
+
+  std::uint64_t shownTopology_ = 0;  // the cut the scene shows (SimulationSnapshot)
+  // The smooth visual vertex of each node of the organ's surface, by the node's rest position
+  // (a cut's copy of a node sits where it did).
+  std::map<std::array<double, 3>, Eigen::Vector3d> smoothVertexAt_;
 
   int framesInWindow_ = 0;
   QElapsedTimer frameWindow_;

@@ -89,6 +89,8 @@ std::vector<Eigen::Vector3d> fibre_directions(const std::vector<Eigen::Vector3d>
   return directions;
 }
 
+}  // namespace
+
 void validate_integrator(const IntegratorSettings& settings) {
   auto fail = [](const std::string& what, double value, const char* expected) {
     std::ostringstream message;
@@ -108,8 +110,6 @@ void validate_integrator(const IntegratorSettings& settings) {
   if (settings.max_newton_iterations < 1)
     fail("Newton iteration limit", settings.max_newton_iterations, "at least 1");
 }
-
-}  // namespace
 
 SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   validate_regions(options.regions);

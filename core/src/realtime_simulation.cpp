@@ -12,8 +12,10 @@
 namespace liversim {
 namespace {
 
-SimulationSnapshot snapshot_of(const SimState& state) {
-  return {state.position_m, state.time_s, state.step_count};
+SimulationSnapshot snapshot_of(const SimState& state, std::shared_ptr<const SimModel> model) {
+  SimulationSnapshot snapshot{state.position_m, state.time_s, state.step_count};
+  snapshot.model = std::move(model);
+  return snapshot;
 }
 
 // Whole steps that fit in `cycle_s`, at least one: a step longer than a cycle is still taken.
@@ -68,7 +70,8 @@ RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
       max_steps_per_cycle_(options.max_steps_per_cycle > 0
                                ? options.max_steps_per_cycle
                                : steps_per_cycle(options.cycle_s, step_s_)),
-      snapshots_(snapshot_of(state_)) {
+      snapshots_(snapshot_of(state_, model_)),
+      integrator_kind_(model_->integrator.kind) {
   if (!(step_s_ > 0.0) || !std::isfinite(step_s_))
     throw std::invalid_argument("the model has no usable time step (" + std::to_string(step_s_) +
                                 " s)");
@@ -96,9 +99,58 @@ void RealtimeSimulation::enable_tools(const BoundarySurface& surface, ContactSet
                                       GraspSettings grasp) {
   if (running()) throw std::logic_error("enable_tools: stop the simulation first");
   tools_.emplace(*model_, surface, contact, grasp);
+  contact_settings_ = contact;
+  grasp_settings_ = grasp;
   // The set springs and at most two per surface node from the tool (hold and contact): no
   // reallocation in a step.
   step_springs_.reserve(options_.spring_capacity + 2 * surface.nodes.size());
+}
+
+void RealtimeSimulation::enable_cutting(CuttingSettings settings) {
+  if (running()) throw std::logic_error("enable_cutting: stop the simulation first");
+  if (!tools_) throw std::logic_error("enable_cutting: enable the tools first");
+  if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
+  cutting_ = settings;
+}
+
+void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
+  const auto edge = blade_edge_m(scalpel);
+  if (!blade_in_tissue_) {
+    // Breaks in where an element the blade pushes is stressed to the cutting threshold.
+    double stress_pa = -1.0;
+    for (const NodeSpring& spring : tools_->springs())
+      for (std::int32_t s = model_->node_slot_begin[spring.node];
+           s < model_->node_slot_begin[spring.node + 1]; ++s)
+        stress_pa = std::max(
+            stress_pa, element_cutting_stress_pa(*model_, state_, model_->node_slot_element[s]));
+    if (stress_pa < cutting_->cutting_stress_pa) return;
+    blade_in_tissue_ = true;
+    stroke_.edges_m.assign(1, edge);
+    return;
+  }
+  // A new instant of the stroke once the edge has moved a tenth of a millimetre.
+  if (!stroke_.edges_m.empty()) {
+    const auto& last = stroke_.edges_m.back();
+    if ((edge[0] - last[0]).norm() < 1e-4 && (edge[1] - last[1]).norm() < 1e-4) return;
+  }
+  stroke_.add(edge);
+  if (stroke_.edges_m.size() < 2) return;
+  CutResult cut = cut_tissue(*model_, state_, stroke_, *cutting_);
+  if (!cut.cut()) return;
+  model_ = std::move(cut.model);
+  state_ = std::move(cut.state);
+  checkpoint_ = make_checkpoint(*model_);
+  const BoundarySurface surface = extract_surface(model_mesh(*model_));
+  tools_.emplace(*model_, surface, contact_settings_, grasp_settings_);
+  step_springs_.reserve(options_.spring_capacity + 2 * surface.nodes.size());
+  {
+    std::lock_guard lock(springs_mutex_);
+    pending_springs_.clear();
+    springs_changed_ = false;
+  }
+  active_springs_.clear();
+  ++topology_version_;
+  resected_volume_m3_ += cut.report.resected_volume_m3;
 }
 
 void RealtimeSimulation::set_tool(const std::optional<Tool>& tool) {
@@ -121,8 +173,8 @@ RealtimeStats RealtimeSimulation::stats() const {
   stats.real_time_factor = real_time_factor_.load();
   stats.step_s = smallest_step_s_.load();
   stats.behind = behind_.load();
-  stats.integrator = model_->integrator.kind;
-  stats.integrator_name = integrator_name(model_->integrator.kind);
+  stats.integrator = integrator_kind_;
+  stats.integrator_name = integrator_name(integrator_kind_);
   stats.requested_step_s = step_s_;
   stats.error_estimate_m = error_estimate_m_.load();
   stats.wall_s_per_simulated_s = wall_s_per_simulated_s_.load();
@@ -159,7 +211,6 @@ void merge_guarded(GuardedReport& total, const GuardedReport& one) {
 void RealtimeSimulation::run() {
   using Clock = std::chrono::steady_clock;
   using Seconds = std::chrono::duration<double>;
-  const SimModel& model = *model_;
   StepAccumulator clock(step_s_, max_steps_per_cycle_);
   auto last_cycle = Clock::now();
 
@@ -191,8 +242,13 @@ void RealtimeSimulation::run() {
         active_tool_ = pending_tool_;
         tool_changed_ = false;
         if (!active_tool_ && tools_) tools_->release();
+        if (!active_tool_ || active_tool_->kind != ToolKind::scalpel) {
+          stroke_.edges_m.clear();
+          blade_in_tissue_ = false;
+        }
       }
     }
+    const SimModel& model = *model_;  // a cut may replace it between cycles
     const bool tool_acts = tools_ && active_tool_;
     const StepInputs inputs{{}, active_springs_};
     const auto cycle_start = Clock::now();
@@ -211,7 +267,8 @@ void RealtimeSimulation::run() {
       // A tool's springs follow the surface: recomputed before every step of the cycle.
       auto tool_inputs = [&] {
         step_springs_.assign(active_springs_.begin(), active_springs_.end());
-        const auto tool_springs = tools_->update(*active_tool_, state_.position_m);
+        const auto tool_springs =
+            tools_->update(*active_tool_, state_.position_m, blade_in_tissue_);
         step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
         return StepInputs{{}, step_springs_};
       };
@@ -237,11 +294,14 @@ void RealtimeSimulation::run() {
       rollbacks_ += guarded.rollbacks;
       if (guarded.inputs_rejected) ++rejected_inputs_;
       if (guarded.gave_up) halted_ = true;
+      if (cutting_ && tool_acts && active_tool_->kind == ToolKind::scalpel && !guarded.gave_up)
+        cut_with_scalpel(*active_tool_);
       const StepReport& report = guarded.steps;
       window_integrating_s += Seconds(Clock::now() - cycle_start).count();
       accumulate(window_report, report);
       SimulationSnapshot& out = snapshots_.back();
-      out.position_m.x = state_.position_m.x;  // same size: copies without allocating
+      // Same size: copies without allocating (a cut's new size allocates once).
+      out.position_m.x = state_.position_m.x;
       out.position_m.y = state_.position_m.y;
       out.position_m.z = state_.position_m.z;
       out.time_s = state_.time_s;
@@ -250,6 +310,10 @@ void RealtimeSimulation::run() {
           tool_acts ? tools_->force_on_tool_n(state_.position_m) : Eigen::Vector3d::Zero();
       out.tool_grasping = tool_acts && tools_->grasping();
       out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
+      out.blade_cutting = tool_acts && blade_in_tissue_;
+      out.model = model_;
+      out.topology_version = topology_version_;
+      out.resected_volume_m3 = resected_volume_m3_;
       snapshots_.publish();
     } else {
       // Sleep towards the next step, but wake often enough to stop and to pick up springs.

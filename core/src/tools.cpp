@@ -292,7 +292,8 @@ void ToolInteraction::try_grasp(const Tool& tool, const NodeArray& position) {
   }
 }
 
-std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const NodeArray& position) {
+std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const NodeArray& position,
+                                                    bool blade_cuts) {
   bvh_.refit(position);
   springs_.clear();
   if (tool.kind == ToolKind::forceps) {
@@ -310,6 +311,7 @@ std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const Node
                           grasp_.stiffness_n_per_m[i], grasp_.damping_n_s_per_m[i]});
     count = 1;  // the shaft only (parts[0] of the forceps)
   }
+  if (blade_cuts && tool.kind == ToolKind::scalpel) count = 1;  // the blade passes: shaft only
   contact_count_ =
       add_contact_springs(*model_, bvh_, position, std::span<const Capsule>(parts.data(), count),
                           contact_, contact_scratch_, springs_);

@@ -282,5 +282,46 @@ TEST_F(RealtimeSteppingFixture, ForcepsInTheLoopHoldPullAndRelease) {
   EXPECT_EQ(check_health(*model, simulation.state()), HealthProblem::none);
 }
 
+// The scalpel in the running loop (issue 7): drawn along the liver with its blade in the
+// tissue, it cuts; the published snapshot carries the cut model (more nodes: copies along the
+// cut) with positions to match, and the simulation goes on healthy.
+TEST_F(RealtimeSteppingFixture, AScalpelDrawnThroughTheLiverCutsItWhileItRuns) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  EXPECT_THROW(simulation.enable_cutting(), std::logic_error) << "tools come first";
+  simulation.enable_tools(extract_surface(*mesh_));
+  CuttingSettings anything;
+  anything.cutting_stress_pa = 0.0;
+  simulation.enable_cutting(anything);
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < model->node_count; ++n) box.extend(model->rest_position_m.at(n));
+  // Blade pointing down (the tool's −z) from 5 mm above the top, 6 cm long.
+  Tool scalpel;
+  scalpel.kind = ToolKind::scalpel;
+  scalpel.geometry.blade_length_m = 0.06;
+  const Eigen::Vector3d start(box.center().x() - 0.04, box.center().y(), box.max().z() + 0.005);
+  scalpel.pose.origin_m = start;
+  simulation.set_tool(scalpel);
+  simulation.start();
+  EXPECT_THROW(simulation.enable_cutting(), std::logic_error) << "only while stopped";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  SimulationSnapshot seen;
+  for (int k = 0; k <= 80 && std::chrono::steady_clock::now() < deadline; ++k) {
+    scalpel.pose.origin_m = start + Eigen::Vector3d(0.001 * k, 0.0, 0.0);
+    simulation.set_tool(scalpel);
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    simulation.update_snapshot();
+    seen = simulation.snapshot();
+  }
+  simulation.set_tool(std::nullopt);
+  simulation.stop();
+  ASSERT_TRUE(seen.model);
+  EXPECT_GT(seen.topology_version, 0u) << "the stroke cut nothing";
+  EXPECT_GT(seen.model->node_count, model->node_count) << "no node copies along the cut";
+  EXPECT_EQ(seen.position_m.size(), seen.model->node_count);
+  EXPECT_FALSE(simulation.stats().halted);
+  EXPECT_EQ(check_health(*seen.model, simulation.state()), HealthProblem::none);
+}
+
 }  // namespace
 }  // namespace liversim

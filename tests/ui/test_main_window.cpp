@@ -356,6 +356,37 @@ TEST_F(MainWindowTest, ForcepsFromTheToolPanelHoldPullAndLetGo) {
   EXPECT_EQ(window_->simulation().snapshot().tool_force_n.norm(), 0.0);
 }
 
+// The scalpel drawn across the liver cuts it (issue 7): the simulation's mesh gains node copies
+// along the cut, the scene shows the cut mesh's surface with its cut faces in the interior colour,
+// and the liver goes on simulating.
+TEST_F(MainWindowTest, TheScalpelDrawnAcrossTheLiverCutsIt) {
+  const std::optional<QPoint> start = pointOnTheLiver();
+  ASSERT_TRUE(start);
+  auto* scalpel = window_->toolPanel()->findChild<QRadioButton*>("toolScalpel");
+  ASSERT_NE(scalpel, nullptr);
+  scalpel->click();
+  const std::size_t nodes_before = window_->simulation().snapshot().model->node_count;
+  const QImage before = window_->viewport()->grabRendering();
+  pictures_.emplace_back("before", before);
+  // Across the liver: a long stroke, so that it passes whole elements.
+  const QPoint across(160, 0);
+  pressAndMove(*start - across / 2, *start + across / 2, [] {});
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().topology_version > 0; },
+                              kSimulatedTimeTimeoutMs))
+      << "the scalpel drawn across the liver cut nothing (contacts "
+      << window_->simulation().snapshot().tool_contacts << ", blade in the tissue "
+      << window_->simulation().snapshot().blade_cutting << ")";
+  const QImage cutting = window_->viewport()->grabRendering();
+  pictures_.emplace_back("cutting", cutting);
+  release(*start + across / 2);
+  ASSERT_TRUE(waitSimulated(0.1));
+  const SimulationSnapshot after = window_->simulation().snapshot();
+  EXPECT_GT(after.model->node_count, nodes_before) << "no node copies along the cut";
+  EXPECT_EQ(after.position_m.size(), after.model->node_count);
+  EXPECT_FALSE(window_->simulation().stats().halted);
+  EXPECT_GT(countDifferentPixels(before, cutting), 100) << "neither the scalpel nor the cut shows";
+}
+
 TEST_F(MainWindowTest, DraggingTheBackgroundTurnsTheCameraAndGrabsNothing) {
   const QPoint corner(20, 20);
   ASSERT_FALSE(pickAt(corner)) << "the liver covers the corner of the viewport";
@@ -431,7 +462,9 @@ TEST_F(MainWindowTest, EveryIntegratorChosenInThePanelRunsTheSimulation) {
 TEST_F(MainWindowTest, ChangingTheIntegratorDuringAPullKeepsTheTissueWhereItIs) {
   const std::optional<QPoint> start = pointOnTheLiver();
   ASSERT_TRUE(start);
-  pressAndMove(*start, *start + kDrag, [] {});
+  // Across the liver: a long stroke, so that it passes whole elements.
+  const QPoint across(160, 0);
+  pressAndMove(*start - across / 2, *start + across / 2, [] {});
   ASSERT_NE(window_->activeGrab(), nullptr);
   const Grab grab = *window_->activeGrab();
   ASSERT_TRUE(waitSimulated(0.5));

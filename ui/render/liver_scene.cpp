@@ -5,6 +5,7 @@
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkCellPicker.h>
 #include <vtkFloatArray.h>
 #include <vtkLight.h>
@@ -18,7 +19,9 @@
 #include <vtkRenderer.h>
 #include <vtkSphereSource.h>
 #include <vtkTubeFilter.h>
+#include <vtkUnsignedCharArray.h>
 
+#include <cmath>
 #include <stdexcept>
 
 namespace liversim {
@@ -26,33 +29,30 @@ namespace {
 
 // Liver parenchyma: a dark red-brown with a moist sheen.
 constexpr double kTissueColour[3] = {0.52, 0.17, 0.13};
+// Cut parenchyma: lighter and redder than the capsule-covered surface.
+constexpr double kCutColour[3] = {0.70, 0.24, 0.20};
 constexpr double kBackgroundTop[3] = {0.16, 0.18, 0.22};
 constexpr double kSteel[3] = {0.7, 0.72, 0.75};
 constexpr double kBackgroundBottom[3] = {0.05, 0.05, 0.07};
 
 }  // namespace
 
-LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual) : visual_(std::move(visual)) {
-  const BoundarySurface& surface = visual_.surface;
+LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual) {
   points_->SetDataTypeToDouble();
-  points_->SetNumberOfPoints(static_cast<vtkIdType>(surface.nodes.size()));
-  vtkNew<vtkCellArray> triangles;
-  triangles->AllocateExact(static_cast<vtkIdType>(surface.triangles.size()),
-                           static_cast<vtkIdType>(3 * surface.triangles.size()));
-  for (const auto& t : surface.triangles) {
-    const vtkIdType ids[3] = {t[0], t[1], t[2]};
-    triangles->InsertNextCell(3, ids);
-  }
   normals_->SetNumberOfComponents(3);
-  normals_->SetNumberOfTuples(static_cast<vtkIdType>(surface.nodes.size()));
   normals_->SetName("Normals");
+  face_colours_->SetNumberOfComponents(3);
+  face_colours_->SetName("Colours");
   polydata_->SetPoints(points_);
-  polydata_->SetPolys(triangles);
   polydata_->GetPointData()->SetNormals(normals_);
-  update_positions(mesh.rest_position_m);
+  polydata_->GetCellData()->SetScalars(face_colours_);
+  set_surface(std::move(visual), {}, mesh.rest_position_m);
 
   vtkNew<vtkPolyDataMapper> mapper;
   mapper->SetInputData(polydata_);
+  // The faces' own colours (the organ's surface, or its interior where cut), lit as the actor.
+  mapper->SetScalarModeToUseCellData();
+  mapper->SetColorModeToDirectScalars();
   liver_actor_->SetMapper(mapper);
   vtkProperty* tissue = liver_actor_->GetProperty();
   tissue->SetColor(kTissueColour[0], kTissueColour[1], kTissueColour[2]);
@@ -129,6 +129,29 @@ LiverScene::~LiverScene() = default;
 
 vtkRenderer* LiverScene::renderer() const {
   return renderer_.Get();
+}
+
+void LiverScene::set_surface(VisualSurface visual, const std::vector<std::uint8_t>& cut_faces,
+                             const NodeArray& position_m) {
+  visual_ = std::move(visual);
+  const BoundarySurface& surface = visual_.surface;
+  points_->SetNumberOfPoints(static_cast<vtkIdType>(surface.nodes.size()));
+  normals_->SetNumberOfTuples(static_cast<vtkIdType>(surface.nodes.size()));
+  vtkNew<vtkCellArray> triangles;
+  triangles->AllocateExact(static_cast<vtkIdType>(surface.triangles.size()),
+                           static_cast<vtkIdType>(3 * surface.triangles.size()));
+  face_colours_->SetNumberOfTuples(static_cast<vtkIdType>(surface.triangles.size()));
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    const vtkIdType ids[3] = {surface.triangles[t][0], surface.triangles[t][1],
+                              surface.triangles[t][2]};
+    triangles->InsertNextCell(3, ids);
+    const double* colour = t < cut_faces.size() && cut_faces[t] ? kCutColour : kTissueColour;
+    for (int k = 0; k < 3; ++k)
+      face_colours_->SetComponent(static_cast<vtkIdType>(t), k, std::round(255.0 * colour[k]));
+  }
+  polydata_->SetPolys(triangles);
+  face_colours_->Modified();
+  update_positions(position_m);
 }
 
 void LiverScene::update_positions(const NodeArray& position_m) {

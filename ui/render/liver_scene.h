@@ -26,6 +26,7 @@ class vtkRenderer;
 class vtkLineSource;
 class vtkSphereSource;
 class vtkTubeFilter;
+class vtkUnsignedCharArray;
 
 namespace liversim {
 
@@ -45,6 +46,10 @@ class LiverScene {
   vtkRenderer* renderer() const;
   const BoundarySurface& surface() const { return visual_.surface; }
 
+  // Shows another surface (the mesh changed: a cut), at these node positions; faces flagged in
+  // `cut_faces` (one per triangle; empty: none) in the colour of the organ's interior.
+  void set_surface(VisualSurface visual, const std::vector<std::uint8_t>& cut_faces,
+                   const NodeArray& position_m);
   // Moves the surface to these node positions (all mesh nodes). Allocates nothing after the first.
   void update_positions(const NodeArray& position_m);
   // Anterior view of the whole organ.
@@ -66,6 +71,7 @@ class LiverScene {
   vtkNew<vtkRenderer> renderer_;
   vtkNew<vtkPoints> points_;
   vtkNew<vtkFloatArray> normals_;
+  vtkNew<vtkUnsignedCharArray> face_colours_;
   vtkNew<vtkPolyData> polydata_;
   vtkNew<vtkActor> liver_actor_;
   vtkNew<vtkActor> grab_marker_;

@@ -135,6 +135,9 @@ struct SimModel {
 // of range.
 SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
 
+// Throws std::invalid_argument naming the first integrator setting out of range.
+void validate_integrator(const IntegratorSettings& settings);
+
 // Fills the model's node → element-corner incidence (node_slot_*) from its corners.
 void build_node_incidence(SimModel& model);
 

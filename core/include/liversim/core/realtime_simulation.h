@@ -8,6 +8,7 @@
 // the backlog beyond that cap is dropped, so simulated time runs slower than the wall clock instead
 // of the loop spiralling into ever longer catch-up cycles.
 
+#include "liversim/core/cutting.h"
 #include "liversim/core/forces.h"
 #include "liversim/core/health.h"
 #include "liversim/core/model.h"
@@ -37,6 +38,12 @@ struct SimulationSnapshot {
   Eigen::Vector3d tool_force_n = Eigen::Vector3d::Zero();
   bool tool_grasping = false;
   std::size_t tool_contacts = 0;
+  bool blade_cutting = false;  // the scalpel has broken into the tissue
+  // The model the positions belong to: a cut replaces it (and raises topology_version), so a
+  // reader rebuilds what it draws from the mesh when the version changes.
+  std::shared_ptr<const SimModel> model;
+  std::uint64_t topology_version = 0;
+  double resected_volume_m3 = 0.0;  // taken out by cuts since the start
 };
 
 struct RealtimeStats {
@@ -139,6 +146,15 @@ class RealtimeSimulation {
   void enable_tools(const BoundarySurface& surface, ContactSettings contact = {},
                     GraspSettings grasp = {});
   bool tools_enabled() const { return tools_.has_value(); }
+  // From then on a scalpel cuts (cutting.h). Its blade presses on the tissue like any tool until
+  // the stress in an element it pushes reaches the cutting threshold; then the blade breaks in:
+  // it stops pushing (only the shaft still does), its edge at each cycle extends the stroke, and
+  // the tissue the stroke has passed through is separated. Taking the scalpel away or changing
+  // the tool ends the stroke. A cut replaces the model and state (see SimulationSnapshot::model)
+  // and drops the springs set by set_springs (their nodes may be gone). Call while stopped,
+  // after enable_tools.
+  void enable_cutting(CuttingSettings settings = {});
+  bool cutting_enabled() const { return cutting_.has_value(); }
   // The tool's kind, pose and jaws from any thread (nothing: no tool in the scene); the newest
   // is used from the next cycle on.
   void set_tool(const std::optional<Tool>& tool);
@@ -147,8 +163,9 @@ class RealtimeSimulation {
   bool update_snapshot() { return snapshots_.update(); }
   const SimulationSnapshot& snapshot() const { return snapshots_.front(); }
 
-  // The simulation's own state; only while it is stopped (e.g. to carry positions and velocities
-  // over to a rebuilt model).
+  // The simulation's own state and model; only while it is stopped (e.g. to carry positions and
+  // velocities over to a rebuilt model). While it runs, a cut may replace both: take the model
+  // from the snapshot.
   const SimState& state() const { return state_; }
 
   RealtimeStats stats() const;
@@ -176,6 +193,16 @@ class RealtimeSimulation {
   std::optional<Tool> active_tool_;       // simulation thread's copy
   std::optional<ToolInteraction> tools_;  // simulation thread only once started
   std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tool's
+  ContactSettings contact_settings_;
+  GraspSettings grasp_settings_;
+  std::optional<CuttingSettings> cutting_;
+  BladeStroke stroke_;            // simulation thread only
+  bool blade_in_tissue_ = false;  // the scalpel broke in: its blade passes and cuts
+  std::uint64_t topology_version_ = 0;
+  double resected_volume_m3_ = 0.0;
+  IntegratorKind integrator_kind_;  // the model's, fixed: stats() reads it from any thread
+  // Extends the stroke with the scalpel's edge, cuts, and swaps in the cut model and state.
+  void cut_with_scalpel(const Tool& scalpel);
 
   std::atomic<bool> stop_requested_{false};
   // Statistics, written by the simulation thread once per window; each field on its own (a reader

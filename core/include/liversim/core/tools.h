@@ -150,9 +150,14 @@ class ToolInteraction {
   ToolInteraction(const SimModel& model, const BoundarySurface& surface,
                   ContactSettings contact = {}, GraspSettings grasp = {});
 
-  // The springs for the next interval at the tool's pose and the tissue's `position`. Allocates
-  // nothing (every buffer is sized for the whole surface at construction).
-  std::span<const NodeSpring> update(const Tool& tool, const NodeArray& position);
+  // The springs for the next interval at the tool's pose and the tissue's `position`. A scalpel
+  // whose blade is cutting (`blade_cuts`) pushes with its shaft only: the blade passes into the
+  // tissue it separates. Allocates nothing (every buffer is sized for the whole surface at
+  // construction).
+  std::span<const NodeSpring> update(const Tool& tool, const NodeArray& position,
+                                     bool blade_cuts = false);
+  // The springs of the last update.
+  std::span<const NodeSpring> springs() const { return springs_; }
 
   // The force of the tissue on the tool at `position` with the springs of the last update (N).
   Eigen::Vector3d force_on_tool_n(const NodeArray& position) const {
