@@ -67,7 +67,7 @@ int run(const CutBenchOptions& o) {
       all_ms.push_back(ms(t0, t1));
       continue;
     }
-    const BoundarySurface surface = extract_surface(model_mesh(*cut.model));
+    const BoundarySurface surface = boundary_surface(*cut.model);
     const auto t2 = clock::now();
     const SurfaceBvh bvh(surface, cut.state.position_m);
     const auto t3 = clock::now();
@@ -93,7 +93,8 @@ int run(const CutBenchOptions& o) {
       << " mm; after each step the cut is\n"
       << "updated with the stroke so far (`cut_tissue`), and when it changed the mesh the surface "
          "is\n"
-      << "extracted again and the contact hierarchy rebuilt. The cutting threshold is 0 (the blade "
+      << "read again (`boundary_surface`) and the contact hierarchy rebuilt. The cutting threshold "
+         "is 0 (the blade "
          "cuts\n"
       << "whatever it passes through). Target (issue 7): one update within a frame, 16 ms.\n\n"
       << std::fixed << std::setprecision(2)
@@ -107,7 +108,7 @@ int run(const CutBenchOptions& o) {
   row("every update (cut, and surface and hierarchy when it cut)", all_ms);
   row("updates that cut, whole", cutting_ms);
   row("`cut_tissue` alone, every update", cut_ms);
-  row("surface extraction, updates that cut", surface_ms);
+  row("surface (`boundary_surface`), updates that cut", surface_ms);
   row("hierarchy build, updates that cut", bvh_ms);
   doc << "\nOver the stroke: " << separated << " faces separated, " << duplicated
       << " node copies, " << snapped << " nodes snapped onto the cut; " << model->tet_count

@@ -311,7 +311,7 @@ void MainWindow::showNewestSnapshot() {
       // A node still where a node of the organ's surface was (the same node, or its copy) keeps
       // that node's smooth visual vertex; the others show where they are.
       const TetMesh mesh = model_mesh(*snapshot.model);
-      BoundarySurface surface = extract_surface(mesh);
+      BoundarySurface surface = boundary_surface(*snapshot.model);
       std::vector<Eigen::Vector3d> vertex_rest(surface.nodes.size());
       for (std::size_t v = 0; v < surface.nodes.size(); ++v) {
         const Eigen::Vector3d rest = mesh.rest_position_m.at(surface.nodes[v]);

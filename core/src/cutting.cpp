@@ -60,6 +60,30 @@ TetMesh model_mesh(const SimModel& model) {
   return mesh;
 }
 
+BoundarySurface boundary_surface(const SimModel& model) {
+  if (model.boundary_face_mask.empty()) return extract_surface(model_mesh(model));
+  BoundarySurface surface;
+  std::vector<std::int32_t> local(model.node_count, -1);
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    for (int f = 0; f < 4; ++f)
+      if ((model.boundary_face_mask[e] >> f) & 1)
+        for (int k = 0; k < 3; ++k) local[model.corner[kTetFace[f][k]][e]] = 0;
+  for (std::size_t n = 0; n < model.node_count; ++n)
+    if (local[n] == 0) {
+      local[n] = static_cast<std::int32_t>(surface.nodes.size());
+      surface.nodes.push_back(static_cast<NodeIndex>(n));
+    }
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    for (int f = 0; f < 4; ++f)
+      if ((model.boundary_face_mask[e] >> f) & 1) {
+        surface.triangles.push_back({local[model.corner[kTetFace[f][0]][e]],
+                                     local[model.corner[kTetFace[f][1]][e]],
+                                     local[model.corner[kTetFace[f][2]][e]]});
+        surface.triangle_tet.push_back(static_cast<TetIndex>(e));
+      }
+  return surface;
+}
+
 std::vector<std::uint8_t> cut_face_flags(const SimModel& model, const BoundarySurface& surface) {
   std::vector<std::uint8_t> flags(surface.triangles.size(), 0);
   if (model.cut_face_mask.empty()) return flags;
@@ -948,6 +972,13 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   for (auto& family : m.fibre_direction) take(family);
   if (m.cut_face_mask.empty()) m.cut_face_mask.assign(tets, 0);
   take(m.cut_face_mask);
+  if (m.boundary_face_mask.empty()) {  // the first cut: the organ's surface
+    m.boundary_face_mask.assign(tets, 0);
+    for (std::size_t e = 0; e < tets; ++e)
+      for (int f = 0; f < 4; ++f)
+        if (!neighbours(e, f)) m.boundary_face_mask[e] |= std::uint8_t(1u << f);
+  }
+  take(m.boundary_face_mask);
   m.element_mass_kg = std::move(geometry.element_mass_kg);
   take(m.element_mass_kg);
 
@@ -974,7 +1005,10 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     }
     if (corners_on_cut >= 3)
       for (int f = 0; f < 4; ++f)
-        if (is_separated(face_key(model, old, f))) m.cut_face_mask[i] |= std::uint8_t(1u << f);
+        if (is_separated(face_key(model, old, f))) {
+          m.cut_face_mask[i] |= std::uint8_t(1u << f);
+          m.boundary_face_mask[i] |= std::uint8_t(1u << f);
+        }
     reshaped[i] = moved;
     if (!moved) continue;
     const Eigen::Vector3d x0 = m.rest_position_m.at(m.corner[0][i]);

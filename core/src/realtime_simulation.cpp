@@ -140,7 +140,7 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   model_ = std::move(cut.model);
   state_ = std::move(cut.state);
   checkpoint_ = make_checkpoint(*model_);
-  const BoundarySurface surface = extract_surface(model_mesh(*model_));
+  const BoundarySurface surface = boundary_surface(*model_);
   tools_.emplace(*model_, surface, contact_settings_, grasp_settings_);
   step_springs_.reserve(options_.spring_capacity + 2 * surface.nodes.size());
   {

@@ -104,6 +104,11 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
 // The mesh of a model (rest positions, elements, regions), e.g. to extract its surface.
 TetMesh model_mesh(const SimModel& model);
 
+// The model's boundary: read off its boundary-face marks once it has been cut (no hashing of
+// every face), else extract_surface of its mesh. The same triangles either way (their order
+// differs).
+BoundarySurface boundary_surface(const SimModel& model);
+
 // Which triangles of `surface` (extracted from the model's mesh) are faces made by cuts (shown as
 // the tissue's interior), one flag per triangle.
 std::vector<std::uint8_t> cut_face_flags(const SimModel& model, const BoundarySurface& surface);

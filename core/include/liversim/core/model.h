@@ -123,6 +123,10 @@ struct SimModel {
   // Faces made by cuts (cutting.h), per element: bit c for the face opposite corner c. Empty until
   // the first cut.
   std::vector<std::uint8_t> cut_face_mask;
+  // Faces on the boundary (the organ's surface and cut faces), per element, bit c as above; kept
+  // by cuts so that a cut surface is read off the elements instead of hashed again. Empty until
+  // the first cut.
+  std::vector<std::uint8_t> boundary_face_mask;
   // Mass of each element, kept through cuts (a node snapped onto a cut on a curved surface
   // changes its elements' volumes a little, never the mass). Empty until the first cut: density
   // times rest volume.
