@@ -5,8 +5,33 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
+#include <array>
+
 namespace liversim {
 namespace {
+
+// Σ term(i) over [0, count) in kChunks fixed chunks added in chunk order, so the sum is the same
+// on any number of threads; on `workers` when given. Allocates nothing.
+template <typename Term>
+double chunked_sum(std::size_t count, WorkerPool* workers, const Term& term) {
+  constexpr std::size_t kChunks = 64;
+  std::array<double, kChunks> partial{};
+  const std::size_t per_chunk = (count + kChunks - 1) / kChunks;
+  auto run_chunk = [&](std::size_t chunk) {
+    double sum = 0.0;
+    const std::size_t end = std::min(count, (chunk + 1) * per_chunk);
+    for (std::size_t i = chunk * per_chunk; i < end; ++i) sum += term(i);
+    partial[chunk] = sum;
+  };
+  if (workers)
+    workers->run(kChunks, run_chunk);
+  else
+    for (std::size_t chunk = 0; chunk < kChunks; ++chunk) run_chunk(chunk);
+  double total = 0.0;
+  for (double value : partial) total += value;
+  return total;
+}
 
 double viscous_element_energy_density(const SimModel& model, const SimState& state,
                                       const ViscousTissueParameters& law, std::size_t e,
@@ -35,9 +60,10 @@ bool is_viscous(const SimModel& model, std::size_t e) {
 // of its volume to each corner (elements of viscous regions keep their own J and take no part).
 // The forces are this potential's exact gradient (forces.cpp). Each element's J is recomputed
 // once per corner rather than stored, so nothing is allocated.
-double nodal_lambda_energy_j(const SimModel& model, const NodeArray& position) {
-  double energy = 0.0;
-  for (std::size_t n = 0; n < model.node_count; ++n) {
+double nodal_lambda_energy_j(const SimModel& model, const NodeArray& position,
+                             WorkerPool* workers) {
+  return chunked_sum(model.node_count, workers, [&](std::size_t n) {
+    double energy = 0.0;
     double weighted = 0.0, volume = 0.0;
     for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
       const auto e = static_cast<std::size_t>(model.node_slot_element[s]);
@@ -52,28 +78,27 @@ double nodal_lambda_energy_j(const SimModel& model, const NodeArray& position) {
       energy += 0.25 * model.rest_volume_m3[e] *
                 neo_hookean::lambda_energy_density(averaged, model.lame_lambda_pa[e]);
     }
-  }
-  return energy;
+    return energy;
+  });
 }
 
 }  // namespace
 
 double tissue_energy_j(const SimModel& model, const SimState& state) {
   const bool averaged_pressure = model.effects.average_nodal_pressure;
-  double energy = 0.0;
-  for (std::size_t e = 0; e < model.tet_count; ++e) {
+  WorkerPool* workers = state.force_scratch.workers.get();
+  double energy = chunked_sum(model.tet_count, workers, [&](std::size_t e) {
     const Eigen::Matrix3d F = deformation_gradient(model, state.position_m, e);
     if (is_viscous(model, e)) {
       const auto& law = *model.viscous_parameters[static_cast<std::size_t>(model.region[e])];
-      energy += model.rest_volume_m3[e] * viscous_element_energy_density(model, state, law, e, F);
-      continue;
+      return model.rest_volume_m3[e] * viscous_element_energy_density(model, state, law, e, F);
     }
     double psi = element_energy_density(model, e, F);
     if (averaged_pressure)  // its λ part is at the nodes
       psi -= neo_hookean::lambda_energy_density(F.determinant(), model.lame_lambda_pa[e]);
-    energy += model.rest_volume_m3[e] * psi;
-  }
-  if (averaged_pressure) energy += nodal_lambda_energy_j(model, state.position_m);
+    return model.rest_volume_m3[e] * psi;
+  });
+  if (averaged_pressure) energy += nodal_lambda_energy_j(model, state.position_m, workers);
   return energy;
 }
 
