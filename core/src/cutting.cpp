@@ -588,6 +588,37 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
   return std::sqrt(std::max(largest, 0.0));
 }
 
+bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
+                          const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m) {
+  const Aabb edge_box = Aabb::around(edge_m[0], edge_m[1], reach_m);
+  const Eigen::Vector3d along = edge_m[1] - edge_m[0];
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const auto p = corners_at(model, position_m, e);
+    Aabb box;
+    for (const auto& q : p) box.grow(q);
+    if (!box.overlaps(edge_box)) continue;
+    // Clip the segment heel + t·along, t in [0, 1], by the element's four faces (Cyrus–Beck).
+    double t_in = 0.0, t_out = 1.0;
+    for (int f = 0; f < 4 && t_in <= t_out; ++f) {
+      const auto& face = kTetFace[f];
+      const Eigen::Vector3d& a = p[face[0]];
+      Eigen::Vector3d normal = (p[face[1]] - a).cross(p[face[2]] - a).normalized();
+      if ((p[f] - a).dot(normal) > 0.0) normal = -normal;  // outward: away from the fourth corner
+      const double height = normal.dot(edge_m[0] - a) - reach_m;  // > 0 outside the pushed face
+      const double rate = normal.dot(along);
+      if (rate == 0.0) {
+        if (height > 0.0) t_out = -1.0;
+      } else if (rate < 0.0) {
+        t_in = std::max(t_in, -height / rate);
+      } else {
+        t_out = std::min(t_out, -height / rate);
+      }
+    }
+    if (t_in <= t_out) return true;
+  }
+  return false;
+}
+
 CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
                      const CuttingSettings& settings) {
   if (auto problem = validate(settings)) throw std::invalid_argument(*problem);

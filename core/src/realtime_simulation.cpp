@@ -133,9 +133,23 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     const auto& last = stroke_.edges_m.back();
     if ((edge[0] - last[0]).norm() < 1e-4 && (edge[1] - last[1]).norm() < 1e-4) return;
   }
+  // Drawn out of the tissue, the blade has to break in again. Within a few millimetres of tissue
+  // it is still in: in its own cut the edge may touch no element.
+  constexpr double kBladeReachM = 0.003;
+  if (!blade_edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)) {
+    blade_in_tissue_ = false;
+    stroke_.edges_m.clear();
+    return;
+  }
   stroke_.add(edge);
   if (stroke_.edges_m.size() < 2) return;
-  CutResult cut = cut_tissue(*model_, state_, stroke_, *cutting_);
+  // Once in, the edge cuts whatever it is drawn through: the stress at a sharp edge in the tissue
+  // (a crack front) is unbounded, which no element's average resolves, so the threshold decides
+  // only where the blade breaks in. Otherwise the tissue, relaxed around a still blade, would let
+  // the blade pass uncut.
+  CuttingSettings propagating = *cutting_;
+  propagating.cutting_stress_pa = 0.0;
+  CutResult cut = cut_tissue(*model_, state_, stroke_, propagating);
   if (!cut.cut()) return;
   model_ = std::move(cut.model);
   state_ = std::move(cut.state);

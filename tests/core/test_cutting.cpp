@@ -246,6 +246,24 @@ TEST(Cutting, ABladeThatDoesNotMoveSweepsNothing) {
   EXPECT_EQ(cut.report.elements_swept, 0u);
 }
 
+TEST(Cutting, ABladeEdgeIsInTheTissueWhereItPassesThroughAnElementOrComesWithinReach) {
+  const SimModel model = block_model();
+  const SimState state = make_rest_state(model);
+  auto in = [&](Eigen::Vector3d heel, Eigen::Vector3d tip, double reach_m = 0.0) {
+    return blade_edge_in_tissue(model, state.position_m, {heel, tip}, reach_m);
+  };
+  // Down into the block's top, and wholly inside it.
+  EXPECT_TRUE(in({0.031, 0.022, 0.06}, {0.031, 0.022, 0.035}));
+  EXPECT_TRUE(in({0.012, 0.013, 0.03}, {0.047, 0.038, 0.01}));
+  // Above the top (z = 0.04), beside a side (x = 0.06), and lying flat just over the top.
+  EXPECT_FALSE(in({0.031, 0.022, 0.06}, {0.031, 0.022, 0.042}));
+  EXPECT_FALSE(in({0.062, 0.01, 0.03}, {0.062, 0.04, 0.01}));
+  EXPECT_FALSE(in({0.01, 0.01, 0.041}, {0.05, 0.04, 0.041}));
+  // Within reach: 2 mm above the top is in with 3 mm of reach, not with 1 mm.
+  EXPECT_TRUE(in({0.031, 0.022, 0.06}, {0.031, 0.022, 0.042}, 0.003));
+  EXPECT_FALSE(in({0.031, 0.022, 0.06}, {0.031, 0.022, 0.042}, 0.001));
+}
+
 TEST(Cutting, CuttingAlongAnExistingCutChangesNothing) {
   const SimModel model = block_model();
   const SimState state = make_rest_state(model);

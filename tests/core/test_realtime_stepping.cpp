@@ -2,6 +2,7 @@
 // and the backlog beyond the cap dropped (simulated time slows down instead of spiralling). The
 // clock is tested with made-up elapsed times; the running loop only for what a tiny cap on a
 // heavy model must give whatever the machine's speed.
+#include "liversim/core/cutting.h"
 #include "liversim/core/default_scene.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/liver_geometry.h"
@@ -321,6 +322,93 @@ TEST_F(RealtimeSteppingFixture, AScalpelDrawnThroughTheLiverCutsItWhileItRuns) {
   EXPECT_EQ(seen.position_m.size(), seen.model->node_count);
   EXPECT_FALSE(simulation.stats().halted);
   EXPECT_EQ(check_health(*seen.model, simulation.state()), HealthProblem::none);
+}
+
+// Waits (at most a minute of wall time) until the running simulation has simulated `duration_s`
+// more, or `done` holds; returns the last snapshot.
+template <class Done>
+SimulationSnapshot run_until(RealtimeSimulation& simulation, double duration_s, Done done) {
+  simulation.update_snapshot();
+  const double until_s = simulation.snapshot().time_s + duration_s;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    simulation.update_snapshot();
+    const SimulationSnapshot& seen = simulation.snapshot();
+    if (seen.time_s >= until_s || done(seen)) break;
+  }
+  return simulation.snapshot();
+}
+
+TEST_F(RealtimeSteppingFixture, AScalpelThatBrokeInCutsWhereverItIsDrawnUntilItIsDrawnOut) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(*mesh_));
+  // A threshold the coarse mesh reaches when pressed: its elements spread the blade's load (the
+  // stress under a pressed blade grows as the elements shrink).
+  CuttingSettings settings;
+  settings.cutting_stress_pa = 300.0;
+  simulation.enable_cutting(settings);
+  // The blade points down (the tool's −z), its tip 1 mm above the highest node near the middle,
+  // long enough to go through the liver there.
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < model->node_count; ++n) box.extend(model->rest_position_m.at(n));
+  const Eigen::Vector2d where(box.center().x() - 0.04, box.center().y());
+  double top_m = -std::numeric_limits<double>::infinity(), bottom_m = -top_m;
+  for (std::size_t n = 0; n < model->node_count; ++n) {
+    const Eigen::Vector3d p = model->rest_position_m.at(n);
+    if ((p.head<2>() - where).norm() >= 0.008) continue;
+    top_m = std::max(top_m, p.z());
+    bottom_m = std::min(bottom_m, p.z());
+  }
+  ASSERT_TRUE(std::isfinite(top_m));
+  const double thickness_m = top_m - bottom_m;
+  Tool scalpel;
+  scalpel.kind = ToolKind::scalpel;
+  scalpel.geometry.blade_length_m = thickness_m + 0.03;
+  Eigen::Vector3d heel(where.x(), where.y(), top_m + 0.001 + scalpel.geometry.blade_length_m);
+  scalpel.pose.origin_m = heel;
+  simulation.set_tool(scalpel);
+  simulation.start();
+  auto move_to = [&](const Eigen::Vector3d& to) {
+    scalpel.pose.origin_m = heel = to;
+    simulation.set_tool(scalpel);
+    return run_until(simulation, 0.01, [](const SimulationSnapshot&) { return false; });
+  };
+
+  // Pressed in until it breaks in.
+  bool broke_in = false;
+  for (int k = 0; k < 150 && !broke_in; ++k)
+    broke_in = move_to(heel - Eigen::Vector3d(0.0, 0.0, 2e-4)).blade_cutting;
+  ASSERT_TRUE(broke_in) << "pressed 30 mm in, the blade did not break in";
+  // In, it passes into the tissue without pushing, on through the liver (so that the stroke
+  // passes through whole elements of this coarse mesh, 2 cm across). Held still, the tissue
+  // closes over the blade and relaxes below the cutting stress.
+  while (heel.z() - scalpel.geometry.blade_length_m > bottom_m - 0.005)
+    move_to(heel - Eigen::Vector3d(0.0, 0.0, 5e-4));
+  run_until(simulation, 0.5, [](const SimulationSnapshot&) { return false; });
+  simulation.stop();
+  double largest_stress_pa = 0.0;
+  for (std::size_t e = 0; e < model->tet_count; ++e)
+    largest_stress_pa =
+        std::max(largest_stress_pa, element_cutting_stress_pa(*model, simulation.state(), e));
+  EXPECT_LT(largest_stress_pa, settings.cutting_stress_pa);
+  EXPECT_EQ(simulation.snapshot().topology_version, 0u) << "a still blade cut";
+  simulation.start();
+
+  // Drawn along, it cuts through the relaxed tissue (8 cm: a stroke that starts and ends inside
+  // the tissue separates only the elements it has passed all the way through).
+  SimulationSnapshot seen;
+  for (int k = 0; k < 80; ++k) seen = move_to(heel + Eigen::Vector3d(1e-3, 0.0, 0.0));
+  EXPECT_GT(seen.topology_version, 0u) << "the blade passed through the tissue uncut";
+  EXPECT_TRUE(seen.blade_cutting);
+  // Drawn out (its tip clear of the tissue), it is out: the next cut needs a new break-in.
+  while (heel.z() - scalpel.geometry.blade_length_m < top_m + 0.01)
+    seen = move_to(heel + Eigen::Vector3d(0.0, 0.0, 1e-3));
+  EXPECT_FALSE(seen.blade_cutting) << "the blade drawn out of the tissue still cuts";
+  simulation.stop();
+  EXPECT_FALSE(simulation.stats().halted);
+  EXPECT_EQ(check_health(*simulation.snapshot().model, simulation.state()), HealthProblem::none);
 }
 
 }  // namespace

@@ -368,9 +368,20 @@ TEST_F(MainWindowTest, TheScalpelDrawnAcrossTheLiverCutsIt) {
   const std::size_t nodes_before = window_->simulation().snapshot().model->node_count;
   const QImage before = window_->viewport()->grabRendering();
   pictures_.emplace_back("before", before);
-  // Across the liver: a long stroke, so that it passes whole elements.
+  // Pressed in, the blade breaks into the tissue once the stress under it reaches the cutting
+  // stress (however slowly this machine simulates); then drawn across the liver, a long stroke
+  // that passes whole elements.
   const QPoint across(160, 0);
-  pressAndMove(*start - across / 2, *start + across / 2, [] {});
+  sendMouse(QEvent::MouseButtonPress, *start - across / 2, Qt::LeftButton, Qt::LeftButton);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().blade_cutting; },
+                              kSimulatedTimeTimeoutMs))
+      << "the pressed blade did not break into the tissue";
+  // Each move after some simulated time, so that a slow machine sees the same stroke.
+  for (int step = 1; step <= kDragMoves; ++step) {
+    ASSERT_TRUE(waitSimulated(0.02));
+    sendMouse(QEvent::MouseMove, *start - across / 2 + across * step / kDragMoves, Qt::NoButton,
+              Qt::LeftButton);
+  }
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().topology_version > 0; },
                               kSimulatedTimeTimeoutMs))
       << "the scalpel drawn across the liver cut nothing (contacts "
@@ -462,7 +473,7 @@ TEST_F(MainWindowTest, EveryIntegratorChosenInThePanelRunsTheSimulation) {
 TEST_F(MainWindowTest, ChangingTheIntegratorDuringAPullKeepsTheTissueWhereItIs) {
   const std::optional<QPoint> start = pointOnTheLiver();
   ASSERT_TRUE(start);
-  // Across the liver: a long stroke, so that it passes whole elements.
+  // A long pull across the liver.
   const QPoint across(160, 0);
   pressAndMove(*start - across / 2, *start + across / 2, [] {});
   ASSERT_NE(window_->activeGrab(), nullptr);

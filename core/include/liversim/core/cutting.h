@@ -61,6 +61,11 @@ struct BladeStroke {
 // The scalpel's edge (heel, tip) in the scene.
 std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel);
 
+// Whether the edge (heel, tip) passes through any element of the model in `position`, or within
+// about `reach_m` of one (each element's faces pushed out by that much).
+bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
+                          const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m = 0.0);
+
 struct CutReport {
   std::size_t elements_swept = 0;           // elements the sweep touches
   std::size_t elements_over_threshold = 0;  // of those, stressed past the cutting threshold
