@@ -167,6 +167,11 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   resected_volume_m3_ += cut.report.resected_volume_m3;
 }
 
+void RealtimeSimulation::set_haptic_servo(ServoLoop* servo) {
+  if (running()) throw std::logic_error("set_haptic_servo: stop the simulation first");
+  haptic_servo_ = servo;
+}
+
 void RealtimeSimulation::set_tool(const std::optional<Tool>& tool) {
   std::lock_guard lock(springs_mutex_);
   pending_tool_ = tool;
@@ -325,6 +330,14 @@ void RealtimeSimulation::run() {
       out.tool_grasping = tool_acts && tools_->grasping();
       out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
       out.blade_cutting = tool_acts && blade_in_tissue_;
+      if (haptic_servo_) {
+        const LocalForceModel force_model =
+            tool_acts ? tool_force_model(tools_->springs(), state_.position_m,
+                                         active_tool_->pose.origin_m,
+                                         1.0 / haptic_servo_->safety().nominal_rate_hz)
+                      : LocalForceModel{};
+        haptic_servo_->publish(force_model);
+      }
       out.model = model_;
       out.topology_version = topology_version_;
       out.resected_volume_m3 = resected_volume_m3_;

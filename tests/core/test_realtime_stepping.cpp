@@ -4,6 +4,7 @@
 // heavy model must give whatever the machine's speed.
 #include "liversim/core/cutting.h"
 #include "liversim/core/default_scene.h"
+#include "liversim/core/emulated_devices.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/liver_geometry.h"
 #include "liversim/core/realtime_simulation.h"
@@ -409,6 +410,56 @@ TEST_F(RealtimeSteppingFixture, AScalpelThatBrokeInCutsWhereverItIsDrawnUntilItI
   simulation.stop();
   EXPECT_FALSE(simulation.stats().halted);
   EXPECT_EQ(check_health(*simulation.snapshot().model, simulation.state()), HealthProblem::none);
+}
+
+TEST_F(RealtimeSteppingFixture, TheForceOnAProbeReachesTheHapticDeviceInNewtons) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(*mesh_));
+  // A probe pressed 4 mm into the top of the liver, held still.
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < model->node_count; ++n) box.extend(model->rest_position_m.at(n));
+  const Eigen::Vector2d where(box.center().x(), box.center().y());
+  double top_m = -std::numeric_limits<double>::infinity();
+  for (std::size_t n = 0; n < model->node_count; ++n) {
+    const Eigen::Vector3d p = model->rest_position_m.at(n);
+    if ((p.head<2>() - where).norm() < 0.008) top_m = std::max(top_m, p.z());
+  }
+  Tool probe;
+  probe.kind = ToolKind::probe;
+  probe.pose.origin_m = {where.x(), where.y(), top_m + probe.geometry.probe_tip_radius_m - 0.004};
+  // The device's origin is the probe's point, its axes the scene's.
+  ManualDevice device;
+  ServoLoop::Options options;
+  options.mapping.offset_m = probe.pose.origin_m;
+  ServoLoop servo(device, options);
+  device.set(Eigen::Vector3d::Zero(), 0);
+  simulation.set_haptic_servo(&servo);
+  simulation.set_tool(probe);
+  servo.start();
+  simulation.start();
+  EXPECT_THROW(simulation.set_haptic_servo(nullptr), std::logic_error) << "only while stopped";
+  run_until(simulation, 1.0, [](const SimulationSnapshot&) { return false; });
+  // Stopped, the simulation's last model stands until it goes stale: within the rate limit's few
+  // ticks the device renders the force of the last snapshot, in newtons.
+  simulation.stop();
+  simulation.update_snapshot();
+  const Eigen::Vector3d simulated_n = simulation.snapshot().tool_force_n;
+  ASSERT_GT(simulated_n.norm(), 0.05) << "the probe pressed nothing";
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  ServoFrame frame;
+  ASSERT_TRUE(servo.newest_frame(frame));
+  EXPECT_LT((frame.force_n - simulated_n).norm(), 1e-9)
+      << "device " << frame.force_n.transpose() << " N, simulation " << simulated_n.transpose()
+      << " N";
+  EXPECT_GT(frame.force_n.z(), 0.0) << "the tissue pushes the probe up";
+  // No new model: the watchdog takes the force away (stale after 0.1 s, then a 0.05 s ramp).
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ASSERT_TRUE(servo.newest_frame(frame));
+  EXPECT_EQ(frame.force_n, Eigen::Vector3d::Zero()) << "a stale model still pushes";
+  EXPECT_GE(servo.stats().watchdog_trips, 1u);
+  servo.stop();
+  EXPECT_EQ(device.last_force_n(), Eigen::Vector3d::Zero()) << "force left on after stop";
 }
 
 }  // namespace

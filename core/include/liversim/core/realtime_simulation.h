@@ -12,6 +12,7 @@
 #include "liversim/core/forces.h"
 #include "liversim/core/health.h"
 #include "liversim/core/model.h"
+#include "liversim/core/servo_loop.h"
 #include "liversim/core/state.h"
 #include "liversim/core/tools.h"
 #include "liversim/core/triple_buffer.h"
@@ -158,6 +159,9 @@ class RealtimeSimulation {
   // The tool's kind, pose and jaws from any thread (nothing: no tool in the scene); the newest
   // is used from the next cycle on.
   void set_tool(const std::optional<Tool>& tool);
+  // Publishes the local model of the force on the tool to `servo` after every cycle (none: the
+  // zero model), for the haptic device to render. Call while stopped; null stops publishing.
+  void set_haptic_servo(ServoLoop* servo);
 
   // Consumer side (one thread, e.g. the UI): the newest snapshot, if one was published since.
   bool update_snapshot() { return snapshots_.update(); }
@@ -190,7 +194,8 @@ class RealtimeSimulation {
   std::vector<NodeSpring> active_springs_;  // simulation thread's copy
   std::optional<Tool> pending_tool_;        // under springs_mutex_
   bool tool_changed_ = false;
-  std::optional<Tool> active_tool_;       // simulation thread's copy
+  std::optional<Tool> active_tool_;  // simulation thread's copy
+  ServoLoop* haptic_servo_ = nullptr;
   std::optional<ToolInteraction> tools_;  // simulation thread only once started
   std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tool's
   ContactSettings contact_settings_;

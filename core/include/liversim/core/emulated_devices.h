@@ -1,0 +1,78 @@
+#pragma once
+// The devices that need no hardware: the mouse and keyboard, a scripted trajectory, and the replay
+// of a logged session. They are product features (the default without a Phantom, the CLI and the
+// instructor's replay) and what the tests drive the force path with.
+
+#include "liversim/core/haptic_device.h"
+#include "liversim/core/triple_buffer.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace liversim {
+
+// The mouse and keyboard: the workstation sets the position (device mm) and buttons from mouse
+// drags, modifiers and the wheel; the servo reads the newest, and takes the velocity from the
+// change. The force written is kept (the mouse cannot push back) so that it can be shown.
+class ManualDevice final : public HapticDevice {
+ public:
+  ManualDevice();
+  std::string name() const override { return "Mouse and keyboard"; }
+  DeviceLimits limits() const override { return limits_; }
+  DeviceStatus read(double time_s, DeviceSample& sample) override;
+  DeviceStatus write_force(const Eigen::Vector3d& force_n) override;
+
+  // UI thread.
+  void set(const Eigen::Vector3d& position_mm, std::uint32_t buttons);
+  Eigen::Vector3d last_force_n();
+
+ private:
+  struct Input {
+    Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+    std::uint32_t buttons = 0;
+  };
+  DeviceLimits limits_;
+  TripleBuffer<Input> input_{Input{}};
+  TripleBuffer<Eigen::Vector3d> force_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d previous_mm_ = Eigen::Vector3d::Zero();
+  double previous_s_ = -1.0;
+};
+
+// One point of a trajectory: where the device is at a time, and which buttons are down.
+struct TrajectoryPoint {
+  double time_s = 0.0;
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+  std::uint32_t buttons = 0;
+};
+
+// A trajectory file: one point per line, `time_s x_mm y_mm z_mm buttons`, whitespace-separated,
+// times strictly increasing; `#` starts a comment. Throws std::runtime_error naming the file, the
+// line and what is wrong.
+std::vector<TrajectoryPoint> load_trajectory(const std::filesystem::path& file);
+void save_trajectory(const std::filesystem::path& file, const std::vector<TrajectoryPoint>& points);
+
+// Plays a trajectory on the servo clock: positions interpolated linearly between points, the
+// velocity the slope there, the buttons of the point before. Before the first point it stays at
+// the first, after the last at the last. A scripted device follows a trajectory file; a replay
+// device follows the device input logged with a session, at its original rate.
+class TrajectoryDevice final : public HapticDevice {
+ public:
+  // Throws std::invalid_argument for an empty trajectory or times that do not increase.
+  TrajectoryDevice(std::string name, std::vector<TrajectoryPoint> points, DeviceLimits limits = {});
+  std::string name() const override { return name_; }
+  DeviceLimits limits() const override { return limits_; }
+  DeviceStatus read(double time_s, DeviceSample& sample) override;
+  DeviceStatus write_force(const Eigen::Vector3d& force_n) override;
+
+  double duration_s() const { return points_.back().time_s; }
+  const std::vector<TrajectoryPoint>& points() const { return points_; }
+
+ private:
+  std::string name_;
+  std::vector<TrajectoryPoint> points_;
+  DeviceLimits limits_;
+  std::size_t cursor_ = 0;  // the segment of the last read: reads move forward, so no search
+};
+
+}  // namespace liversim
