@@ -31,8 +31,14 @@ const fs::path kDataDir = LIVERSIM_TEST_DATA_DIR;
 const fs::path kLiverPath =
     fs::path(LIVERSIM_SHARED_DIR) / "data" / "external" / "zhang-liver" / "Liver_Iso.inp";
 
+// A directory per test (ctest runs the tests of this file in parallel processes, and cases of a
+// parameterised test write files of the same name).
 fs::path output_path(const std::string& name) {
-  const fs::path dir = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "mesh_io";
+  const testing::TestInfo* test = testing::UnitTest::GetInstance()->current_test_info();
+  std::string folder = test ? std::string(test->test_suite_name()) + "." + test->name() : "none";
+  for (char& c : folder)
+    if (c == '/') c = '_';
+  const fs::path dir = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "mesh_io" / folder;
   fs::create_directories(dir);
   return dir / name;
 }
