@@ -1,4 +1,5 @@
 #include "liversim/core/cutting.h"
+#include "validation_message.h"
 
 #include "liversim/core/forces.h"
 #include "liversim/core/integrator.h"
@@ -11,16 +12,14 @@
 #include <limits>
 #include <numeric>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 
 namespace liversim {
 
 std::optional<std::string> validate(const CuttingSettings& settings) {
   auto out_of_range = [](const char* name, double value, const char* expected) {
-    std::ostringstream message;
-    message << "cutting setting " << name << " = " << value << " is invalid: expected " << expected;
-    return std::optional<std::string>(message.str());
+    return std::optional<std::string>(
+        out_of_range_message(std::string("cutting setting ") + name, value, expected));
   };
   if (!std::isfinite(settings.cutting_stress_pa) || settings.cutting_stress_pa < 0.0)
     return out_of_range("cutting stress (Pa)", settings.cutting_stress_pa, "a finite value >= 0");

@@ -1,18 +1,14 @@
 #include "liversim/core/material.h"
+#include "validation_message.h"
 
 #include <Eigen/Geometry>
 
 #include <cmath>
-#include <sstream>
 
 namespace liversim {
 
 std::optional<std::string> validate(const TissueMaterial& material) {
-  auto out_of_range = [](const char* name, double value, const char* expected) {
-    std::ostringstream message;
-    message << name << " = " << value << " is invalid: expected " << expected;
-    return message.str();
-  };
+  const auto& out_of_range = out_of_range_message;
   if (!std::isfinite(material.youngs_modulus_pa) || material.youngs_modulus_pa <= 0.0)
     return out_of_range("Young's modulus (Pa)", material.youngs_modulus_pa, "a finite value > 0");
   if (!std::isfinite(material.poisson_ratio) || material.poisson_ratio <= -1.0 ||

@@ -1,4 +1,5 @@
 #include "liversim/core/model.h"
+#include "validation_message.h"
 
 #include "liversim/core/integrator.h"
 #include "liversim/core/mesh_quality.h"
@@ -6,7 +7,6 @@
 #include <Eigen/Dense>
 
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -93,9 +93,7 @@ std::vector<Eigen::Vector3d> fibre_directions(const std::vector<Eigen::Vector3d>
 
 void validate_integrator(const IntegratorSettings& settings) {
   auto fail = [](const std::string& what, double value, const char* expected) {
-    std::ostringstream message;
-    message << "integrator " << what << " = " << value << " is invalid: expected " << expected;
-    throw std::invalid_argument(message.str());
+    throw std::invalid_argument(out_of_range_message("integrator " + what, value, expected));
   };
   if (!std::isfinite(settings.step_s) || settings.step_s < 0.0)
     fail("step (s)", settings.step_s, "a finite value >= 0");

@@ -1,4 +1,5 @@
 #include "liversim/core/viscous_tissue.h"
+#include "validation_message.h"
 
 #include "liversim/core/material.h"
 
@@ -7,17 +8,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 namespace liversim {
 namespace {
 
-std::string out_of_range(const char* name, double value, const char* expected) {
-  std::ostringstream message;
-  message << name << " = " << value << " is invalid: expected " << expected;
-  return message.str();
-}
+const auto& out_of_range = out_of_range_message;
 
 bool positive(double value) {
   return std::isfinite(value) && value > 0.0;
