@@ -10,11 +10,6 @@
 
 namespace liversim {
 
-ManualDevice::ManualDevice() {
-  // What a mouse "device" can reach: the Omni's workspace; it pushes nothing back.
-  limits_.max_force_n = 3.3;
-}
-
 void ManualDevice::set(const Eigen::Vector3d& position_mm, std::uint32_t buttons) {
   input_.back() = Input{position_mm, buttons};
   input_.publish();

@@ -1,21 +1,17 @@
 #include "liversim/core/haptics.h"
+#include "validation_message.h"
 
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace liversim {
 namespace {
 
 constexpr double kMmPerM = 1000.0;
 
-std::string out_of_range(const char* what, double value, const char* expected) {
-  std::ostringstream text;
-  text << what << " is " << value << "; expected " << expected;
-  return text.str();
-}
+const auto& out_of_range = out_of_range_message;
 
 bool finite(const DeviceForceModel& model) {
   return model.force_n.allFinite() && model.stiffness_n_per_m.allFinite() &&
@@ -143,10 +139,12 @@ void HapticRenderer::accept(const DeviceForceModel& model) {
 
 void HapticRenderer::hold_zero(bool zero) {
   held_ = zero;
-  if (zero) {
-    gain_ = 0.0;
-    last_force_n_.setZero();
-  }
+  if (zero) restart_ramp();
+}
+
+void HapticRenderer::restart_ramp() {
+  gain_ = 0.0;
+  last_force_n_.setZero();
 }
 
 Eigen::Vector3d HapticRenderer::command(double now_s, const DeviceSample& sample) {
@@ -219,23 +217,6 @@ LocalForceModel tool_force_model(std::span<const NodeSpring> springs, const Node
   model.stiffness_n_per_m = stiffness * Eigen::Matrix3d::Identity();
   model.damping_n_s_per_m = stiffness * servo_period_s * Eigen::Matrix3d::Identity();
   model.position_m = tool_point_m;
-  return model;
-}
-
-DeviceForceModel virtual_wall_model(const Eigen::Vector3d& point_mm, const Eigen::Vector3d& normal,
-                                    const Eigen::Vector3d& tool_mm, double stiffness_n_per_m,
-                                    double damping_n_s_per_m, double published_s) {
-  const Eigen::Vector3d n = normal.normalized();
-  const double depth_mm = -(tool_mm - point_mm).dot(n);
-  DeviceForceModel model;
-  model.position_mm = tool_mm;
-  model.radius_mm = 10.0;
-  model.published_s = published_s;
-  if (depth_mm > 0.0) {
-    model.force_n = stiffness_n_per_m * (depth_mm / kMmPerM) * n;
-    model.stiffness_n_per_m = stiffness_n_per_m * n * n.transpose();
-    model.damping_n_s_per_m = damping_n_s_per_m * n * n.transpose();
-  }
   return model;
 }
 

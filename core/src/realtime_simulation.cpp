@@ -128,19 +128,14 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     stroke_.edges_m.assign(1, edge);
     return;
   }
-  // A new instant of the stroke once the edge has moved a tenth of a millimetre.
-  if (!stroke_.edges_m.empty()) {
-    const auto& last = stroke_.edges_m.back();
-    if ((edge[0] - last[0]).norm() < 1e-4 && (edge[1] - last[1]).norm() < 1e-4) return;
-  }
+  // A new instant of the stroke once the edge has moved a tenth of a millimetre (a broken-in
+  // blade's stroke starts where it broke in).
+  const auto& last = stroke_.edges_m.back();
+  if ((edge[0] - last[0]).norm() < 1e-4 && (edge[1] - last[1]).norm() < 1e-4) return;
   // Drawn out of the tissue, the blade has to break in again. Within a few millimetres of tissue
   // it is still in: in its own cut the edge may touch no element.
   constexpr double kBladeReachM = 0.003;
-  if (!blade_edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)) {
-    blade_in_tissue_ = false;
-    stroke_.edges_m.clear();
-    return;
-  }
+  if (!blade_edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)) return end_stroke();
   stroke_.add(edge);
   if (stroke_.edges_m.size() < 2) return;
   // Once in, the edge cuts whatever it is drawn through: the stress at a sharp edge in the tissue
@@ -165,6 +160,16 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   active_springs_.clear();
   ++topology_version_;
   resected_volume_m3_ += cut.report.resected_volume_m3;
+}
+
+void RealtimeSimulation::end_stroke() {
+  stroke_.edges_m.clear();
+  blade_in_tissue_ = false;
+}
+
+double RealtimeSimulation::haptic_servo_period_s() const {
+  // Without a servo the model's damping is not used: any period will do.
+  return haptic_servo_ ? 1.0 / haptic_servo_->safety().nominal_rate_hz : 1e-3;
 }
 
 void RealtimeSimulation::set_haptic_servo(ServoLoop* servo) {
@@ -261,10 +266,7 @@ void RealtimeSimulation::run() {
         active_tool_ = pending_tool_;
         tool_changed_ = false;
         if (!active_tool_ && tools_) tools_->release();
-        if (!active_tool_ || active_tool_->kind != ToolKind::scalpel) {
-          stroke_.edges_m.clear();
-          blade_in_tissue_ = false;
-        }
+        if (!active_tool_ || active_tool_->kind != ToolKind::scalpel) end_stroke();
       }
     }
     const SimModel& model = *model_;  // a cut may replace it between cycles
@@ -325,19 +327,16 @@ void RealtimeSimulation::run() {
       out.position_m.z = state_.position_m.z;
       out.time_s = state_.time_s;
       out.step_count = state_.step_count;
-      out.tool_force_n =
-          tool_acts ? tools_->force_on_tool_n(state_.position_m) : Eigen::Vector3d::Zero();
+      // The local model of the force on the tool: its F0 is the snapshot's tool force.
+      const LocalForceModel force_model =
+          tool_acts ? tool_force_model(tools_->springs(), state_.position_m,
+                                       active_tool_->pose.origin_m, haptic_servo_period_s())
+                    : LocalForceModel{};
+      out.tool_force_n = force_model.force_n;
       out.tool_grasping = tool_acts && tools_->grasping();
       out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
       out.blade_cutting = tool_acts && blade_in_tissue_;
-      if (haptic_servo_) {
-        const LocalForceModel force_model =
-            tool_acts ? tool_force_model(tools_->springs(), state_.position_m,
-                                         active_tool_->pose.origin_m,
-                                         1.0 / haptic_servo_->safety().nominal_rate_hz)
-                      : LocalForceModel{};
-        haptic_servo_->publish(force_model);
-      }
+      if (haptic_servo_) haptic_servo_->publish(force_model);
       out.model = model_;
       out.topology_version = topology_version_;
       out.resected_volume_m3 = resected_volume_m3_;

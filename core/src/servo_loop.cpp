@@ -96,12 +96,13 @@ void ServoLoop::tick(double now_s) {
   }
   if (models_.update()) renderer_.accept(models_.front());
   renderer_.hold_zero(paused_.load(std::memory_order_relaxed));
-  if (read.fault == DeviceFault::recoverable) {
-    fault_message_ = read.message;
-    renderer_.hold_zero(true);  // zero now; the force ramps back from the next tick
-    renderer_.hold_zero(false);
-  }
   frame.force_n = renderer_.command(now_s, frame.sample);
+  if (read.fault ==
+      DeviceFault::recoverable) {  // zero now; the force ramps back from the next tick
+    fault_message_ = read.message;
+    renderer_.restart_ramp();
+    frame.force_n.setZero();
+  }
   const DeviceStatus wrote = device_.write_force(frame.force_n);
   if (wrote.fault == DeviceFault::fatal) {
     fatal_ = true;

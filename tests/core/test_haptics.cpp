@@ -22,6 +22,25 @@ namespace {
 constexpr double kTickS = 1e-3;
 const DeviceLimits kOmni{};  // PHANTOM Omni: 3.3 N, 700 N/m, 5 N·s/m
 
+// A model for a flat virtual wall through `point_mm` with outward `normal` (device frame): the
+// force of the wall on a tool at `tool_mm` (none when outside), linearised there.
+DeviceForceModel virtual_wall_model(const Eigen::Vector3d& point_mm, const Eigen::Vector3d& normal,
+                                    const Eigen::Vector3d& tool_mm, double stiffness_n_per_m,
+                                    double damping_n_s_per_m, double published_s) {
+  const Eigen::Vector3d n = normal.normalized();
+  const double depth_mm = -(tool_mm - point_mm).dot(n);
+  DeviceForceModel model;
+  model.position_mm = tool_mm;
+  model.radius_mm = 10.0;
+  model.published_s = published_s;
+  if (depth_mm > 0.0) {
+    model.force_n = stiffness_n_per_m * (depth_mm / 1000.0) * n;
+    model.stiffness_n_per_m = stiffness_n_per_m * n * n.transpose();
+    model.damping_n_s_per_m = damping_n_s_per_m * n * n.transpose();
+  }
+  return model;
+}
+
 // Runs the renderer on a clock of exact 1 ms ticks until its start-up ramp (50 ms) is done, before
 // the model (published at 0) goes stale at 100 ms.
 void settle(HapticRenderer& renderer, double& now_s, const DeviceSample& at) {
@@ -77,6 +96,31 @@ TEST(WorkspaceMapping, ScaledMotionScalesForceSoThatPowerIsTheSameOnBothSides) {
   mapping.scale = std::nan("");
   EXPECT_TRUE(validate(mapping));
   EXPECT_NE(validate(mapping)->find("workspace scale"), std::string::npos);
+}
+
+TEST(HapticSafetySettings, BadSettingsAreRefusedByNameAndTheServoWillNotStartWithThem) {
+  EXPECT_FALSE(validate(HapticSafetySettings{}));
+  auto problem_with = [](auto change) {
+    HapticSafetySettings settings;
+    change(settings);
+    return validate(settings).value_or("");
+  };
+  EXPECT_NE(problem_with([](auto& s) { s.force_cap_n = std::nan(""); }).find("force cap (N)"),
+            std::string::npos);
+  EXPECT_NE(problem_with([](auto& s) { s.max_force_rate_n_per_s = 0.0; }).find("force rate"),
+            std::string::npos);
+  EXPECT_NE(problem_with([](auto& s) { s.stale_after_s = -1.0; }).find("stale model"),
+            std::string::npos);
+  EXPECT_NE(problem_with([](auto& s) { s.ramp_s = 0.0; }).find("force ramp"), std::string::npos);
+  EXPECT_NE(problem_with([](auto& s) { s.min_rate_hz = 2000.0; }).find("lowest servo rate"),
+            std::string::npos);
+  ManualDevice device;
+  ServoLoop::Options options;
+  options.safety.force_cap_n = -1.0;
+  EXPECT_THROW(ServoLoop(device, options), std::invalid_argument);
+  options = {};
+  options.mapping.rotation.coeffs() << 0.0, 0.0, 0.0, 2.0;  // not a unit quaternion
+  EXPECT_THROW(ServoLoop(device, options), std::invalid_argument);
 }
 
 TEST(HapticRenderer, AdversarialModelsNeverGetPastTheCapsOrTheRateLimitOrGiveANaN) {
@@ -405,18 +449,24 @@ TEST(ServoLoop, RunsNearOneKilohertzOnItsOwnThreadAndEndsWithZeroForce) {
   EXPECT_GE(logged, stats.ticks) << "frames lost";
 }
 
+// Ticks a servo by hand on a clock of its own (no thread), the simulation publishing `push` at
+// every tick.
+struct HandTicks {
+  ServoLoop& servo;
+  LocalForceModel push;
+  int k = 0;
+  void operator()() {
+    servo.publish(push, k * kTickS);
+    servo.tick(k++ * kTickS);
+  }
+};
+
 TEST(ServoLoop, PauseZeroesTheForceAndItRampsBackAfter) {
   ManualDevice device;
   ServoLoop servo(device, {});
-  LocalForceModel push;
-  push.force_n = {0.8, 0.0, 0.0};
-  // Ticked by hand on a clock of its own (no thread): the device's force follows.
-  int k = 0;
-  auto tick = [&] {
-    servo.publish(push, k * kTickS);
-    servo.tick(k++ * kTickS);
-  };
-  while (k < 200) tick();
+  HandTicks tick{servo, {}};
+  tick.push.force_n = {0.8, 0.0, 0.0};
+  while (tick.k < 200) tick();
   EXPECT_NEAR(device.last_force_n().x(), 0.8, 1e-9);
   servo.set_paused(true);
   tick();
@@ -424,8 +474,46 @@ TEST(ServoLoop, PauseZeroesTheForceAndItRampsBackAfter) {
   servo.set_paused(false);
   tick();
   EXPECT_LT(device.last_force_n().x(), 0.1) << "the force jumped back after the pause";
-  while (k < 400) tick();
+  while (tick.k < 400) tick();
   EXPECT_NEAR(device.last_force_n().x(), 0.8, 1e-9) << "the force did not come back";
+}
+
+// A device that reports a passing fault (warm motors) when told to.
+class WarmingDevice final : public HapticDevice {
+ public:
+  bool warm = false;
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  std::string name() const override { return "warming"; }
+  DeviceLimits limits() const override { return {}; }
+  DeviceStatus read(double, DeviceSample&) override {
+    return warm ? DeviceStatus{DeviceFault::recoverable, "warm motors"} : DeviceStatus{};
+  }
+  DeviceStatus write_force(const Eigen::Vector3d& force) override {
+    force_n = force;
+    return {};
+  }
+};
+
+TEST(ServoLoop, APassingDeviceFaultDropsTheForceAndItRampsBackButNeverDuringAPause) {
+  WarmingDevice device;
+  ServoLoop servo(device, {});
+  HandTicks tick{servo, {}};
+  tick.push.force_n = {0.0, 0.6, 0.0};
+  while (tick.k < 100) tick();
+  ASSERT_NEAR(device.force_n.y(), 0.6, 1e-9);
+  device.warm = true;
+  tick();
+  EXPECT_EQ(device.force_n, Eigen::Vector3d::Zero()) << "the fault did not drop the force";
+  device.warm = false;
+  while (tick.k < 200) tick();
+  EXPECT_NEAR(device.force_n.y(), 0.6, 1e-9) << "the force did not come back";
+  // Paused, a fault does not lift the pause.
+  servo.set_paused(true);
+  device.warm = true;
+  for (int i = 0; i < 20; ++i) {
+    tick();
+    ASSERT_EQ(device.force_n, Eigen::Vector3d::Zero()) << "force during a pause";
+  }
 }
 
 // Records a session on a scripted device pressing into a wall that the "simulation" republishes

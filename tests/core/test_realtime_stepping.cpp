@@ -115,6 +115,26 @@ struct RealtimeSteppingFixture : ::testing::Test {
     options.integrator = integrator;
     return std::make_shared<const SimModel>(build_model(*mesh_, options));
   }
+  static Eigen::AlignedBox3d rest_box(const SimModel& model) {
+    Eigen::AlignedBox3d box;
+    for (std::size_t n = 0; n < model.node_count; ++n) box.extend(model.rest_position_m.at(n));
+    return box;
+  }
+  // The highest and lowest rest heights of the nodes within 8 mm (in x–y) of `where`.
+  struct Column {
+    double top_m = -std::numeric_limits<double>::infinity();
+    double bottom_m = std::numeric_limits<double>::infinity();
+  };
+  static Column column_at(const SimModel& model, const Eigen::Vector2d& where) {
+    Column column;
+    for (std::size_t n = 0; n < model.node_count; ++n) {
+      const Eigen::Vector3d p = model.rest_position_m.at(n);
+      if ((p.head<2>() - where).norm() >= 0.008) continue;
+      column.top_m = std::max(column.top_m, p.z());
+      column.bottom_m = std::min(column.bottom_m, p.z());
+    }
+    return column;
+  }
   static TetMesh* mesh_;
 };
 TetMesh* RealtimeSteppingFixture::mesh_ = nullptr;
@@ -295,8 +315,7 @@ TEST_F(RealtimeSteppingFixture, AScalpelDrawnThroughTheLiverCutsItWhileItRuns) {
   CuttingSettings anything;
   anything.cutting_stress_pa = 0.0;
   simulation.enable_cutting(anything);
-  Eigen::AlignedBox3d box;
-  for (std::size_t n = 0; n < model->node_count; ++n) box.extend(model->rest_position_m.at(n));
+  const Eigen::AlignedBox3d box = rest_box(*model);
   // Blade pointing down (the tool's −z) from 5 mm above the top, 6 cm long.
   Tool scalpel;
   scalpel.kind = ToolKind::scalpel;
@@ -352,16 +371,9 @@ TEST_F(RealtimeSteppingFixture, AScalpelThatBrokeInCutsWhereverItIsDrawnUntilItI
   simulation.enable_cutting(settings);
   // The blade points down (the tool's −z), its tip 1 mm above the highest node near the middle,
   // long enough to go through the liver there.
-  Eigen::AlignedBox3d box;
-  for (std::size_t n = 0; n < model->node_count; ++n) box.extend(model->rest_position_m.at(n));
+  const Eigen::AlignedBox3d box = rest_box(*model);
   const Eigen::Vector2d where(box.center().x() - 0.04, box.center().y());
-  double top_m = -std::numeric_limits<double>::infinity(), bottom_m = -top_m;
-  for (std::size_t n = 0; n < model->node_count; ++n) {
-    const Eigen::Vector3d p = model->rest_position_m.at(n);
-    if ((p.head<2>() - where).norm() >= 0.008) continue;
-    top_m = std::max(top_m, p.z());
-    bottom_m = std::min(bottom_m, p.z());
-  }
+  const auto [top_m, bottom_m] = column_at(*model, where);
   ASSERT_TRUE(std::isfinite(top_m));
   const double thickness_m = top_m - bottom_m;
   Tool scalpel;
@@ -417,14 +429,9 @@ TEST_F(RealtimeSteppingFixture, TheForceOnAProbeReachesTheHapticDeviceInNewtons)
   RealtimeSimulation simulation(model, make_rest_state(*model));
   simulation.enable_tools(extract_surface(*mesh_));
   // A probe pressed 4 mm into the top of the liver, held still.
-  Eigen::AlignedBox3d box;
-  for (std::size_t n = 0; n < model->node_count; ++n) box.extend(model->rest_position_m.at(n));
-  const Eigen::Vector2d where(box.center().x(), box.center().y());
-  double top_m = -std::numeric_limits<double>::infinity();
-  for (std::size_t n = 0; n < model->node_count; ++n) {
-    const Eigen::Vector3d p = model->rest_position_m.at(n);
-    if ((p.head<2>() - where).norm() < 0.008) top_m = std::max(top_m, p.z());
-  }
+  const Eigen::Vector2d where = rest_box(*model).center().head<2>();
+  const double top_m = column_at(*model, where).top_m;
+  ASSERT_TRUE(std::isfinite(top_m));
   Tool probe;
   probe.kind = ToolKind::probe;
   probe.pose.origin_m = {where.x(), where.y(), top_m + probe.geometry.probe_tip_radius_m - 0.004};

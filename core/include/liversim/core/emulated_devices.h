@@ -17,7 +17,6 @@ namespace liversim {
 // change. The force written is kept (the mouse cannot push back) so that it can be shown.
 class ManualDevice final : public HapticDevice {
  public:
-  ManualDevice();
   std::string name() const override { return "Mouse and keyboard"; }
   DeviceLimits limits() const override { return limits_; }
   DeviceStatus read(double time_s, DeviceSample& sample) override;
@@ -32,7 +31,7 @@ class ManualDevice final : public HapticDevice {
     Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
     std::uint32_t buttons = 0;
   };
-  DeviceLimits limits_;
+  DeviceLimits limits_;  // the Omni's: the mouse pushes nothing back
   TripleBuffer<Input> input_{Input{}};
   TripleBuffer<Eigen::Vector3d> force_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d previous_mm_ = Eigen::Vector3d::Zero();

@@ -120,6 +120,8 @@ class HapticRenderer {
 
   // Pause, error or shutdown: the force is zero from the next tick on, and ramps back up after.
   void hold_zero(bool zero);
+  // A passing fault (e.g. warm motors): the force drops to zero now and ramps back up.
+  void restart_ramp();
 
   // The watchdog's gain now: 1 in normal running, ramping to 0 when tripped.
   double gain() const { return gain_; }
@@ -150,11 +152,5 @@ class HapticRenderer {
 // (Colgate: b > K·T/2, T the servo period). x0 is the tool's point.
 LocalForceModel tool_force_model(std::span<const NodeSpring> springs, const NodeArray& position_m,
                                  const Eigen::Vector3d& tool_point_m, double servo_period_s);
-
-// A model for a flat virtual wall through `point_mm` with outward `normal` (device frame): the
-// force of the wall on a tool `depth_mm` into it (0 when outside), linearised there.
-DeviceForceModel virtual_wall_model(const Eigen::Vector3d& point_mm, const Eigen::Vector3d& normal,
-                                    const Eigen::Vector3d& tool_mm, double stiffness_n_per_m,
-                                    double damping_n_s_per_m, double published_s);
 
 }  // namespace liversim

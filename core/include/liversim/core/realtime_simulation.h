@@ -208,6 +208,8 @@ class RealtimeSimulation {
   IntegratorKind integrator_kind_;  // the model's, fixed: stats() reads it from any thread
   // Extends the stroke with the scalpel's edge, cuts, and swaps in the cut model and state.
   void cut_with_scalpel(const Tool& scalpel);
+  void end_stroke();  // the blade is out: the next cut needs a new break-in
+  double haptic_servo_period_s() const;
 
   std::atomic<bool> stop_requested_{false};
   // Statistics, written by the simulation thread once per window; each field on its own (a reader
