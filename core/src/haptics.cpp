@@ -220,4 +220,17 @@ LocalForceModel tool_force_model(std::span<const NodeSpring> springs, const Node
   return model;
 }
 
+Tool device_tool(const DeviceToolSettings& settings, const Eigen::Vector3d& origin_m,
+                 std::uint32_t buttons) {
+  Tool tool;
+  tool.kind = settings.kind;
+  tool.geometry = settings.geometry;
+  tool.pose.origin_m = origin_m;
+  tool.pose.orientation = settings.orientation.normalized();
+  const bool acting = (buttons & settings.action_buttons) != 0;
+  tool.jaw_opening = acting ? 0.0 : 1.0;
+  tool.blade_armed = acting;
+  return tool;
+}
+
 }  // namespace liversim

@@ -116,6 +116,7 @@ void RealtimeSimulation::enable_cutting(CuttingSettings settings) {
 void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   const auto edge = blade_edge_m(scalpel);
   if (!blade_in_tissue_) {
+    if (!scalpel.blade_armed) return;
     // Breaks in where an element the blade pushes is stressed to the cutting threshold.
     double stress_pa = -1.0;
     for (const NodeSpring& spring : tools_->springs())
@@ -136,6 +137,11 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   // it is still in: in its own cut the edge may touch no element.
   constexpr double kBladeReachM = 0.003;
   if (!blade_edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)) return end_stroke();
+  // Disarmed, the blade passes on without cutting; armed again, the stroke goes on from here.
+  if (!scalpel.blade_armed) {
+    stroke_.edges_m.assign(1, edge);
+    return;
+  }
   stroke_.add(edge);
   if (stroke_.edges_m.size() < 2) return;
   // Once in, the edge cuts whatever it is drawn through: the stress at a sharp edge in the tissue
@@ -175,6 +181,51 @@ double RealtimeSimulation::haptic_servo_period_s() const {
 void RealtimeSimulation::set_haptic_servo(ServoLoop* servo) {
   if (running()) throw std::logic_error("set_haptic_servo: stop the simulation first");
   haptic_servo_ = servo;
+}
+
+void RealtimeSimulation::set_device_tool(const std::optional<DeviceToolSettings>& settings) {
+  std::lock_guard lock(springs_mutex_);
+  pending_device_tool_ = settings;
+  device_tool_changed_ = true;
+  // The tool held so far goes with the change; a set_tool after this call counts.
+  pending_tool_.reset();
+  tool_changed_ = false;
+}
+
+void RealtimeSimulation::change_tool(const std::optional<Tool>& tool) {
+  const bool kind_changed = !tool || !active_tool_ || tool->kind != active_tool_->kind;
+  active_tool_ = tool;
+  if (!active_tool_ && tools_) tools_->release();
+  if (kind_changed || active_tool_->kind != ToolKind::scalpel) end_stroke();
+}
+
+void RealtimeSimulation::take_inputs() {
+  {
+    std::lock_guard lock(springs_mutex_);
+    if (springs_changed_) {
+      active_springs_.assign(pending_springs_.begin(), pending_springs_.end());  // no realloc
+      springs_changed_ = false;
+    }
+    if (device_tool_changed_) {
+      // The tool held so far goes: the device's appears with its first frame, or without a
+      // device, set_tool's next one.
+      device_tool_changed_ = false;
+      device_tool_ = pending_device_tool_;
+      device_sample_.reset();
+      change_tool(std::nullopt);
+    }
+    if (tool_changed_) {
+      tool_changed_ = false;
+      if (!device_tool_) change_tool(pending_tool_);
+    }
+  }
+  ServoFrame frame;
+  if (device_tool_ && haptic_servo_ && haptic_servo_->newest_frame(frame)) {
+    device_sample_ = frame.sample;
+    change_tool(device_tool(*device_tool_,
+                            haptic_servo_->mapping().scene_position_m(frame.sample.position_mm),
+                            frame.sample.buttons));
+  }
 }
 
 void RealtimeSimulation::set_tool(const std::optional<Tool>& tool) {
@@ -256,19 +307,7 @@ void RealtimeSimulation::run() {
   double dropped_s = 0.0;
 
   while (!stop_requested_.load(std::memory_order_relaxed)) {
-    {
-      std::lock_guard lock(springs_mutex_);
-      if (springs_changed_) {
-        active_springs_.assign(pending_springs_.begin(), pending_springs_.end());  // no realloc
-        springs_changed_ = false;
-      }
-      if (tool_changed_) {
-        active_tool_ = pending_tool_;
-        tool_changed_ = false;
-        if (!active_tool_ && tools_) tools_->release();
-        if (!active_tool_ || active_tool_->kind != ToolKind::scalpel) end_stroke();
-      }
-    }
+    take_inputs();
     const SimModel& model = *model_;  // a cut may replace it between cycles
     const bool tool_acts = tools_ && active_tool_;
     const StepInputs inputs{{}, active_springs_};
@@ -336,6 +375,8 @@ void RealtimeSimulation::run() {
       out.tool_grasping = tool_acts && tools_->grasping();
       out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
       out.blade_cutting = tool_acts && blade_in_tissue_;
+      out.tool = tool_acts ? active_tool_ : std::nullopt;
+      out.device_sample = device_sample_;
       if (haptic_servo_) haptic_servo_->publish(force_model);
       out.model = model_;
       out.topology_version = topology_version_;

@@ -261,15 +261,20 @@ ToolInteraction::ToolInteraction(const SimModel& model, const BoundarySurface& s
 }
 
 void ToolInteraction::try_grasp(const Tool& tool, const NodeArray& position) {
-  const Eigen::Vector3d point = forceps_grasp_point_m(tool);
+  // What the closing jaws take: the surface near them, hinge to tip. Open jaws come down on the
+  // tissue and push it aside before they close, so near the grasp point alone may be nothing.
+  const Eigen::Vector3d hinge = tool.pose.origin_m;
+  const Eigen::Vector3d tip =
+      tool.pose.to_scene(Eigen::Vector3d(0.0, 0.0, -tool.geometry.jaw_length_m));
   const double radius = grasp_settings_.radius_m;
   grasp_.clear();
   grasp_weight_.clear();
-  bvh_.for_each_triangle_overlapping(Aabb::around(point, point, radius), [&](std::size_t t) {
+  bvh_.for_each_triangle_overlapping(Aabb::around(hinge, tip, radius), [&](std::size_t t) {
     for (NodeIndex n : bvh_.triangles()[t]) {
       const auto node = static_cast<std::size_t>(n);
       if (node_mark_[node] || model_->inverse_mass_per_kg[node] == 0.0) continue;
-      const double d = (position.at(n) - point).norm();
+      const Eigen::Vector3d p = position.at(n);
+      const double d = (p - closest_point_on_segment(hinge, tip, p)).norm();
       if (d >= radius) continue;
       node_mark_[node] = 1;
       // The grab's weighting: every held node has the same spring frequency, and the hold fades

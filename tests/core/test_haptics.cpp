@@ -330,6 +330,23 @@ TEST(HapticCoupling, AStiffWallIsPassiveWithTheDampingColgatesConditionAsks) {
   EXPECT_NEAR(with_damping_j, -without_damping_j, 0.1 * without_damping_j);
 }
 
+TEST(DeviceTool, TheDevicePointIsTheToolsOriginAndItsActionButtonClosesTheJawsOrArmsTheBlade) {
+  DeviceToolSettings settings;
+  settings.kind = ToolKind::forceps;
+  settings.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()));
+  settings.action_buttons = 2;  // the second button acts
+  const Eigen::Vector3d at(0.01, -0.02, 0.03);
+  const Tool open = device_tool(settings, at, 1);
+  EXPECT_EQ(open.kind, ToolKind::forceps);
+  EXPECT_EQ(open.pose.origin_m, at);
+  EXPECT_TRUE(open.pose.orientation.isApprox(settings.orientation));
+  EXPECT_EQ(open.jaw_opening, 1.0) << "the first button is not the action button";
+  EXPECT_FALSE(open.blade_armed);
+  const Tool closed = device_tool(settings, at, 3);
+  EXPECT_EQ(closed.jaw_opening, 0.0);
+  EXPECT_TRUE(closed.blade_armed);
+}
+
 TEST(SpscRing, DeliversInOrderAndDropsWhenFullWithoutBlocking) {
   SpscRing<int> ring(4);
   for (int i = 0; i < 6; ++i) ring.push(i);

@@ -469,5 +469,110 @@ TEST_F(RealtimeSteppingFixture, TheForceOnAProbeReachesTheHapticDeviceInNewtons)
   EXPECT_EQ(device.last_force_n(), Eigen::Vector3d::Zero()) << "force left on after stop";
 }
 
+// A scripted device holds the forceps (issue 8): the servo's mapping puts the device's origin on
+// the forceps' origin over a marked node; the open jaws come down into the tissue, the action
+// button closes them on it, the
+// device lifts 10 mm and the liver comes with it; the force model reaches the device, pulling it
+// back down; the button released lets go.
+TEST_F(RealtimeSteppingFixture, AScriptedDeviceHoldsTheForcepsPullsTheLiverAndFeelsItPullBack) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(*mesh_));
+  const NodeIndex node = anterior_marked_node(*mesh_);
+  const Eigen::Vector3d marked = model->rest_position_m.at(node);
+  DeviceToolSettings held;
+  held.kind = ToolKind::forceps;
+  Tool closed = device_tool(held, Eigen::Vector3d::Zero(), 1);
+  ServoLoop::Options options;
+  options.mapping.offset_m = marked - forceps_grasp_point_m(closed);  // device origin → grasp
+  // Open, 15 mm above; down to the origin (the open jaws push the tissue down by about 1 cm);
+  // closed from 0.6 s; lifted by 25 mm over 1 s, held, let go at 30 s.
+  TrajectoryDevice device("script", {{0.0, {0.0, 0.0, 15.0}, 0},
+                                     {0.4, {0.0, 0.0, 0.0}, 0},
+                                     {0.6, {0.0, 0.0, 0.0}, 1},
+                                     {1.0, {0.0, 0.0, 0.0}, 1},
+                                     {2.0, {0.0, 0.0, 25.0}, 1},
+                                     {30.0, {0.0, 0.0, 25.0}, 0}});
+  ServoLoop servo(device, options);
+  simulation.set_haptic_servo(&servo);
+  simulation.set_device_tool(held);
+  simulation.set_tool(std::nullopt);  // ignored while the device holds a tool
+  servo.start();
+  simulation.start();
+  const SimulationSnapshot grasped = run_until(
+      simulation, 60.0, [](const SimulationSnapshot& seen) { return seen.tool_grasping; });
+  ASSERT_TRUE(grasped.tool_grasping) << "the jaws closed by the button took no hold";
+  ASSERT_TRUE(grasped.tool && grasped.device_sample);
+  EXPECT_EQ(grasped.tool->kind, ToolKind::forceps);
+  EXPECT_EQ(grasped.tool->jaw_opening, 0.0);
+  EXPECT_LT((grasped.tool->pose.origin_m -
+             options.mapping.scene_position_m(grasped.device_sample->position_mm))
+                .norm(),
+            1e-12)
+      << "the tool is not where the mapping puts the device";
+  // Lifted: the held node comes up above where it was at rest.
+  const SimulationSnapshot lifted = run_until(simulation, 60.0, [&](const SimulationSnapshot& s) {
+    return s.position_m.z[node] - marked.z() > 0.005;
+  });
+  EXPECT_GT(lifted.position_m.z[node] - marked.z(), 0.005);
+  EXPECT_TRUE(lifted.tool_grasping);
+  EXPECT_LT(lifted.tool_force_n.z(), 0.0) << "the tissue pulls the forceps back down";
+  simulation.stop();  // the last model stands for the servo until it goes stale
+  servo.stop();
+  EXPECT_GT(servo.stats().ticks, 0u);
+  EXPECT_LT(servo.stats().max_force_n, servo.safety().force_cap_n + 1e-12);
+  EXPECT_FALSE(simulation.stats().halted);
+  // Without the device's tool, set_tool's acts again.
+  simulation.set_device_tool(std::nullopt);
+  Tool probe;
+  probe.pose.origin_m = marked + Eigen::Vector3d(0.0, 0.0, 0.05);
+  simulation.set_tool(probe);
+  simulation.start();
+  const SimulationSnapshot after = run_until(
+      simulation, 60.0, [](const SimulationSnapshot& seen) { return seen.tool.has_value(); });
+  simulation.stop();
+  ASSERT_TRUE(after.tool);
+  EXPECT_EQ(after.tool->kind, ToolKind::probe);
+  EXPECT_FALSE(after.device_sample);
+  EXPECT_FALSE(after.tool_grasping) << "the forceps let go when the device put them down";
+}
+
+// A disarmed blade (the cut button up) only pushes: pressed far past the point where an armed one
+// breaks in, it never does; armed, it breaks in.
+TEST_F(RealtimeSteppingFixture, ADisarmedScalpelPressesButNeverBreaksIn) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(*mesh_));
+  CuttingSettings settings;
+  settings.cutting_stress_pa = 300.0;  // as in the break-in test above
+  simulation.enable_cutting(settings);
+  const Eigen::AlignedBox3d box = rest_box(*model);
+  const Eigen::Vector2d where(box.center().x() - 0.04, box.center().y());
+  const double top_m = column_at(*model, where).top_m;
+  ASSERT_TRUE(std::isfinite(top_m));
+  Tool scalpel;
+  scalpel.kind = ToolKind::scalpel;
+  scalpel.blade_armed = false;
+  scalpel.geometry.blade_length_m = 0.04;
+  scalpel.pose.origin_m = {where.x(), where.y(), top_m + 0.001 + scalpel.geometry.blade_length_m};
+  simulation.set_tool(scalpel);
+  simulation.start();
+  auto press = [&](double by_m) {
+    scalpel.pose.origin_m.z() -= by_m;
+    simulation.set_tool(scalpel);
+    return run_until(simulation, 0.01, [](const SimulationSnapshot&) { return false; });
+  };
+  SimulationSnapshot seen;
+  for (int k = 0; k < 100; ++k) seen = press(2e-4);  // 20 mm
+  EXPECT_FALSE(seen.blade_cutting) << "a disarmed blade broke in";
+  EXPECT_EQ(seen.topology_version, 0u);
+  EXPECT_GT(seen.tool_contacts, 0u) << "the blade pressed nothing";
+  scalpel.blade_armed = true;
+  for (int k = 0; k < 150 && !seen.blade_cutting; ++k) seen = press(1e-4);
+  simulation.stop();
+  EXPECT_TRUE(seen.blade_cutting) << "armed, the pressed blade did not break in";
+  EXPECT_FALSE(simulation.stats().halted);
+}
+
 }  // namespace
 }  // namespace liversim

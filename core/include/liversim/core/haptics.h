@@ -13,6 +13,7 @@
 
 #include "liversim/core/forces.h"
 #include "liversim/core/haptic_device.h"
+#include "liversim/core/tools.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -152,5 +153,21 @@ class HapticRenderer {
 // (Colgate: b > K·T/2, T the servo period). x0 is the tool's point.
 LocalForceModel tool_force_model(std::span<const NodeSpring> springs, const NodeArray& position_m,
                                  const Eigen::Vector3d& tool_point_m, double servo_period_s);
+
+// How a haptic device holds a tool. The device reports a position only (the Omni's gimbal angles
+// are not used), so the shaft keeps a set direction; the device's point, through the workspace
+// mapping, is the tool's origin: the probe's ball centre, the forceps' jaw hinge, the blade's heel.
+struct DeviceToolSettings {
+  ToolKind kind = ToolKind::probe;
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // tool frame → scene
+  // The device buttons (bit mask) that act: held, the forceps close and the scalpel's blade is
+  // armed to cut.
+  std::uint32_t action_buttons = 1;
+  ToolGeometry geometry;
+};
+
+// The tool at scene point `origin_m` with the device's `buttons` down.
+Tool device_tool(const DeviceToolSettings& settings, const Eigen::Vector3d& origin_m,
+                 std::uint32_t buttons);
 
 }  // namespace liversim

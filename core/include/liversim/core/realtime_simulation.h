@@ -40,6 +40,10 @@ struct SimulationSnapshot {
   bool tool_grasping = false;
   std::size_t tool_contacts = 0;
   bool blade_cutting = false;  // the scalpel has broken into the tissue
+  // The tool acting in the last cycle (set_tool's, or the device's), for drawing.
+  std::optional<Tool> tool;
+  // The haptic device's frame the tool followed (set_device_tool), if it follows one.
+  std::optional<DeviceSample> device_sample;
   // The model the positions belong to: a cut replaces it (and raises topology_version), so a
   // reader rebuilds what it draws from the mesh when the version changes.
   std::shared_ptr<const SimModel> model;
@@ -162,6 +166,10 @@ class RealtimeSimulation {
   // Publishes the local model of the force on the tool to `servo` after every cycle (none: the
   // zero model), for the haptic device to render. Call while stopped; null stops publishing.
   void set_haptic_servo(ServoLoop* servo);
+  // From any thread: the haptic device holds this tool (nothing: it holds none). While one is set
+  // and a servo is attached, each cycle takes the device's newest frame, maps it into the scene
+  // (the servo's WorkspaceMapping) and uses device_tool() as the tool; set_tool is then ignored.
+  void set_device_tool(const std::optional<DeviceToolSettings>& settings);
 
   // Consumer side (one thread, e.g. the UI): the newest snapshot, if one was published since.
   bool update_snapshot() { return snapshots_.update(); }
@@ -194,7 +202,11 @@ class RealtimeSimulation {
   std::vector<NodeSpring> active_springs_;  // simulation thread's copy
   std::optional<Tool> pending_tool_;        // under springs_mutex_
   bool tool_changed_ = false;
-  std::optional<Tool> active_tool_;  // simulation thread's copy
+  std::optional<Tool> active_tool_;                        // simulation thread's copy
+  std::optional<DeviceToolSettings> pending_device_tool_;  // under springs_mutex_
+  bool device_tool_changed_ = false;
+  std::optional<DeviceToolSettings> device_tool_;  // simulation thread's copy
+  std::optional<DeviceSample> device_sample_;      // the frame the device's tool followed
   ServoLoop* haptic_servo_ = nullptr;
   std::optional<ToolInteraction> tools_;  // simulation thread only once started
   std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tool's
@@ -209,6 +221,9 @@ class RealtimeSimulation {
   // Extends the stroke with the scalpel's edge, cuts, and swaps in the cut model and state.
   void cut_with_scalpel(const Tool& scalpel);
   void end_stroke();  // the blade is out: the next cut needs a new break-in
+  // Takes the inputs set from other threads (springs, tool, device tool) for the next cycle.
+  void take_inputs();
+  void change_tool(const std::optional<Tool>& tool);
   double haptic_servo_period_s() const;
 
   std::atomic<bool> stop_requested_{false};

@@ -55,6 +55,9 @@ struct Tool {
   ToolKind kind = ToolKind::probe;
   ToolPose pose;
   double jaw_opening = 1.0;  // forceps: 0 closed, 1 fully open
+  // Scalpel: the blade may break in and cut (a device's cut button held); disarmed it only pushes,
+  // and a blade already in passes on without cutting until armed again or drawn out.
+  bool blade_armed = true;
   ToolGeometry geometry;
 };
 
@@ -119,7 +122,7 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
                                 const ContactSettings& settings, ContactScratch& scratch,
                                 std::vector<NodeSpring>& springs);
 
-// The forceps' hold on the tissue: the surface nodes near the grasp point when the jaws closed,
+// The forceps' hold on the tissue: the surface nodes near the jaws when they closed,
 // carried rigidly with the tool from then on. Empty: no hold.
 struct ForcepsGrasp {
   std::vector<NodeIndex> nodes;
@@ -139,7 +142,7 @@ struct ForcepsGrasp {
 struct GraspSettings {
   double close_below = 0.3;    // jaw opening at which the jaws take hold
   double release_above = 0.5;  // and let go (hysteresis: a hold does not flicker)
-  double radius_m = 0.01;      // surface nodes this close to the grasp point are held
+  double radius_m = 0.01;      // surface nodes this close to the closed jaws are held
   double total_stiffness_n_per_m = 300.0;
 };
 
