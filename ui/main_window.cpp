@@ -1,23 +1,31 @@
 #include "main_window.h"
 
 #include "accuracy_panel.h"
+#include "calibration_dialog.h"
+#include "device_panel.h"
 #include "render/liver_scene.h"
 #include "tool_panel.h"
 #include "vtk_viewport.h"
 
 #include "liversim/core/cutting.h"
+#include "liversim/core/emulated_devices.h"
 #include "liversim/core/integrator.h"
+#include "liversim/core/openhaptics_device.h"
 #include "liversim/core/surface.h"
 
 #include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
 #include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
 #include <QGuiApplication>
 #include <QLabel>
+#include <QSettings>
 #include <QStatusBar>
 
 #include <cmath>
+#include <cstdlib>
 #include <exception>
 #include <numbers>
 #include <string_view>
@@ -83,6 +91,29 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   toolPanel_ = new ToolPanel(this);
   toolPanel_->setObjectName("toolPanel");
   addPanelDock(tr("Tool"), "toolDock", toolPanel_);
+  connect(toolPanel_, &ToolPanel::toolChanged, this, [this] {
+    if (servo_) simulation_->set_device_tool(deviceToolSettings());
+  });
+
+  devicePanel_ = new DevicePanel(this);
+  devicePanel_->setObjectName("devicePanel");
+  addPanelDock(tr("Device"), "deviceDock", devicePanel_);
+  {
+    QSettings settings;
+    haptics_ = load_haptic_preferences(settings);
+  }
+  openOmni();
+  connect(devicePanel_, &DevicePanel::deviceChosen, this, [this](DeviceChoice device) {
+    if (device != DeviceChoice::scripted) return void(useDevice(device));
+    const QString file =
+        QFileDialog::getOpenFileName(this, tr("Trajectory to play"), haptics_.trajectory_file,
+                                     tr("Trajectories (*.txt *.trajectory);;All files (*)"));
+    if (file.isEmpty())
+      devicePanel_->showDevice(haptics_.device);  // cancelled: the device in use stays
+    else
+      useDevice(device, file);
+  });
+  connect(devicePanel_, &DevicePanel::calibrateRequested, this, [this] { openCalibration(); });
 
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("simulationStatus");
@@ -99,6 +130,13 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   statusTimer_.start(500);
   frameWindow_.start();
   simulation_->start();
+  // The device of the last session: the Omni if it is there again (a script is played on
+  // request only).
+  const DeviceChoice last = haptics_.device;
+  haptics_.device = DeviceChoice::mouse;
+  devicePanel_->showDevice(DeviceChoice::mouse);
+  devicePanel_->showStatus(tr("The mouse moves the tool."));
+  if (last == DeviceChoice::openhaptics) useDevice(DeviceChoice::openhaptics);
 }
 
 void MainWindow::addPanelDock(const QString& title, const char* name, QWidget* panel) {
@@ -112,6 +150,7 @@ void MainWindow::addPanelDock(const QString& title, const char* name, QWidget* p
 MainWindow::~MainWindow() {
   if (modelBuilder_.joinable()) modelBuilder_.join();
   simulation_->stop();
+  detachDevice();  // the servo's last command is a zero force
 }
 
 bool MainWindow::applyIntegratorSettings(const IntegratorSettings& settings) {
@@ -195,6 +234,7 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   simulation_->enable_tools(scene_->surface());
   simulation_->enable_cutting();
   if (tool_) simulation_->set_tool(tool_);
+  attachDevice();
   simulation_->start();
   setup_.model_options.integrator = settings;
   accuracyPanel_->setSettings(settings);
@@ -205,7 +245,10 @@ bool MainWindow::beginGrab(QPoint pos, Qt::MouseButton button, Qt::KeyboardModif
   // While the tissue is held, other buttons must not move the camera under the handle.
   if (grab_ || tool_) return true;
   if (button != Qt::LeftButton || modifiers != Qt::NoModifier) return false;
-  if (const auto kind = toolPanel_->tool()) return beginTool(*kind, pos);
+  if (const auto kind = toolPanel_->tool()) {
+    if (servo_) return false;  // the device holds the tool: the mouse turns the view
+    return beginTool(*kind, pos);
+  }
   const auto hit = scene_->pick(pos.x(), pos.y());
   if (!hit) return false;  // background: the camera takes the drag
   grab_ = grab_surface(scene_->surface(), simulation_->snapshot().position_m,
@@ -231,27 +274,26 @@ void MainWindow::endGrab() {
   scene_->show_grab_marker(std::nullopt);
 }
 
+Eigen::Quaterniond MainWindow::toolOrientationFromView() const {
+  const Eigen::Quaterniond view = deviceAxesFromView();
+  const Eigen::Vector3d toward_viewer = view * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d view_up = view * Eigen::Vector3d::UnitY();
+  constexpr double kTiltRad = 35.0 * std::numbers::pi / 180.0;
+  const Eigen::Vector3d shaft_direction =
+      (std::cos(kTiltRad) * toward_viewer + std::sin(kTiltRad) * view_up).normalized();
+  return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), shaft_direction);
+}
+
 // The tool is put on the liver where the mouse presses, its shaft toward the viewer and tilted up
 // by 35° (as a laparoscopic instrument comes in through a port, and so that it shows): the probe's
 // ball on the surface, the forceps' jaws closed on it, the blade's tip touching it.
 bool MainWindow::beginTool(ToolKind kind, QPoint pos) {
   const auto hit = scene_->pick(pos.x(), pos.y());
   if (!hit) return false;  // background: the camera takes the drag
-  double direction[3], up[3];
-  vtkCamera* camera = scene_->renderer()->GetActiveCamera();
-  camera->GetDirectionOfProjection(direction);
-  camera->GetViewUp(up);
-  const Eigen::Vector3d toward_viewer =
-      -Eigen::Vector3d(direction[0], direction[1], direction[2]).normalized();
-  const Eigen::Vector3d view_up = Eigen::Vector3d(up[0], up[1], up[2]).normalized();
-  constexpr double kTiltRad = 35.0 * std::numbers::pi / 180.0;
-  const Eigen::Vector3d shaft_direction =
-      (std::cos(kTiltRad) * toward_viewer + std::sin(kTiltRad) * view_up).normalized();
   Tool tool;
   tool.kind = kind;
   tool.jaw_opening = 0.0;
-  tool.pose.orientation =
-      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), shaft_direction);
+  tool.pose.orientation = toolOrientationFromView();
   const Eigen::Vector3d shaft = tool.pose.orientation * Eigen::Vector3d::UnitZ();
   switch (kind) {
     case ToolKind::probe:
@@ -269,7 +311,7 @@ bool MainWindow::beginTool(ToolKind kind, QPoint pos) {
   tool_ = tool;
   toolPoint_m_ = hit->point_m;
   simulation_->set_tool(tool_);
-  showTool();
+  showTool(tool_);
   return true;
 }
 
@@ -287,18 +329,18 @@ void MainWindow::moveTool(QPoint pos) {
   tool_->pose.origin_m += move;
   toolPoint_m_ += move;
   simulation_->set_tool(tool_);
-  showTool();
+  showTool(tool_);
 }
 
 void MainWindow::endTool() {
   tool_.reset();
   simulation_->set_tool(std::nullopt);  // the forceps let go as they leave
-  showTool();
+  showTool(tool_);
 }
 
-void MainWindow::showTool() {
+void MainWindow::showTool(const std::optional<Tool>& tool) {
   std::array<Capsule, 3> parts;
-  const int count = tool_ ? tool_capsules(*tool_, parts) : 0;
+  const int count = tool ? tool_capsules(*tool, parts) : 0;
   scene_->show_tool(std::span<const Capsule>(parts.data(), static_cast<std::size_t>(count)));
   viewport_->scheduleRender();
 }
@@ -324,7 +366,8 @@ void MainWindow::showNewestSnapshot() {
       shownTopology_ = snapshot.topology_version;
     }
     scene_->update_positions(snapshot.position_m);
-    if (tool_)
+    if (servo_) showTool(snapshot.tool);  // the device moves it
+    if (tool_ || (servo_ && snapshot.tool))
       toolPanel_->showForce(snapshot.time_s, snapshot.tool_force_n, snapshot.tool_grasping);
     else if (grab_)
       toolPanel_->showForce(snapshot.time_s,
@@ -336,6 +379,7 @@ void MainWindow::showNewestSnapshot() {
 }
 
 void MainWindow::updateStatus() {
+  checkDevice();
   const double window_s = frameWindow_.restart() / 1000.0;
   framesPerSecond_ = window_s > 0 ? framesInWindow_ / window_s : 0.0;
   framesInWindow_ = 0;
@@ -416,6 +460,204 @@ QString MainWindow::accuracyStatus(const RealtimeStats& stats) const {
   }
   if (stats.stability_limited) text += tr(" · stability-limited");
   return text;
+}
+
+Eigen::Quaterniond MainWindow::deviceAxesFromView() const {
+  double direction[3], up[3];
+  vtkCamera* camera = scene_->renderer()->GetActiveCamera();
+  camera->GetDirectionOfProjection(direction);
+  camera->GetViewUp(up);
+  const Eigen::Vector3d toward_user =
+      -Eigen::Vector3d(direction[0], direction[1], direction[2]).normalized();
+  const Eigen::Vector3d up_m(up[0], up[1], up[2]);
+  const Eigen::Vector3d view_up = (up_m - toward_user.dot(up_m) * toward_user).normalized();
+  Eigen::Matrix3d axes;
+  axes.col(0) = view_up.cross(toward_user);  // right
+  axes.col(1) = view_up;
+  axes.col(2) = toward_user;
+  return Eigen::Quaterniond(axes).normalized();
+}
+
+Eigen::Vector3d MainWindow::deviceHome_m() const {
+  Eigen::AlignedBox3d box;
+  const NodeArray& position = simulation_->snapshot().position_m;
+  for (std::size_t n = 0; n < position.size(); ++n) box.extend(position.at(n));
+  // From the centre toward the viewer, out of the box, and a centimetre further.
+  const Eigen::Vector3d toward_user = deviceAxesFromView() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d half = box.sizes() / 2.0;
+  double out_m = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis)
+    if (std::abs(toward_user[axis]) > 1e-9)
+      out_m = std::min(out_m, half[axis] / std::abs(toward_user[axis]));
+  return box.center() + (out_m + 0.01) * toward_user;
+}
+
+std::optional<DeviceToolSettings> MainWindow::deviceToolSettings() const {
+  const auto kind = toolPanel_->tool();
+  if (!kind) return std::nullopt;  // the hand: the device holds nothing
+  DeviceToolSettings settings;
+  settings.kind = *kind;
+  settings.orientation = toolOrientationFromView();
+  settings.action_buttons = haptics_.action_buttons;
+  return settings;
+}
+
+void MainWindow::attachDevice() {
+  if (!servo_) return;
+  simulation_->set_haptic_servo(servo_.get());
+  simulation_->set_device_tool(deviceToolSettings());
+}
+
+void MainWindow::detachDevice() {
+  if (!simulation_->running()) {
+    simulation_->set_haptic_servo(nullptr);
+    simulation_->set_device_tool(std::nullopt);
+  }
+  servo_.reset();  // stops: the last command is a zero force
+  scripted_.reset();
+}
+
+void MainWindow::openOmni() {
+  const QByteArray library = qgetenv("LIVERSIM_OPENHAPTICS_LIBRARY");
+  OpenHapticsOpening omni =
+      open_openhaptics_device(library.isEmpty() ? "libHD.so" : library.toStdString());
+  omni_ = std::move(omni.device);
+  omniProblem_ = QString::fromStdString(omni.problem);
+  devicePanel_->setOpenHapticsProblem(omniProblem_);
+}
+
+void MainWindow::saveHapticPreferences() {
+  QSettings settings;
+  save_haptic_preferences(settings, haptics_);
+}
+
+bool MainWindow::useDevice(DeviceChoice choice, const QString& trajectoryFile) {
+  auto refuse = [&](const QString& why) {
+    devicePanel_->showStatus(why, true);
+    devicePanel_->showDevice(haptics_.device);
+    return false;
+  };
+  HapticDevice* device = nullptr;
+  std::unique_ptr<HapticDevice> scripted;
+  QString file = trajectoryFile.isEmpty() ? haptics_.trajectory_file : trajectoryFile;
+  switch (choice) {
+    case DeviceChoice::mouse:
+      break;
+    case DeviceChoice::openhaptics:
+      if (!omni_) openOmni();
+      if (!omni_) return refuse(tr("The Phantom Omni is not available: %1").arg(omniProblem_));
+      device = omni_.get();
+      break;
+    case DeviceChoice::scripted:
+      if (file.isEmpty()) return refuse(tr("Choose a trajectory file to play."));
+      try {
+        scripted = std::make_unique<TrajectoryDevice>(
+            tr("Scripted: %1").arg(QFileInfo(file).fileName()).toStdString(),
+            load_trajectory(file.toStdString()));
+      } catch (const std::exception& e) {
+        return refuse(tr("Cannot play the trajectory: %1").arg(QString::fromUtf8(e.what())));
+      }
+      device = scripted.get();
+      break;
+  }
+  if (device && !haptics_.mapping_set) {
+    // First use: the device's axes the screen's, its origin just in front of the liver, and
+    // its workspace (about 16 cm across for an Omni) over the liver's 25 cm.
+    haptics_.mapping.rotation = deviceAxesFromView();
+    haptics_.mapping.scale = 1.5;
+    haptics_.mapping.offset_m = deviceHome_m();
+    haptics_.mapping_set = true;
+  }
+  std::unique_ptr<ServoLoop> servo;
+  if (device) {
+    ServoLoop::Options options;
+    options.mapping = haptics_.mapping;
+    try {
+      servo = std::make_unique<ServoLoop>(*device, options);
+    } catch (const std::exception& e) {
+      return refuse(tr("Cannot run the device: %1").arg(QString::fromUtf8(e.what())));
+    }
+  }
+  // The mouse lets go of what it held; the device's tool appears with its first frame.
+  if (tool_) endTool();
+  simulation_->stop();
+  detachDevice();
+  servo_ = std::move(servo);
+  scripted_ = std::move(scripted);
+  haptics_.device = choice;
+  if (choice == DeviceChoice::scripted) haptics_.trajectory_file = file;
+  attachDevice();
+  simulation_->start();
+  if (servo_) servo_->start();
+  if (!servo_) showTool(std::nullopt);
+  saveHapticPreferences();
+  devicePanel_->showDevice(choice);
+  devicePanel_->setCalibrationAvailable(servo_ != nullptr);
+  devicePanel_->showServoStats(nullptr);
+  devicePanel_->showStatus(device ? tr("%1 moves the tool chosen in the Tool panel.")
+                                        .arg(QString::fromStdString(device->name()))
+                                  : tr("The mouse moves the tool."));
+  return true;
+}
+
+void MainWindow::checkDevice() {
+  if (!servo_) return;
+  const ServoStats stats = servo_->stats();
+  devicePanel_->showServoStats(&stats);
+  const std::string fault = servo_->device_fault();
+  if (fault.empty()) return;
+  // A vanished or broken device: its force is off already; the mouse takes over.
+  const bool omni = haptics_.device == DeviceChoice::openhaptics;
+  const QString name = omni ? QString::fromStdString(omni_->name()) : tr("The device");
+  const QString why = tr("%1 stopped: %2. The mouse moves the tool now; choose the device again "
+                         "once it is back.")
+                          .arg(name, QString::fromStdString(fault));
+  useDevice(DeviceChoice::mouse);
+  if (omni) {
+    // Its fault sticks: choosing it again opens it anew.
+    omni_.reset();
+    omniProblem_ = QString::fromStdString(fault);
+    devicePanel_->setOpenHapticsProblem(omniProblem_);
+  }
+  devicePanel_->showStatus(why, true);
+  statusBar()->showMessage(why);
+}
+
+CalibrationDialog* MainWindow::openCalibration() {
+  if (calibration_) {
+    calibration_->raise();
+    return calibration_;
+  }
+  CalibrationDialog::Context context;
+  context.device_name = haptics_.device == DeviceChoice::openhaptics && omni_
+                            ? QString::fromStdString(omni_->name())
+                        : haptics_.device == DeviceChoice::scripted ? tr("the scripted device")
+                                                                    : tr("the device");
+  if (auto* omni = dynamic_cast<OpenHapticsDevice*>(
+          haptics_.device == DeviceChoice::openhaptics ? omni_.get() : nullptr))
+    context.calibration = omni->calibration_ok()
+                              ? tr("calibrated")
+                              : tr("not calibrated: put the stylus in its inkwell (or move it "
+                                   "through its whole range), then open this dialog again");
+  context.view_rotation = deviceAxesFromView();
+  context.home_m = deviceHome_m();
+  context.device_position_mm = [this]() -> std::optional<Eigen::Vector3d> {
+    const auto& sample = simulation_->snapshot().device_sample;
+    return sample ? std::optional<Eigen::Vector3d>(sample->position_mm) : std::nullopt;
+  };
+  HapticPreferences shown = haptics_;
+  if (!shown.mapping_set) shown.mapping.rotation = context.view_rotation;
+  calibration_ = new CalibrationDialog(shown, std::move(context), this);
+  calibration_->setAttribute(Qt::WA_DeleteOnClose);
+  connect(calibration_, &QDialog::accepted, this, [this] {
+    haptics_.mapping = calibration_->mapping();
+    haptics_.action_buttons = calibration_->actionButtons();
+    haptics_.mapping_set = true;
+    saveHapticPreferences();
+    if (servo_) useDevice(haptics_.device);  // the servo takes the new mapping
+  });
+  calibration_->show();
+  return calibration_;
 }
 
 }  // namespace liversim

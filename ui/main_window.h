@@ -3,12 +3,17 @@
 // integrator and step) beside it, live statistics in the status bar. The simulation runs on its own
 // thread; the viewport renders from its newest snapshot.
 
+#include "haptic_preferences.h"
+
 #include "liversim/core/default_scene.h"
 #include "liversim/core/grab.h"
+#include "liversim/core/haptic_device.h"
 #include "liversim/core/realtime_simulation.h"
+#include "liversim/core/servo_loop.h"
 
 #include <QElapsedTimer>
 #include <QMainWindow>
+#include <QPointer>
 #include <QTimer>
 
 #include <array>
@@ -23,6 +28,8 @@ class QLabel;
 namespace liversim {
 
 class AccuracyPanel;
+class CalibrationDialog;
+class DevicePanel;
 class LiverScene;
 class ToolPanel;
 class VtkViewport;
@@ -51,6 +58,20 @@ class MainWindow : public QMainWindow {
   bool applyIntegratorSettings(const IntegratorSettings& settings);
   bool changingIntegrator() const { return changingIntegrator_; }
 
+  // Haptic devices (Device panel). The mouse moves the tool directly; any other device drives it
+  // through the 1 kHz servo, holding the tool chosen in the Tool panel (the hand: none). The
+  // Phantom Omni is looked for at start, in the OpenHaptics runtime libHD.so (or the library
+  // named by LIVERSIM_OPENHAPTICS_LIBRARY). Returns false, saying why in the panel, when the
+  // device cannot be used; the device in use then stays.
+  bool useDevice(DeviceChoice device, const QString& trajectoryFile = {});
+  DeviceChoice device() const { return haptics_.device; }
+  DevicePanel* devicePanel() const { return devicePanel_; }
+  ServoLoop* servo() const { return servo_.get(); }
+  const HapticPreferences& hapticPreferences() const { return haptics_; }
+  // Opens the calibration dialog for the device in use (not modal); accepting it saves and uses
+  // the new mapping.
+  CalibrationDialog* openCalibration();
+
   // Spring stiffness of a mouse grab and the radius of tissue it holds.
   static constexpr double kGrabStiffnessNPerM = 300.0;
   static constexpr double kGrabRadiusM = 0.02;
@@ -67,7 +88,19 @@ class MainWindow : public QMainWindow {
   bool beginTool(ToolKind kind, QPoint vtkDisplayPos);
   void moveTool(QPoint vtkDisplayPos);
   void endTool();
-  void showTool();
+  void showTool(const std::optional<Tool>& tool);
+  // The shaft's direction for a tool put on the liver: toward the viewer, tilted up by 35°.
+  Eigen::Quaterniond toolOrientationFromView() const;
+  // Device axes (x right, y up, z toward the user) → scene, for the current view.
+  Eigen::Quaterniond deviceAxesFromView() const;
+  // Just in front of the liver, seen from the camera: where a centred stylus puts the tool.
+  Eigen::Vector3d deviceHome_m() const;
+  std::optional<DeviceToolSettings> deviceToolSettings() const;
+  void attachDevice();  // the servo and the device's tool to the (stopped) simulation
+  void detachDevice();  // stops the servo; the simulation must be stopped
+  void checkDevice();   // servo statistics and faults, with the status
+  void saveHapticPreferences();
+  void openOmni();  // looks for the Phantom Omni: omni_, or why not in omniProblem_
   void finishIntegratorChange(const IntegratorSettings& settings,
                               std::shared_ptr<const SimModel> model, const QString& error);
   void showNewestSnapshot();
@@ -82,6 +115,8 @@ class MainWindow : public QMainWindow {
   VtkViewport* viewport_ = nullptr;
   AccuracyPanel* accuracyPanel_ = nullptr;
   ToolPanel* toolPanel_ = nullptr;
+  DevicePanel* devicePanel_ = nullptr;
+  QPointer<CalibrationDialog> calibration_;
   QLabel* statusLabel_ = nullptr;
   QTimer frameTimer_;
   QTimer statusTimer_;
@@ -101,6 +136,12 @@ class MainWindow : public QMainWindow {
   int framesInWindow_ = 0;
   QElapsedTimer frameWindow_;
   double framesPerSecond_ = 0.0;
+
+  HapticPreferences haptics_;
+  std::unique_ptr<HapticDevice> omni_;  // opened at start when its runtime and device are there
+  QString omniProblem_;                 // why not, otherwise
+  std::unique_ptr<HapticDevice> scripted_;
+  std::unique_ptr<ServoLoop> servo_;  // runs while a device other than the mouse is in use
 
   // Builds the model of an integrator change; reads setup_.mesh, which never changes.
   std::thread modelBuilder_;

@@ -13,7 +13,10 @@ namespace liversim {
 namespace {
 
 SimulationSnapshot snapshot_of(const SimState& state, std::shared_ptr<const SimModel> model) {
-  SimulationSnapshot snapshot{state.position_m, state.time_s, state.step_count};
+  SimulationSnapshot snapshot;
+  snapshot.position_m = state.position_m;
+  snapshot.time_s = state.time_s;
+  snapshot.step_count = state.step_count;
   snapshot.model = std::move(model);
   return snapshot;
 }
@@ -181,6 +184,7 @@ double RealtimeSimulation::haptic_servo_period_s() const {
 void RealtimeSimulation::set_haptic_servo(ServoLoop* servo) {
   if (running()) throw std::logic_error("set_haptic_servo: stop the simulation first");
   haptic_servo_ = servo;
+  device_sample_.reset();
 }
 
 void RealtimeSimulation::set_device_tool(const std::optional<DeviceToolSettings>& settings) {
@@ -211,7 +215,6 @@ void RealtimeSimulation::take_inputs() {
       // device, set_tool's next one.
       device_tool_changed_ = false;
       device_tool_ = pending_device_tool_;
-      device_sample_.reset();
       change_tool(std::nullopt);
     }
     if (tool_changed_) {
@@ -220,11 +223,12 @@ void RealtimeSimulation::take_inputs() {
     }
   }
   ServoFrame frame;
-  if (device_tool_ && haptic_servo_ && haptic_servo_->newest_frame(frame)) {
+  if (haptic_servo_ && haptic_servo_->newest_frame(frame)) {
     device_sample_ = frame.sample;
-    change_tool(device_tool(*device_tool_,
-                            haptic_servo_->mapping().scene_position_m(frame.sample.position_mm),
-                            frame.sample.buttons));
+    if (device_tool_)
+      change_tool(device_tool(*device_tool_,
+                              haptic_servo_->mapping().scene_position_m(frame.sample.position_mm),
+                              frame.sample.buttons));
   }
 }
 

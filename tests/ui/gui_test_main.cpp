@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 #include <QApplication>
+#include <QDir>
+#include <QSettings>
 
 #include <iostream>
 
@@ -24,5 +26,15 @@ int main(int argc, char** argv) {
   }
   liversim::VtkViewport::setDefaultSurfaceFormat();
   QApplication app(argc, argv);
-  return RUN_ALL_TESTS();
+  // Settings of their own, never the user's: an INI file in a folder of this process.
+  QApplication::setOrganizationName("LiverSimTests");
+  QApplication::setApplicationName("LiverSimTests");
+  QSettings::setDefaultFormat(QSettings::IniFormat);
+  const QString settings_dir =
+      QDir(QDir::tempPath())
+          .filePath(QStringLiteral("liversim-gui-tests-%1").arg(app.applicationPid()));
+  QSettings::setPath(QSettings::IniFormat, QSettings::UserScope, settings_dir);
+  const int result = RUN_ALL_TESTS();
+  QDir(settings_dir).removeRecursively();
+  return result;
 }

@@ -17,6 +17,7 @@
 #include <QMouseEvent>
 #include <QPushButton>
 #include <QRadioButton>
+#include <QSettings>
 #include <QSignalSpy>
 #include <QTest>
 #include <algorithm>
@@ -76,6 +77,7 @@ int countDifferentPixels(const QImage& a, const QImage& b, int tolerance = 8) {
 class MainWindowTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    QSettings().clear();  // the defaults, whatever an earlier test saved
     SceneSetup setup = default_scene(kTetCount);
     mesh_ = setup.mesh;
     window_ = std::make_unique<MainWindow>(std::move(setup));

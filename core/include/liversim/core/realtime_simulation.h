@@ -42,7 +42,7 @@ struct SimulationSnapshot {
   bool blade_cutting = false;  // the scalpel has broken into the tissue
   // The tool acting in the last cycle (set_tool's, or the device's), for drawing.
   std::optional<Tool> tool;
-  // The haptic device's frame the tool followed (set_device_tool), if it follows one.
+  // The haptic device's newest frame (set_haptic_servo), which the device's tool follows.
   std::optional<DeviceSample> device_sample;
   // The model the positions belong to: a cut replaces it (and raises topology_version), so a
   // reader rebuilds what it draws from the mesh when the version changes.
@@ -164,7 +164,9 @@ class RealtimeSimulation {
   // is used from the next cycle on.
   void set_tool(const std::optional<Tool>& tool);
   // Publishes the local model of the force on the tool to `servo` after every cycle (none: the
-  // zero model), for the haptic device to render. Call while stopped; null stops publishing.
+  // zero model), for the haptic device to render, and takes the device's newest frame from it
+  // each cycle (the only reader of ServoLoop::newest_frame while it runs). Call while stopped;
+  // null stops both.
   void set_haptic_servo(ServoLoop* servo);
   // From any thread: the haptic device holds this tool (nothing: it holds none). While one is set
   // and a servo is attached, each cycle takes the device's newest frame, maps it into the scene

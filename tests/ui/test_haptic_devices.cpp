@@ -1,0 +1,269 @@
+// The workstation's haptic devices under a real X server: the Device panel, a scripted trajectory
+// holding the probe on the liver through the 1 kHz servo, the calibration dialog and the settings
+// that remember it, and the Phantom Omni through an OpenHaptics runtime (a fake libHD.so built by
+// tests/openhaptics, loaded with dlopen like the real one): offered when it opens, said to be
+// missing when it does not, and a fatal fault handing the tool back to the mouse.
+#include <gtest/gtest.h>
+
+#include <dlfcn.h>
+#include <QComboBox>
+#include <QDir>
+#include <QSettings>
+#include <QTemporaryDir>
+#include <QTest>
+
+#include <algorithm>
+#include <fstream>
+#include <limits>
+#include <memory>
+
+#include "calibration_dialog.h"
+#include "device_panel.h"
+#include "haptic_preferences.h"
+#include "liversim/core/default_scene.h"
+#include "liversim/core/emulated_devices.h"
+#include "main_window.h"
+#include "tool_panel.h"
+
+namespace liversim {
+namespace {
+
+constexpr int kTetCount = 1500;
+constexpr int kTimeoutMs = 90'000;
+
+TEST(HapticPreferences, SurviveARestartAndADamagedValueGivesTheDefault) {
+  QTemporaryDir folder;
+  ASSERT_TRUE(folder.isValid());
+  const QString file = folder.filePath("settings.ini");
+  HapticPreferences saved;
+  saved.device = DeviceChoice::openhaptics;
+  saved.trajectory_file = "/somewhere/stroke.txt";
+  saved.action_buttons = 2;
+  saved.mapping_set = true;
+  saved.mapping.scale = 1.7;
+  saved.mapping.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()));
+  saved.mapping.offset_m = {0.01, -0.2, 0.3};
+  {
+    QSettings settings(file, QSettings::IniFormat);
+    save_haptic_preferences(settings, saved);
+  }
+  QSettings settings(file, QSettings::IniFormat);
+  const HapticPreferences loaded = load_haptic_preferences(settings);
+  EXPECT_EQ(loaded.device, DeviceChoice::openhaptics);
+  EXPECT_EQ(loaded.trajectory_file, saved.trajectory_file);
+  EXPECT_EQ(loaded.action_buttons, 2u);
+  ASSERT_TRUE(loaded.mapping_set);
+  EXPECT_DOUBLE_EQ(loaded.mapping.scale, 1.7);
+  EXPECT_LT(loaded.mapping.rotation.angularDistance(saved.mapping.rotation), 1e-12);
+  EXPECT_LT((loaded.mapping.offset_m - saved.mapping.offset_m).norm(), 1e-15);
+  // A hand-edited or damaged file: not a number, a zero scale, an unknown button.
+  for (const auto& [key, value] : {std::pair<QString, QString>{"haptics/mapping/scale", "abc"},
+                                   {"haptics/mapping/scale", "0"},
+                                   {"haptics/mapping/offsetXMm", "nan"}}) {
+    QSettings damaged(file, QSettings::IniFormat);
+    save_haptic_preferences(damaged, saved);
+    damaged.setValue(key, value);
+    const HapticPreferences fallback = load_haptic_preferences(damaged);
+    EXPECT_FALSE(fallback.mapping_set) << key.toStdString() << " = " << value.toStdString();
+    EXPECT_EQ(fallback.mapping.scale, 1.0);
+  }
+  settings.setValue("haptics/actionButtons", 9);
+  EXPECT_EQ(load_haptic_preferences(settings).action_buttons, 1u);
+}
+
+class DeviceTest : public ::testing::Test {
+ protected:
+  void SetUp() override { QSettings().clear(); }
+  void TearDown() override {
+    window_.reset();
+    qunsetenv("LIVERSIM_OPENHAPTICS_LIBRARY");
+  }
+
+  void openWindow() {
+    SceneSetup setup = default_scene(kTetCount);
+    mesh_ = setup.mesh;
+    window_ = std::make_unique<MainWindow>(std::move(setup));
+    window_->show();
+    ASSERT_TRUE(QTest::qWaitForWindowExposed(window_.get()));
+    ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().time_s > 0.0; }, kTimeoutMs));
+  }
+
+  const SimulationSnapshot& snapshot() const { return window_->simulation().snapshot(); }
+
+  // A trajectory file in the test's folder.
+  QString writeTrajectory(const std::vector<TrajectoryPoint>& points) {
+    const QString file = folder_.filePath("trajectory.txt");
+    save_trajectory(file.toStdString(), points);
+    return file;
+  }
+
+  // Device millimetres are scene millimetres: the settings the window starts with.
+  static void useSceneMillimetres() {
+    HapticPreferences preferences;
+    preferences.mapping_set = true;
+    QSettings settings;
+    save_haptic_preferences(settings, preferences);
+  }
+
+  // The highest rest point of the liver within 8 mm (in x–y) of its centre, in mm.
+  Eigen::Vector3d topOfTheMiddle_mm() const {
+    Eigen::AlignedBox3d box;
+    for (std::size_t n = 0; n < mesh_.rest_position_m.size(); ++n)
+      box.extend(mesh_.rest_position_m.at(n));
+    Eigen::Vector3d top(box.center().x(), box.center().y(),
+                        -std::numeric_limits<double>::infinity());
+    for (std::size_t n = 0; n < mesh_.rest_position_m.size(); ++n) {
+      const Eigen::Vector3d p = mesh_.rest_position_m.at(n);
+      if ((p.head<2>() - box.center().head<2>()).norm() < 0.008) top.z() = std::max(top.z(), p.z());
+    }
+    return top * 1e3;
+  }
+
+  QTemporaryDir folder_;
+  TetMesh mesh_;
+  std::unique_ptr<MainWindow> window_;
+};
+
+TEST_F(DeviceTest, WithoutTheOpenHapticsRuntimeTheOmniIsNotFoundSaysWhyAndTheMouseStays) {
+  qputenv("LIVERSIM_OPENHAPTICS_LIBRARY", "/nonexistent/libHD.so");
+  openWindow();
+  DevicePanel* panel = window_->devicePanel();
+  EXPECT_FALSE(panel->openHapticsOffered());
+  EXPECT_TRUE(panel->openHapticsToolTip().contains("/nonexistent/libHD.so"))
+      << panel->openHapticsToolTip().toStdString();
+  EXPECT_FALSE(window_->useDevice(DeviceChoice::openhaptics));
+  EXPECT_TRUE(panel->statusText().contains("not available")) << panel->statusText().toStdString();
+  EXPECT_EQ(window_->device(), DeviceChoice::mouse);
+  EXPECT_EQ(panel->shownDevice(), DeviceChoice::mouse);
+  EXPECT_EQ(window_->servo(), nullptr);
+}
+
+TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
+  useSceneMillimetres();
+  openWindow();
+  // The probe's ball 3 mm into the top of the liver, held there.
+  const double ball_radius_mm = Tool{}.geometry.probe_tip_radius_m * 1e3;
+  const Eigen::Vector3d pressed = topOfTheMiddle_mm() + Eigen::Vector3d(0, 0, ball_radius_mm - 3);
+  const QString file = writeTrajectory(
+      {{0.0, pressed + Eigen::Vector3d(0, 0, 20), 0}, {0.5, pressed, 0}, {600.0, pressed, 0}});
+  window_->toolPanel()->setTool(ToolKind::probe);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file))
+      << window_->devicePanel()->statusText().toStdString();
+  ASSERT_NE(window_->servo(), nullptr);
+  EXPECT_TRUE(window_->devicePanel()->statusText().contains("trajectory.txt"));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().tool_force_n.norm() > 0.05; }, kTimeoutMs))
+      << "the scripted probe pressed nothing: " << snapshot().tool_force_n.transpose();
+  ASSERT_TRUE(snapshot().tool && snapshot().device_sample);
+  EXPECT_EQ(snapshot().tool->kind, ToolKind::probe);
+  EXPECT_LT((snapshot().tool->pose.origin_m - window_->hapticPreferences().mapping.scene_position_m(
+                                                  snapshot().device_sample->position_mm))
+                .norm(),
+            1e-12);
+  EXPECT_GT(snapshot().tool_force_n.z(), 0.0) << "the liver pushes the probe up";
+  EXPECT_TRUE(window_->toolPanel()->forceText().contains("Force on the tool"));
+  // The servo's figures reach the panel (the status timer, every half second).
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 200; }, kTimeoutMs));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->devicePanel()->servoText().contains(" Hz"); },
+                              kTimeoutMs))
+      << window_->devicePanel()->servoText().toStdString();
+  // The mouse again: the servo stops, the probe goes.
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  EXPECT_EQ(window_->servo(), nullptr);
+  EXPECT_TRUE(window_->devicePanel()->servoText().contains("not running"));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return !snapshot().tool.has_value(); }, kTimeoutMs));
+}
+
+TEST_F(DeviceTest, ABadTrajectoryFileIsNamedWithItsLineAndTheDeviceInUseStays) {
+  openWindow();
+  const QString file = folder_.filePath("broken.txt");
+  std::ofstream(file.toStdString()) << "0 0 0 0 0\n0.5 1 2 x 0\n";
+  EXPECT_FALSE(window_->useDevice(DeviceChoice::scripted, file));
+  const QString status = window_->devicePanel()->statusText();
+  EXPECT_TRUE(status.contains("broken.txt:2")) << status.toStdString();
+  EXPECT_TRUE(status.contains("'x' is not a number")) << status.toStdString();
+  EXPECT_EQ(window_->device(), DeviceChoice::mouse);
+  EXPECT_EQ(window_->servo(), nullptr);
+  EXPECT_FALSE(window_->useDevice(DeviceChoice::scripted, folder_.filePath("missing.txt")));
+  EXPECT_TRUE(window_->devicePanel()->statusText().contains("missing.txt"));
+}
+
+TEST_F(DeviceTest, CalibrationPutsTheStylusJustInFrontOfTheLiverAndIsRemembered) {
+  openWindow();
+  const Eigen::Vector3d stylus_mm(10.0, 20.0, 30.0);
+  const QString file = writeTrajectory({{0.0, stylus_mm, 0}, {600.0, stylus_mm, 0}});
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().device_sample.has_value(); }, kTimeoutMs));
+  CalibrationDialog* dialog = window_->openCalibration();
+  ASSERT_NE(dialog, nullptr);
+  dialog->alignWithView();
+  ASSERT_TRUE(dialog->centreHere());
+  auto* action = dialog->findChild<QComboBox*>("calibrationAction");
+  ASSERT_NE(action, nullptr);
+  action->setCurrentIndex(action->findData(2u));
+  dialog->accept();
+  const HapticPreferences& used = window_->hapticPreferences();
+  EXPECT_EQ(used.action_buttons, 2u);
+  // The stylus maps to a point outside the liver's box, within a few centimetres of it.
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < mesh_.rest_position_m.size(); ++n)
+    box.extend(mesh_.rest_position_m.at(n));
+  const Eigen::Vector3d at = used.mapping.scene_position_m(stylus_mm);
+  EXPECT_FALSE(box.contains(at)) << at.transpose();
+  EXPECT_LT(box.exteriorDistance(at), 0.03) << at.transpose();
+  // The servo runs with the new mapping, and the settings keep it.
+  ASSERT_NE(window_->servo(), nullptr);
+  EXPECT_LT((window_->servo()->mapping().offset_m - used.mapping.offset_m).norm(), 1e-12);
+  QSettings settings;
+  const HapticPreferences kept = load_haptic_preferences(settings);
+  ASSERT_TRUE(kept.mapping_set);
+  EXPECT_LT((kept.mapping.scene_position_m(stylus_mm) - at).norm(), 1e-9);
+  EXPECT_EQ(kept.action_buttons, 2u);
+  EXPECT_EQ(kept.device, DeviceChoice::scripted);
+}
+
+#ifdef LIVERSIM_FAKE_HD_LIBRARY
+// The fake runtime's test hooks (fake_hd.cpp), looked up in the loaded library.
+template <class Function>
+Function fakeHook(const char* name) {
+  void* library = dlopen(LIVERSIM_FAKE_HD_LIBRARY, RTLD_NOW | RTLD_NOLOAD);
+  if (library == nullptr) return nullptr;
+  auto function = reinterpret_cast<Function>(dlsym(library, name));
+  dlclose(library);  // still loaded: the driver never unloads it
+  return function;
+}
+
+TEST_F(DeviceTest, TheOmniIsOfferedWhenItOpensAndAFatalFaultHandsTheToolBackToTheMouse) {
+  qputenv("LIVERSIM_OPENHAPTICS_LIBRARY", LIVERSIM_FAKE_HD_LIBRARY);
+  openWindow();
+  DevicePanel* panel = window_->devicePanel();
+  ASSERT_TRUE(panel->openHapticsOffered()) << panel->openHapticsToolTip().toStdString();
+  window_->toolPanel()->setTool(ToolKind::probe);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::openhaptics)) << panel->statusText().toStdString();
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 200; }, kTimeoutMs));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().tool.has_value(); }, kTimeoutMs))
+      << "the Omni's stylus moves no tool";
+  // Unplugged: HD_COMM_ERROR is fatal.
+  auto inject = fakeHook<void (*)(unsigned, int)>("fake_hd_inject_error");
+  auto last_force = fakeHook<void (*)(double*)>("fake_hd_last_force");
+  ASSERT_TRUE(inject && last_force);
+  inject(0x0302, 0);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->device() == DeviceChoice::mouse; }, kTimeoutMs))
+      << "the workstation did not notice the fault";
+  EXPECT_TRUE(panel->statusText().contains("stopped")) << panel->statusText().toStdString();
+  EXPECT_TRUE(panel->statusText().contains("mouse")) << panel->statusText().toStdString();
+  EXPECT_FALSE(panel->openHapticsOffered());
+  EXPECT_EQ(window_->servo(), nullptr);
+  double force_n[3];
+  last_force(force_n);
+  EXPECT_EQ(Eigen::Vector3d(force_n[0], force_n[1], force_n[2]), Eigen::Vector3d::Zero());
+  // Plugged in again: choosing it opens it anew.
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::openhaptics)) << panel->statusText().toStdString();
+  EXPECT_TRUE(panel->openHapticsOffered());
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 200; }, kTimeoutMs));
+  EXPECT_TRUE(window_->servo()->device_fault().empty());
+}
+#endif
+
+}  // namespace
+}  // namespace liversim

@@ -1,0 +1,118 @@
+#include "device_panel.h"
+
+#include <QComboBox>
+#include <QLabel>
+#include <QPushButton>
+#include <QVBoxLayout>
+
+namespace liversim {
+
+DevicePanel::DevicePanel(QWidget* parent) : QWidget(parent) {
+  auto* layout = new QVBoxLayout(this);
+  devices_ = new QComboBox(this);
+  devices_->setObjectName("deviceChoice");
+  devices_->addItem(tr("Mouse and keyboard"), static_cast<int>(DeviceChoice::mouse));
+  devices_->addItem(tr("Phantom Omni (OpenHaptics)"), static_cast<int>(DeviceChoice::openhaptics));
+  devices_->addItem(tr("Scripted trajectory…"), static_cast<int>(DeviceChoice::scripted));
+  devices_->setItemData(0, tr("Move the tool with the mouse in the viewport"), Qt::ToolTipRole);
+  devices_->setItemData(2,
+                        tr("Play a trajectory file (time s, x y z mm, buttons per line) on the "
+                           "tool"),
+                        Qt::ToolTipRole);
+  layout->addWidget(devices_);
+  status_ = new QLabel(this);
+  status_->setObjectName("deviceStatus");
+  status_->setWordWrap(true);
+  layout->addWidget(status_);
+  calibrate_ = new QPushButton(tr("&Calibrate…"), this);
+  calibrate_->setObjectName("deviceCalibrate");
+  layout->addWidget(calibrate_);
+  servo_ = new QLabel(this);
+  servo_->setObjectName("servoStats");
+  servo_->setWordWrap(true);
+  servo_->setToolTip(
+      tr("The haptic servo loop: tick rate, tick periods (median and 99th "
+         "percentile), late ticks, and the safety limits it applied"));
+  layout->addWidget(servo_);
+  layout->addStretch(1);
+  showServoStats(nullptr);
+  setCalibrationAvailable(false);
+  connect(devices_, &QComboBox::activated, this, [this](int index) {
+    emit deviceChosen(static_cast<DeviceChoice>(devices_->itemData(index).toInt()));
+  });
+  connect(calibrate_, &QPushButton::clicked, this, &DevicePanel::calibrateRequested);
+}
+
+void DevicePanel::showDevice(DeviceChoice device) {
+  devices_->setCurrentIndex(devices_->findData(static_cast<int>(device)));
+}
+
+DeviceChoice DevicePanel::shownDevice() const {
+  return static_cast<DeviceChoice>(devices_->currentData().toInt());
+}
+
+void DevicePanel::setOpenHapticsProblem(const QString& problem) {
+  // Still offered when missing: choosing it looks again (a device plugged in since).
+  const int index = devices_->findData(static_cast<int>(DeviceChoice::openhaptics));
+  omniProblem_ = problem;
+  devices_->setItemText(index, problem.isEmpty() ? tr("Phantom Omni (OpenHaptics)")
+                                                 : tr("Phantom Omni (OpenHaptics): not found"));
+  devices_->setItemData(index,
+                        problem.isEmpty() ? tr("The Phantom Omni found through OpenHaptics")
+                                          : tr("Not available: %1. Choose it again to look "
+                                               "again.")
+                                                .arg(problem),
+                        Qt::ToolTipRole);
+}
+
+bool DevicePanel::openHapticsOffered() const {
+  return omniProblem_.isEmpty();
+}
+
+QString DevicePanel::openHapticsToolTip() const {
+  return devices_
+      ->itemData(devices_->findData(static_cast<int>(DeviceChoice::openhaptics)), Qt::ToolTipRole)
+      .toString();
+}
+
+void DevicePanel::setCalibrationAvailable(bool available) {
+  calibrate_->setEnabled(available);
+  calibrate_->setToolTip(available ? tr("Map the device's workspace onto the scene and choose its "
+                                        "buttons")
+                                   : tr("Choose a device first: the mouse needs no calibration"));
+}
+
+void DevicePanel::showStatus(const QString& text, bool problem) {
+  status_->setText(text);
+  status_->setStyleSheet(problem ? QStringLiteral("color: #b00020") : QString());
+}
+
+QString DevicePanel::statusText() const {
+  return status_->text();
+}
+
+QString DevicePanel::servoSummary(const ServoStats& stats) {
+  if (stats.ticks < 2) return tr("Servo: starting");
+  return tr("Servo: %1 Hz · period %2 ms median, %3 ms p99 · %4 late · clamped: stiffness %5, "
+            "force %6, rate %7 · watchdog %8 · device faults %9")
+      .arg(stats.rate_hz(), 0, 'f', 0)
+      .arg(stats.period_percentile_s(0.5) * 1e3, 0, 'f', 2)
+      .arg(stats.period_percentile_s(0.99) * 1e3, 0, 'f', 2)
+      .arg(stats.missed_deadlines)
+      .arg(stats.stiffness_clamps)
+      .arg(stats.force_clamps)
+      .arg(stats.rate_limited)
+      .arg(stats.watchdog_trips)
+      .arg(stats.device_faults);
+}
+
+void DevicePanel::showServoStats(const ServoStats* stats) {
+  servo_->setText(stats ? servoSummary(*stats)
+                        : tr("Servo: not running (the mouse moves the tool)"));
+}
+
+QString DevicePanel::servoText() const {
+  return servo_->text();
+}
+
+}  // namespace liversim

@@ -1,0 +1,31 @@
+#pragma once
+// The haptic device the workstation uses and how it is mapped, kept in the user's settings
+// (QSettings, group "haptics") so that a trainee's calibration survives a restart.
+
+#include "liversim/core/haptics.h"
+
+#include <QString>
+
+#include <cstdint>
+
+class QSettings;
+
+namespace liversim {
+
+enum class DeviceChoice { mouse, openhaptics, scripted };
+
+struct HapticPreferences {
+  DeviceChoice device = DeviceChoice::mouse;
+  QString trajectory_file;  // the scripted device's
+  // Set once calibrated (or saved); until then the mapping is made from the view on first use.
+  bool mapping_set = false;
+  WorkspaceMapping mapping;
+  std::uint32_t action_buttons = 1;  // device buttons that grasp or cut (bit mask)
+};
+
+// What is stored; a value that is missing, unreadable or out of range gives the default, so a
+// damaged settings file never stops the workstation.
+HapticPreferences load_haptic_preferences(QSettings& settings);
+void save_haptic_preferences(QSettings& settings, const HapticPreferences& preferences);
+
+}  // namespace liversim
