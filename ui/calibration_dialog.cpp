@@ -9,8 +9,7 @@
 #include <QPushButton>
 #include <QTimer>
 
-#include <cmath>
-#include <numbers>
+#include <algorithm>
 
 namespace liversim {
 
@@ -95,9 +94,9 @@ CalibrationDialog::CalibrationDialog(const HapticPreferences& preferences, Conte
 
   showRotation();
   showDevicePosition();
-  timer_ = new QTimer(this);
-  connect(timer_, &QTimer::timeout, this, &CalibrationDialog::showDevicePosition);
-  timer_->start(50);
+  auto* timer = new QTimer(this);
+  connect(timer, &QTimer::timeout, this, &CalibrationDialog::showDevicePosition);
+  timer->start(50);
 }
 
 WorkspaceMapping CalibrationDialog::mapping() const {

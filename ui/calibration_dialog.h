@@ -17,7 +17,6 @@
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
-class QTimer;
 
 namespace liversim {
 
@@ -55,7 +54,6 @@ class CalibrationDialog : public QDialog {
   QLabel* position_ = nullptr;
   QLabel* message_ = nullptr;
   QComboBox* action_ = nullptr;
-  QTimer* timer_ = nullptr;
 };
 
 }  // namespace liversim

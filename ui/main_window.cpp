@@ -25,7 +25,6 @@
 #include <QStatusBar>
 
 #include <cmath>
-#include <cstdlib>
 #include <exception>
 #include <numbers>
 #include <string_view>

@@ -208,7 +208,7 @@ class RealtimeSimulation {
   std::optional<DeviceToolSettings> pending_device_tool_;  // under springs_mutex_
   bool device_tool_changed_ = false;
   std::optional<DeviceToolSettings> device_tool_;  // simulation thread's copy
-  std::optional<DeviceSample> device_sample_;      // the frame the device's tool followed
+  std::optional<DeviceSample> device_sample_;      // the servo's newest frame
   ServoLoop* haptic_servo_ = nullptr;
   std::optional<ToolInteraction> tools_;  // simulation thread only once started
   std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tool's
