@@ -224,11 +224,11 @@ std::string table1_markdown(const std::vector<Table1Row>& rows, double simulated
        << format(rk4.real_time_factor(settings)) << " | " << rk4.steps.substeps << " | ";
     if (row.seed)
       md << number(row.seed->seed_deform_ms) << " | " << number(row.seed->conical_spring_deform_ms)
-         << " | " << number(row.seed->implicit_fem_deform_ms) << " | not built yet (issue 7) | "
+         << " | " << number(row.seed->implicit_fem_deform_ms) << " | see cutting-performance.md | "
          << number(row.seed->seed_cut_ms) << " | " << number(row.seed->conical_spring_cut_ms)
          << " | " << number(row.seed->implicit_fem_cut_ms) << " |\n";
     else
-      md << "- | - | - | not built yet (issue 7) | - | - | - |\n";
+      md << "- | - | - | see cutting-performance.md | - | - | - |\n";
   }
   return md.str();
 }
@@ -531,7 +531,9 @@ int run_bench(const BenchOptions& o) {
      << effect_off.str()
      << "\nGravity, lesions, cutting and haptics are not effects of the force loops: the engine "
         "has no gravity yet; a lesion is only other per-element moduli (the same arrays, no "
-        "branch); cutting (issue 7) and the haptic force path (issue 8) are not built yet.\n"
+        "branch); a cut changes the mesh and rebuilds the model (its cost: "
+        "cutting-performance.md), "
+        "and the haptic force path runs on the servo thread, outside the force loops.\n"
      << "\n## Memory (bytes per tetrahedron, " << o.tet_counts.back()
      << "-tet target size)\n\nHeap arrays of the model and of a central-difference state "
         "(`model_bytes`, `state_bytes`).\n\n"
@@ -562,7 +564,8 @@ int run_bench(const BenchOptions& o) {
         "simulated time over wall time (≥ 1: faster than real time). Seed columns: the seed's "
         "Table 1 (its unit is not stated and is read as ms; its \"deformation time\" is not "
         "defined; i7-10700); [3] conical-spring model, [14] FEM with optimised implicit Euler. "
-        "Our cutting column: cutting is not built yet (issue 7). Sizes that are not the seed's "
+        "Our cutting column: the cost of a cut update is measured by `liversim-cli bench-cut` "
+        "(docs/cutting-performance.md). Sizes that are not the seed's "
         "have no seed figures (-). The same measurement with more detail: `liversim-cli "
         "experiment timing` (docs/seed-experiments.md).\n"
      << "\n## Workstation peak resident memory\n\n"

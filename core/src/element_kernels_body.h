@@ -227,13 +227,21 @@ void element_forces(const ElasticKernelData& data, std::size_t begin, std::size_
   seen.max_fibre_modulus_pa = max_fibre;
 }
 
+// J = det F = det Ds / det Dm, det Dm = 6 V: the deformed volume over the rest volume, without
+// forming F (half the arithmetic of the loop that does).
 void volume_ratios(const ElasticKernelData& data, std::size_t begin, std::size_t end) {
   const ElasticKernelData d = data;
 #pragma omp simd
   for (std::size_t e = begin; e < end; ++e) {
-    const Matrix3 F = deformation_gradient(d, e);
-    const Matrix3 cof = cofactor(F);
-    d.volume_ratio[e] = F.m[0][0] * cof.m[0][0] + F.m[1][0] * cof.m[1][0] + F.m[2][0] * cof.m[2][0];
+    const std::int32_t n0 = d.corner[0][e], n1 = d.corner[1][e], n2 = d.corner[2][e],
+                       n3 = d.corner[3][e];
+    const double x0 = d.x[n0], y0 = d.y[n0], z0 = d.z[n0];
+    const double ax = d.x[n1] - x0, ay = d.y[n1] - y0, az = d.z[n1] - z0;
+    const double bx = d.x[n2] - x0, by = d.y[n2] - y0, bz = d.z[n2] - z0;
+    const double cx = d.x[n3] - x0, cy = d.y[n3] - y0, cz = d.z[n3] - z0;
+    const double six_volume =
+        ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx);
+    d.volume_ratio[e] = six_volume / (6.0 * d.rest_volume_m3[e]);
   }
 }
 
@@ -249,6 +257,8 @@ struct ViscousBlock {
   alignas(32) double elastic_stress[6][kViscousBlock];       // S_e(Fe), Voigt
   alignas(32) double arm[6][kViscousBlock];                  // H after the step, Voigt
   alignas(32) double stress[9][kViscousBlock];               // P, row-major entries
+  alignas(32) double flagged[kViscousBlock];                 // 1: left to the general update
+  alignas(32) double dashpot_work_j[kViscousBlock];          // 0 where flagged
 };
 
 inline Matrix3 load_matrix(const double (&m)[9][kViscousBlock], std::size_t i) {
@@ -323,10 +333,8 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
   min_j_out = min_j;
   max_j_out = max_j;
 
-  // S = g0·S_e + g1·H; the yield check on τ = Fe·S·Feᵀ; P = Fe·S·Fp⁻ᵀ; the dashpots' work; the
-  // commit.
-  double dissipated = dissipated_out;
-#pragma omp simd reduction(+ : dissipated)
+  // S = g0·S_e + g1·H; the yield check on τ = Fe·S·Feᵀ; P = Fe·S·Fp⁻ᵀ.
+#pragma omp simd
   for (std::size_t i = 0; i < count; ++i) {
     const Matrix3 fe = load_matrix(b.elastic_deformation, i);
     const double g0 = constant(v.relaxed_fraction, i), g1 = constant(v.arm_fraction, i);
@@ -354,8 +362,9 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
     const double J = fe.m[0][0] * (fe.m[1][1] * fe.m[2][2] - fe.m[2][1] * fe.m[1][2]) +
                      fe.m[1][0] * (fe.m[2][1] * fe.m[0][2] - fe.m[0][1] * fe.m[2][2]) +
                      fe.m[2][0] * (fe.m[0][1] * fe.m[1][2] - fe.m[1][1] * fe.m[0][2]);
-    const bool general = !(J >= kMinVolumeRatio) || 1.5 * deviator_sq > yield * yield;
+    const bool general = !(J >= kMinVolumeRatio) | (1.5 * deviator_sq > yield * yield);
     v.needs_general[block + i] = general ? 1 : 0;
+    b.flagged[i] = general ? 1.0 : 0.0;
     // (Fp⁻ᵀ)[k][j] = Fp⁻¹[j][k], stored in component 12 + j + 3k.
 #pragma GCC unroll 3
     for (int a = 0; a < 3; ++a)
@@ -364,8 +373,14 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
         b.stress[3 * a + j][i] = feS[a][0] * history[(12 + j) * kViscousBlock + i] +
                                  feS[a][1] * history[(15 + j) * kViscousBlock + i] +
                                  feS[a][2] * history[(18 + j) * kViscousBlock + i];
-    // The dashpots' work over the step: V·Δt/τ·(ψ(H before) + ψ(H)) (trapezoid of 2ψ/τ), with
-    // ψ = a·(H:H − b·(tr H)²).
+  }
+
+  // The dashpots' work over the step: V·Δt/τ·(ψ(H before) + ψ(H)) (trapezoid of 2ψ/τ), with
+  // ψ = a·(H:H − b·(tr H)²); the commit (a flagged element keeps what it had for the general
+  // update). A loop of its own: one loop with the stress held more values than there are registers.
+#pragma omp simd
+  for (std::size_t i = 0; i < count; ++i) {
+    const bool general = b.flagged[i] != 0.0;
     double trace_before = 0.0, trace_after = 0.0, contraction_before = 0.0, contraction_after = 0.0;
 #pragma GCC unroll 6
     for (int k = 0; k < 6; ++k) {
@@ -381,8 +396,7 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
                         constant(v.arm_energy_scale, i) *
                         (contraction_before - b_vol * trace_before * trace_before +
                          contraction_after - b_vol * trace_after * trace_after);
-    dissipated += general ? 0.0 : work;
-    // Commit; a flagged element keeps what it had for the general update.
+    b.dashpot_work_j[i] = general ? 0.0 : work;
 #pragma GCC unroll 6
     for (int k = 0; k < 6; ++k) {
       double& arm = history[k * kViscousBlock + i];
@@ -391,6 +405,10 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
       elastic = general ? elastic : b.elastic_stress[k][i];
     }
   }
+  // Summed in element order after the loop: GCC 12 leaves this loop scalar when it carries a
+  // simd reduction (measured), and the order makes the sum the same on every run.
+  double dissipated = dissipated_out;
+  for (std::size_t i = 0; i < count; ++i) dissipated += b.dashpot_work_j[i];
   dissipated_out = dissipated;
 }
 
