@@ -5,6 +5,7 @@
 #include "liversim/core/integrator.h"
 #include "liversim/core/mesh_io.h"
 #include "liversim/core/mesh_quality.h"
+#include "liversim/core/scenario.h"
 #include "liversim/core/state.h"
 #include "liversim/core/surface.h"
 #include "liversim/core/viscous_tissue.h"
@@ -98,6 +99,18 @@ ExperimentScene build_scene(int tet_count, const IntegratorSettings& integrator,
 namespace {
 
 SceneSetup load_scene(const MeshSource& source) {
+  if (source.scenario) {
+    if (source.file || source.fixed_set)
+      throw std::invalid_argument(
+          "--scenario names its own organ: leave out --mesh and --fixed-set");
+    const ScenarioReading reading = read_scenario_file(*source.scenario);
+    if (!reading.scenario) {
+      std::string message = source.scenario->string() + " is not a valid scenario:";
+      for (const ScenarioError& error : reading.errors) message += "\n  " + error.text();
+      throw std::invalid_argument(message);
+    }
+    return build_scene(*reading.scenario, source.scenario->parent_path());
+  }
   if (source.file) return scene_from_file(*source.file, source.fixed_set);
   if (source.fixed_set) throw std::invalid_argument("--fixed-set needs --mesh");
   return default_scene(source.tet_count);
@@ -166,12 +179,31 @@ int mesh_report(const MeshSource& mesh) {
   });
 }
 
+int validate_scenarios(const std::vector<std::filesystem::path>& files) {
+  int invalid = 0;
+  for (const auto& file : files) {
+    const ScenarioReading reading = read_scenario_file(file);
+    if (reading.scenario) {
+      std::cout << file.string() << ": valid: \"" << reading.scenario->title
+                << "\" (format version " << reading.file_version
+                << (reading.file_version < kScenarioFormatVersion ? ", migrated" : "") << ")\n";
+      continue;
+    }
+    ++invalid;
+    for (const ScenarioError& error : reading.errors)
+      std::cout << file.string() << ": " << error.text() << "\n";
+  }
+  return invalid == 0 ? 0 : 1;
+}
+
 int simulate(const SimulateOptions& options) {
   return guarded([&]() -> int {
     if (!options.force_n.allFinite()) return fail("--force must be three finite numbers");
-    const IntegratorSettings integrator = integrator_settings(options.integrator, options.dt_s);
     SceneSetup scene = load_scene(options.mesh);
-    scene.model_options.integrator = integrator;
+    // A scenario brings its integrator; the options override it only when given.
+    if (!options.mesh.scenario || options.integrator || options.dt_s != 0.0)
+      scene.model_options.integrator =
+          integrator_settings(options.integrator.value_or("central-difference"), options.dt_s);
     const SimModel model = build_model(scene.mesh, scene.model_options);
     const NodeIndex node = options.node.value_or(anterior_marked_node(scene.mesh));
     if (node < 0 || static_cast<std::size_t>(node) >= model.node_count)

@@ -15,14 +15,16 @@
 namespace liversim::cli {
 
 struct MeshSource {
-  int tet_count = 5406;                       // built-in liver at this element count
-  std::optional<std::filesystem::path> file;  // or a .inp / .msh file
-  std::optional<std::string> fixed_set;       // node set of `file` held fixed
+  int tet_count = 5406;                           // built-in liver at this element count
+  std::optional<std::filesystem::path> file;      // or a .inp / .msh file
+  std::optional<std::string> fixed_set;           // node set of `file` held fixed
+  std::optional<std::filesystem::path> scenario;  // or a scenario file (organ, tissue, lesions)
 };
 
 struct SimulateOptions {
   MeshSource mesh;
-  std::string integrator = "central-difference";  // a name of integrator_from_name
+  // A name of integrator_from_name; unset: the scenario's, else central difference.
+  std::optional<std::string> integrator;
   double dt_s = 0.0;  // requested integrator step; 0: the stable step (explicit schemes only)
   double duration_s = 1.0;
   std::optional<int> node;  // default: a point on the anterior surface of the right lobe
@@ -68,6 +70,9 @@ struct ScreenshotOptions {
 
 int mesh_report(const MeshSource& mesh);
 int simulate(const SimulateOptions& options);
+// Reads and checks scenario files; prints each error as "FILE: field.path: message". Exit status 0
+// when every file is valid, 1 otherwise.
+int validate_scenarios(const std::vector<std::filesystem::path>& files);
 int screenshot(const ScreenshotOptions& options);
 int material_test(const MaterialTestOptions& options);
 // Reports a problem on stderr as "liversim-cli: error: <message>" and returns exit code 2.

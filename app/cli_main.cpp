@@ -19,6 +19,10 @@ void add_mesh_options(CLI::App& command, liversim::cli::MeshSource& mesh) {
   command.add_option("--mesh", mesh.file, "Tetrahedral mesh file (.inp or .msh) instead")
       ->check(CLI::ExistingFile);
   command.add_option("--fixed-set", mesh.fixed_set, "Node set of --mesh to hold fixed");
+  command
+      .add_option("--scenario", mesh.scenario,
+                  "Scenario file (scenarios/*.json): its organ, tissue, lesions and integrator")
+      ->check(CLI::ExistingFile);
 }
 
 }  // namespace
@@ -34,6 +38,13 @@ int main(int argc, char** argv) {
   MeshSource report_mesh;
   auto* report = app.add_subcommand("mesh-report", "Print the quality report of a mesh");
   add_mesh_options(*report, report_mesh);
+
+  std::vector<std::filesystem::path> scenario_files;
+  auto* validate_cmd = app.add_subcommand(
+      "validate",
+      "Check scenario files; print each error with the field's path, its value and what is "
+      "expected (exit status 1 when any file is invalid)");
+  validate_cmd->add_option("files", scenario_files, "Scenario files (.json)")->required();
 
   SimulateOptions sim;
   std::vector<double> force;
@@ -52,10 +63,9 @@ int main(int argc, char** argv) {
                    "Spread the load over surface nodes within this radius (m)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  simulate_cmd
-      ->add_option("--integrator", sim.integrator,
-                   "central-difference, rk4, dopri5, backward-euler or bdf2")
-      ->capture_default_str();
+  simulate_cmd->add_option("--integrator", sim.integrator,
+                           "central-difference, rk4, dopri5, backward-euler or bdf2 (default: the "
+                           "scenario's, else central-difference)");
   simulate_cmd
       ->add_option("--dt", sim.dt_s,
                    "Requested integrator step (s; 0: the stable step, explicit schemes only)")
@@ -151,6 +161,7 @@ int main(int argc, char** argv) {
   if (auto exit_code = run_cut_bench()) return *exit_code;
   if (report->parsed()) return mesh_report(report_mesh);
   if (simulate_cmd->parsed()) return simulate(sim);
+  if (validate_cmd->parsed()) return validate_scenarios(scenario_files);
   if (screenshot_cmd->parsed()) return screenshot(shot);
   if (material_cmd->parsed()) {
     material.test = material_tests.at(material_test_name);

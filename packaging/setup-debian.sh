@@ -9,7 +9,7 @@ packages=(
   libqt6sql6-sqlite libgl-dev libgl1-mesa-dri
   libvtk9-dev libeigen3-dev libassimp-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev nlohmann-json3-dev
+  libcli11-dev nlohmann-json3-dev python3 python3-jsonschema
   xvfb xauth
 )
 

@@ -1,0 +1,374 @@
+// Scenario files: every field survives a save and a load, the shipped scenarios build, and each
+// file of the malformed corpus is refused with its own error naming the field.
+#include "liversim/core/model.h"
+#include "liversim/core/scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+
+namespace liversim {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kShippedDir = fs::path(LIVERSIM_TEST_DATA_DIR) / ".." / ".." / "scenarios";
+const fs::path kCorpusDir = fs::path(LIVERSIM_TEST_DATA_DIR) / "scenarios";
+
+// A valid scenario whose every field differs from its default.
+Scenario every_field_set() {
+  Scenario s;
+  s.title = "All fields";
+  s.description = "Every field away from its default";
+  s.organ.target_tet_count = 3841;
+  s.organ.fix_ligament = false;
+  s.organ.fixed_balls = {{{-60.0, 20.0, -30.0}, 15.0}, {{10.0, 0.0, -35.0}, 8.5}};
+  s.parenchyma.elastic = TissueMaterial{4000.0, 0.48, 1055.0, 0.0};
+  s.parenchyma.viscoelastic = ViscoelasticParameters{2500.0, 1500.0, 3000.0};
+  s.parenchyma.viscoplastic = ViscoplasticParameters{60.0, 5000.0, 0.6};
+  s.parenchyma.fibres = FibreSpec{1200.0, 3.0, {0.0, 0.6, 0.8}};
+  LesionSpec lesion;
+  lesion.name = "tumour";
+  lesion.centre_mm = {-45.0, 5.0, 30.0};
+  lesion.radii_mm = {10.0, 12.5, 9.0};
+  lesion.youngs_modulus_pa = 20000.0;
+  lesion.yield_limit_pa = 400.0;
+  lesion.viscosity_pa_s = 9000.0;
+  lesion.hidden = true;
+  s.lesions = {lesion};
+  s.effects = {false, true, true, true};
+  s.integrator.kind = IntegratorKind::backward_euler;
+  s.integrator.step_s = 0.002;
+  s.integrator.tolerance_m = 2e-6;
+  s.tools = {ToolKind::scalpel, ToolKind::forceps};
+  s.task.kind = TaskKind::resect_lesion;
+  s.task.instructions = "Cut it out";
+  s.task.time_limit_s = 450.0;
+  s.task.lesion = "tumour";
+  s.task.margin_mm = 12.0;
+  s.task.planned_plane = PlaneSpec{{-45.0, 5.0, 5.0}, {0.0, 0.0, 1.0}};
+  s.rubric = {{"lesion_breached", 3.0, PassRule::at_most, 0.0},
+              {"lesion_margin_mm", 2.0, PassRule::at_least, 10.0}};
+  return s;
+}
+
+Scenario round_trip(const Scenario& s) {
+  const ScenarioReading reading = read_scenario(write_scenario(s));
+  for (const ScenarioError& e : reading.errors) ADD_FAILURE() << e.text();
+  return reading.scenario.value_or(Scenario{});
+}
+
+TEST(ScenarioFile, EveryFieldSurvivesASaveAndALoad) {
+  const Scenario full = every_field_set();
+  EXPECT_TRUE(validate(full).empty());
+  EXPECT_EQ(round_trip(full), full);
+
+  // Each field changed alone is written and read back: it is not lost in either direction.
+  const std::vector<std::pair<const char*, std::function<void(Scenario&)>>> changes = {
+      {"title", [](Scenario& s) { s.title = "Other"; }},
+      {"description", [](Scenario& s) { s.description = "Other text, with \"quotes\" and é"; }},
+      {"organ.target_tet_count", [](Scenario& s) { s.organ.target_tet_count = 7312; }},
+      {"organ.fix_ligament", [](Scenario& s) { s.organ.fix_ligament = true; }},
+      {"organ.fixed_balls", [](Scenario& s) { s.organ.fixed_balls[1].radius_mm = 9.25; }},
+      {"parenchyma.youngs_modulus_pa",
+       [](Scenario& s) {
+         s.parenchyma.elastic.youngs_modulus_pa = 4500.0;
+         s.parenchyma.viscoelastic->e1_pa = 3000.0;
+       }},
+      {"parenchyma.poisson_ratio", [](Scenario& s) { s.parenchyma.elastic.poisson_ratio = 0.45; }},
+      {"parenchyma.density", [](Scenario& s) { s.parenchyma.elastic.density_kg_per_m3 = 1070.0; }},
+      {"parenchyma.viscoelastic.eta1",
+       [](Scenario& s) { s.parenchyma.viscoelastic->eta1_pa_s = 10.5e3; }},
+      {"parenchyma.viscoplastic.yield",
+       [](Scenario& s) { s.parenchyma.viscoplastic->yield_limit_pa = 33.3; }},
+      {"parenchyma.viscoplastic.eta2",
+       [](Scenario& s) { s.parenchyma.viscoplastic->eta2_pa_s_pow_n = 7e4; }},
+      {"parenchyma.viscoplastic.n",
+       [](Scenario& s) { s.parenchyma.viscoplastic->creep_index_n = 1.0; }},
+      {"parenchyma.fibres.k1", [](Scenario& s) { s.parenchyma.fibres->k1_pa = 800.0; }},
+      {"parenchyma.fibres.k2", [](Scenario& s) { s.parenchyma.fibres->k2 = 0.7; }},
+      {"parenchyma.fibres.direction",
+       [](Scenario& s) {
+         s.parenchyma.fibres->direction = {1.0, 0.0, 0.0};
+       }},
+      {"lesions[0].centre_mm", [](Scenario& s) { s.lesions[0].centre_mm[2] = 25.0; }},
+      {"lesions[0].radii_mm", [](Scenario& s) { s.lesions[0].radii_mm[1] = 7.0; }},
+      {"lesions[0].youngs_modulus_pa",
+       [](Scenario& s) { s.lesions[0].youngs_modulus_pa = 8000.0; }},
+      {"lesions[0].yield_limit_pa", [](Scenario& s) { s.lesions[0].yield_limit_pa.reset(); }},
+      {"lesions[0].viscosity_pa_s", [](Scenario& s) { s.lesions[0].viscosity_pa_s.reset(); }},
+      {"lesions[0].hidden", [](Scenario& s) { s.lesions[0].hidden = false; }},
+      {"effects.near_incompressibility",
+       [](Scenario& s) { s.effects.near_incompressibility = true; }},
+      {"effects.fibres", [](Scenario& s) { s.effects.fibres = false; }},
+      {"effects.viscoplastic", [](Scenario& s) { s.effects.viscoplastic = false; }},
+      {"integrator.kind", [](Scenario& s) { s.integrator.kind = IntegratorKind::bdf2; }},
+      {"integrator.step_s", [](Scenario& s) { s.integrator.step_s = 0.001; }},
+      {"integrator.tolerance_m", [](Scenario& s) { s.integrator.tolerance_m = 1e-7; }},
+      {"tools", [](Scenario& s) { s.tools.push_back(ToolKind::probe); }},
+      {"task.instructions", [](Scenario& s) { s.task.instructions.clear(); }},
+      {"task.time_limit_s", [](Scenario& s) { s.task.time_limit_s = 60.0; }},
+      {"task.margin_mm", [](Scenario& s) { s.task.margin_mm = 0.0; }},
+      {"task.planned_plane", [](Scenario& s) { s.task.planned_plane.reset(); }},
+      {"rubric[1].threshold", [](Scenario& s) { s.rubric[1].threshold = 5.5; }},
+      {"rubric[0].rule", [](Scenario& s) { s.rubric[0].rule = PassRule::at_least; }},
+      {"rubric[0].weight", [](Scenario& s) { s.rubric[0].weight = 0.25; }},
+      {"rubric[0].metric", [](Scenario& s) { s.rubric[0].metric = "task_success"; }},
+  };
+  for (const auto& [field, change] : changes) {
+    Scenario changed = full;
+    change(changed);
+    ASSERT_FALSE(changed == full) << field << ": the change changed nothing";
+    EXPECT_EQ(round_trip(changed), changed) << field;
+  }
+
+  // The other task kinds keep their own fields.
+  Scenario retract = full;
+  retract.task = TaskSpec{};
+  retract.task.kind = TaskKind::retract_lobe;
+  retract.task.grasp_point_mm = {100.0, 0.0, 20.0};
+  retract.task.lift_mm = 42.0;
+  retract.tools = {ToolKind::forceps};
+  EXPECT_EQ(round_trip(retract), retract);
+  Scenario mesh_file = full;
+  mesh_file.organ = OrganSpec{};
+  mesh_file.organ.geometry = OrganGeometry::tet_mesh_file;
+  mesh_file.organ.file = "meshes/liver.inp";
+  mesh_file.organ.fixed_node_set = "FixT&P";
+  mesh_file.lesions.clear();
+  mesh_file.task = retract.task;
+  mesh_file.tools = {ToolKind::forceps};
+  EXPECT_EQ(round_trip(mesh_file), mesh_file);
+}
+
+TEST(ScenarioFile, WritingReplacesTheFileWholeAndNamesAFolderThatIsMissing) {
+  const fs::path file = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "written-scenario.json";
+  const Scenario full = every_field_set();
+  write_scenario_file(full, file);
+  const ScenarioReading reading = read_scenario_file(file);
+  ASSERT_TRUE(reading.scenario.has_value());
+  EXPECT_EQ(*reading.scenario, full);
+  EXPECT_FALSE(fs::exists(fs::path(file) += ".saving"));
+
+  const fs::path nowhere = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "no-such-folder" / "s.json";
+  try {
+    write_scenario_file(full, nowhere);
+    FAIL() << "writing into a missing folder succeeded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no-such-folder"), std::string::npos) << e.what();
+  }
+  const ScenarioReading missing = read_scenario_file(nowhere);
+  ASSERT_EQ(missing.errors.size(), 1u);
+  EXPECT_NE(missing.errors[0].message.find("no such file"), std::string::npos);
+}
+
+TEST(ScenarioFile, VersionsNewerThanThisBuildAreRefusedAndTheCurrentOneIsRead) {
+  std::string text = write_scenario(every_field_set());
+  const ScenarioReading current = read_scenario(text);
+  EXPECT_TRUE(current.scenario.has_value());
+  EXPECT_EQ(current.file_version, kScenarioFormatVersion);
+
+  const std::string version = "\"version\": " + std::to_string(kScenarioFormatVersion);
+  const auto at = text.find(version);
+  ASSERT_NE(at, std::string::npos);
+  std::string newer = text;
+  newer.replace(at, version.size(), "\"version\": " + std::to_string(kScenarioFormatVersion + 1));
+  const ScenarioReading refused = read_scenario(newer);
+  EXPECT_FALSE(refused.scenario.has_value());
+  ASSERT_EQ(refused.errors.size(), 1u);
+  EXPECT_EQ(refused.errors[0].path, "version");
+  EXPECT_NE(refused.errors[0].message.find("newer than this LiverSim reads"), std::string::npos);
+
+  std::string zero = text;
+  zero.replace(at, version.size(), "\"version\": 0");
+  EXPECT_FALSE(read_scenario(zero).scenario.has_value());
+}
+
+// Each malformed file and the error it must produce (its field path and a part of its message).
+// Every file of the corpus is listed: a new file without an expectation fails the test.
+TEST(ScenarioFile, EachMalformedFileGetsItsOwnErrorAndNothingIsHalfLoaded) {
+  const std::map<std::string, std::pair<std::string, std::string>> expected = {
+      {"schema-not-json.json", {"", "not valid JSON at line 46, column 3"}},
+      {"schema-not-an-object.json", {"", "expected an object"}},
+      {"schema-wrong-format.json", {"format", "\"liversim-session\" is invalid"}},
+      {"schema-newer-version.json", {"version", "99 is newer than this LiverSim reads"}},
+      {"schema-missing-title.json", {"title", "missing"}},
+      {"schema-unknown-field.json", {"lesion", "unknown field: expected one of"}},
+      {"schema-negative-radius.json",
+       {"lesions[0].radii_mm[0]", "-3 is invalid: expected a number, 2 to 50 mm"}},
+      {"schema-poisson-half.json",
+       {"parenchyma.poisson_ratio", "0.5 is invalid: expected Poisson's ratio ν, 0.3 to 0.499"}},
+      {"schema-modulus-as-text.json",
+       {"parenchyma.youngs_modulus_pa", "\"3500\" is invalid: expected a number"}},
+      {"schema-unknown-tool.json", {"tools[1]", "\"laser\" is invalid"}},
+      {"schema-rubric-both-rules.json", {"rubric[0]", "exactly one of at_most and at_least"}},
+      {"schema-unknown-metric.json", {"rubric[0].metric", "\"speed\" is invalid"}},
+      {"schema-unknown-integrator.json", {"integrator.kind", "\"euler\" is invalid"}},
+      {"schema-tet-count-out-of-range.json",
+       {"organ.target_tet_count", "10 is invalid: expected a whole number from 1000 to 50000"}},
+      {"schema-missing-task.json", {"task", "missing"}},
+      {"schema-implicit-without-step.json",
+       {"integrator.step_s", "0 is invalid with bdf2: expected a step above 0"}},
+      {"semantic-lesion-outside-liver.json",
+       {"lesions[0].centre_mm",
+        "(500, 0, 0) mm is invalid: expected a point inside the built-in liver"}},
+      {"semantic-unknown-task-lesion.json",
+       {"task.lesion", "\"nope\" is invalid: expected the name of a lesion"}},
+      {"semantic-viscoplastic-without-viscoelastic.json",
+       {"effects.viscoplastic", "without effects.viscoelastic"}},
+      {"semantic-viscoelastic-law-missing.json", {"parenchyma.viscoelastic", "missing"}},
+      {"semantic-instantaneous-modulus-mismatch.json",
+       {"parenchyma.viscoelastic", "e1_pa + e2_pa = 4000 Pa is invalid"}},
+      {"semantic-task-needs-probe.json", {"tools", "needs the probe"}},
+      {"semantic-lesion-softer-than-parenchyma.json",
+       {"lesions[0].youngs_modulus_pa",
+        "2000 Pa is invalid: expected 1 to 100 times the parenchyma's 3500 Pa"}},
+      {"semantic-duplicate-lesion-names.json", {"lesions[1].name", "another lesion has this name"}},
+      {"semantic-zero-fibre-direction.json", {"parenchyma.fibres.direction", "not all 0"}},
+      {"semantic-rubric-weights-zero.json", {"rubric", "the weights sum to 0"}},
+  };
+  std::set<std::string> seen;
+  for (const auto& entry : fs::directory_iterator(kCorpusDir)) {
+    const std::string name = entry.path().filename().string();
+    seen.insert(name);
+    const auto it = expected.find(name);
+    ASSERT_NE(it, expected.end()) << name << " has no expected error in this test";
+    const ScenarioReading reading = read_scenario_file(entry.path());
+    EXPECT_FALSE(reading.scenario.has_value()) << name;
+    ASSERT_EQ(reading.errors.size(), 1u)
+        << name << ": one fault, one error; got "
+        << (reading.errors.empty() ? "none" : reading.errors[1].text());
+    EXPECT_EQ(reading.errors[0].path, it->second.first) << name;
+    EXPECT_NE(reading.errors[0].message.find(it->second.second), std::string::npos)
+        << name << ": " << reading.errors[0].text();
+  }
+  EXPECT_EQ(seen.size(), expected.size()) << "a listed file is missing from " << kCorpusDir;
+}
+
+TEST(ScenarioFile, SeveralFaultsAreAllReported) {
+  Scenario s = every_field_set();
+  std::string text = write_scenario(s);
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace("\"poisson_ratio\": 0.48", "\"poisson_ratio\": 0.7");
+  replace("\"time_limit_s\": 450.0", "\"time_limit_s\": -1");
+  const ScenarioReading reading = read_scenario(text);
+  EXPECT_FALSE(reading.scenario.has_value());
+  std::set<std::string> paths;
+  for (const ScenarioError& e : reading.errors) paths.insert(e.path);
+  EXPECT_EQ(paths, (std::set<std::string>{"parenchyma.poisson_ratio", "task.time_limit_s"}));
+}
+
+// The shipped scenarios read cleanly and build a model with the effects and lesions they ask for.
+TEST(ShippedScenario, EachBuildsTheModelItDescribes) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(kShippedDir)) {
+    if (entry.path().extension() != ".json") continue;
+    ++count;
+    const std::string name = entry.path().filename().string();
+    const ScenarioReading reading = read_scenario_file(entry.path());
+    for (const ScenarioError& e : reading.errors) ADD_FAILURE() << name << ": " << e.text();
+    ASSERT_TRUE(reading.scenario.has_value()) << name;
+    const Scenario& s = *reading.scenario;
+    SceneSetup scene = build_scene(s, entry.path().parent_path());
+    const SimModel model = build_model(scene.mesh, scene.model_options);
+    EXPECT_EQ(model.effects.viscous, s.effects.viscoelastic) << name;
+    EXPECT_EQ(model.effects.fibres, s.effects.fibres) << name;
+    EXPECT_EQ(model.effects.average_nodal_pressure, s.effects.near_incompressibility) << name;
+    EXPECT_EQ(model.regions.size(), 1 + s.lesions.size()) << name;
+    EXPECT_FALSE(scene.model_options.fixed_nodes.empty()) << name;
+    // Each lesion's elements are those whose centroid is in its ellipsoid, with its stiffness.
+    for (std::size_t i = 0; i < s.lesions.size(); ++i) {
+      const auto region = static_cast<std::int32_t>(i + 1);
+      const double volume_expected_m3 = 4.0 / 3.0 * 3.14159265358979 * s.lesions[i].radii_mm[0] *
+                                        s.lesions[i].radii_mm[1] * s.lesions[i].radii_mm[2] * 1e-9;
+      double volume_m3 = 0.0;
+      for (std::size_t e = 0; e < model.tet_count; ++e)
+        if (model.region[e] == region) volume_m3 += model.rest_volume_m3[e];
+      // Centroid sampling on ~1 cm elements: within half of the ellipsoid's volume either way.
+      EXPECT_GT(volume_m3, 0.5 * volume_expected_m3) << name;
+      EXPECT_LT(volume_m3, 1.5 * volume_expected_m3) << name;
+      EXPECT_EQ(model.regions[region].tissue.youngs_modulus_pa, s.lesions[i].youngs_modulus_pa);
+    }
+  }
+  EXPECT_GE(count, 4);
+}
+
+TEST(ScenarioScene, ALesionRelaxesLikeTheParenchymaUnlessGivenItsOwnViscosity) {
+  Scenario s = every_field_set();
+  s.effects = {true, true, true, false};
+  s.lesions[0].viscosity_pa_s.reset();
+  s.lesions[0].yield_limit_pa.reset();
+  s.organ.fixed_balls.clear();
+  s.organ.fix_ligament = true;
+  SceneSetup scene = build_scene(s, ".");
+  ASSERT_EQ(scene.model_options.regions.size(), 2u);
+  const RegionMaterial& parenchyma = scene.model_options.regions[0];
+  const RegionMaterial& lesion = scene.model_options.regions[1];
+  ASSERT_TRUE(lesion.viscoelastic && parenchyma.viscoelastic);
+  EXPECT_DOUBLE_EQ(lesion.viscoelastic->instantaneous_modulus_pa(), s.lesions[0].youngs_modulus_pa);
+  EXPECT_DOUBLE_EQ(lesion.viscoelastic->eta1_pa_s / lesion.viscoelastic->e1_pa,
+                   parenchyma.viscoelastic->eta1_pa_s / parenchyma.viscoelastic->e1_pa);
+  EXPECT_EQ(lesion.viscoplastic->yield_limit_pa, parenchyma.viscoplastic->yield_limit_pa);
+  EXPECT_FALSE(lesion.fibres.has_value());
+
+  s.lesions[0].viscosity_pa_s = 9000.0;
+  s.lesions[0].yield_limit_pa = 400.0;
+  scene = build_scene(s, ".");
+  EXPECT_EQ(scene.model_options.regions[1].viscoelastic->eta1_pa_s, 9000.0);
+  EXPECT_EQ(scene.model_options.regions[1].viscoplastic->yield_limit_pa, 400.0);
+}
+
+TEST(ScenarioScene, AnEffectThatIsOffIsNotInTheModelButItsParametersAreKept) {
+  Scenario s = every_field_set();
+  s.effects = {true, false, false, false};
+  s.organ.fixed_balls.clear();
+  s.organ.fix_ligament = true;
+  const SceneSetup scene = build_scene(s, ".");
+  const SimModel model = build_model(scene.mesh, scene.model_options);
+  EXPECT_FALSE(model.effects.viscous);
+  EXPECT_FALSE(model.effects.fibres);
+  EXPECT_TRUE(model.viscous_parameters.empty());
+  EXPECT_TRUE(model.fibre_parameters.empty());
+  EXPECT_TRUE(round_trip(s).parenchyma.viscoelastic.has_value());
+}
+
+TEST(ScenarioScene, PaintedBallsHoldTheSurfaceInsideThem) {
+  Scenario s = every_field_set();
+  s.effects = {true, false, false, false};
+  s.organ.fix_ligament = false;
+  s.organ.fixed_balls = {{{-60.0, 20.0, -30.0}, 20.0}};
+  const SceneSetup scene = build_scene(s, ".");
+  ASSERT_FALSE(scene.model_options.fixed_nodes.empty());
+  for (NodeIndex n : scene.model_options.fixed_nodes)
+    EXPECT_LE((scene.mesh.rest_position_m.at(n) - Eigen::Vector3d(-0.060, 0.020, -0.030)).norm(),
+              0.020 + 1e-12);
+}
+
+TEST(ScenarioScene, AMeshFileWithoutTheNamedNodeSetIsAClearError) {
+  Scenario s = every_field_set();
+  s.organ = OrganSpec{};
+  s.organ.geometry = OrganGeometry::tet_mesh_file;
+  s.organ.file = "cube_sparse.inp";
+  s.organ.fixed_node_set = "NoSuchSet";
+  s.lesions.clear();
+  s.task = TaskSpec{};
+  s.task.kind = TaskKind::retract_lobe;
+  s.tools = {ToolKind::forceps};
+  s.effects = {true, false, false, false};
+  try {
+    build_scene(s, LIVERSIM_TEST_DATA_DIR);
+    FAIL() << "a missing node set was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("NoSuchSet"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace liversim
