@@ -26,6 +26,7 @@ struct CutBenchOptions {
   double stroke_mm = 120.0;
   std::filesystem::path output_dir = "docs";
   int threads = 2;
+  int repeats = 5;
 };
 
 double percentile(std::vector<double> values, double p) {
@@ -41,54 +42,88 @@ int run(const CutBenchOptions& o) {
     return std::chrono::duration<double, std::milli>(b - a).count();
   };
   const SceneSetup scene = default_scene(o.tets);
-  auto model = std::make_shared<const SimModel>(build_model(scene.mesh, scene.model_options));
+  const auto start_model =
+      std::make_shared<const SimModel>(build_model(scene.mesh, scene.model_options));
   // The threads the state's loops run on (the workstation's run on both cores).
   auto workers = o.threads > 1 ? std::make_shared<WorkerPool>(o.threads) : nullptr;
-  SimState state = make_rest_state(*model, workers);
-  const double start_step_s = model->stable_time_step_s;
-  const std::size_t start_tets = model->tet_count;
+  const SimState start_state = make_rest_state(*start_model, workers);
+  const double start_step_s = start_model->stable_time_step_s;
+  const std::size_t start_tets = start_model->tet_count;
   Eigen::AlignedBox3d box;
-  for (std::size_t n = 0; n < model->node_count; ++n) box.extend(model->rest_position_m.at(n));
+  for (std::size_t n = 0; n < start_model->node_count; ++n)
+    box.extend(start_model->rest_position_m.at(n));
   const Eigen::Vector3d centre = box.center();
 
   // A vertical blade drawn along the liver's length through its whole depth, the cut updated
-  // at every step of the stroke (as the workstation does once per interval).
+  // at every step of the stroke (as the workstation does once per interval). The stroke is drawn
+  // `repeats` times from the same start, making the same cuts each time; each update's times are
+  // its fastest over the repeats, which leaves out what other work on the machine added.
   CuttingSettings settings;
   settings.cutting_stress_pa = 0.0;
-  BladeStroke stroke;
-  std::vector<double> all_ms, cutting_ms, cut_ms, surface_ms, bvh_ms;
-  std::size_t separated = 0, duplicated = 0, snapped = 0;
   const int steps = static_cast<int>(o.stroke_mm / o.step_mm);
-  for (int k = 0; k <= steps; ++k) {
-    const double x = centre.x() - 0.5e-3 * o.stroke_mm + 1e-3 * o.step_mm * k;
-    stroke.add({Eigen::Vector3d(x, centre.y(), box.max().z() + 0.01),
-                Eigen::Vector3d(x, centre.y(), box.min().z() - 0.01)});
-    const auto t0 = clock::now();
-    CutResult cut = cut_tissue(*model, state, stroke, settings);
-    const auto t1 = clock::now();
-    cut_ms.push_back(ms(t0, t1));
-    if (!cut.cut()) {
-      all_ms.push_back(ms(t0, t1));
-      continue;
+  struct UpdateTimes {
+    bool cut = false;
+    double cut_ms = 0.0, surface_ms = 0.0, bvh_ms = 0.0;
+    double whole_ms() const { return cut_ms + surface_ms + bvh_ms; }
+  };
+  std::vector<UpdateTimes> fastest;
+  std::shared_ptr<const SimModel> model;
+  std::size_t separated = 0, duplicated = 0, snapped = 0;
+  for (int repeat = 0; repeat < o.repeats; ++repeat) {
+    model = start_model;
+    SimState state = start_state;
+    BladeStroke stroke;
+    separated = duplicated = snapped = 0;
+    for (int k = 0; k <= steps; ++k) {
+      const double x = centre.x() - 0.5e-3 * o.stroke_mm + 1e-3 * o.step_mm * k;
+      stroke.add({Eigen::Vector3d(x, centre.y(), box.max().z() + 0.01),
+                  Eigen::Vector3d(x, centre.y(), box.min().z() - 0.01)});
+      UpdateTimes times;
+      const auto t0 = clock::now();
+      CutResult cut = cut_tissue(*model, state, stroke, settings);
+      const auto t1 = clock::now();
+      times.cut_ms = ms(t0, t1);
+      if ((times.cut = cut.cut())) {
+        const BoundarySurface surface = boundary_surface(*cut.model);
+        const auto t2 = clock::now();
+        const SurfaceBvh bvh(surface, cut.state.position_m);
+        const auto t3 = clock::now();
+        times.surface_ms = ms(t1, t2);
+        times.bvh_ms = ms(t2, t3);
+        separated += cut.report.separated_faces;
+        duplicated += cut.report.duplicated_nodes;
+        snapped += cut.report.snapped_nodes;
+        model = cut.model;
+        state = std::move(cut.state);
+      }
+      if (repeat == 0) {
+        fastest.push_back(times);
+        continue;
+      }
+      UpdateTimes& best = fastest[static_cast<std::size_t>(k)];
+      if (best.cut != times.cut) {
+        std::cerr << "bench-cut: update " << k << " cut on one repeat and not on another\n";
+        return 1;
+      }
+      best.cut_ms = std::min(best.cut_ms, times.cut_ms);
+      best.surface_ms = std::min(best.surface_ms, times.surface_ms);
+      best.bvh_ms = std::min(best.bvh_ms, times.bvh_ms);
     }
-    const BoundarySurface surface = boundary_surface(*cut.model);
-    const auto t2 = clock::now();
-    const SurfaceBvh bvh(surface, cut.state.position_m);
-    const auto t3 = clock::now();
-    surface_ms.push_back(ms(t1, t2));
-    bvh_ms.push_back(ms(t2, t3));
-    all_ms.push_back(ms(t0, t3));
-    cutting_ms.push_back(ms(t0, t3));
-    separated += cut.report.separated_faces;
-    duplicated += cut.report.duplicated_nodes;
-    snapped += cut.report.snapped_nodes;
-    model = cut.model;
-    state = std::move(cut.state);
+  }
+  std::vector<double> all_ms, cutting_ms, cut_ms, surface_ms, bvh_ms;
+  for (const UpdateTimes& t : fastest) {
+    all_ms.push_back(t.whole_ms());
+    cut_ms.push_back(t.cut_ms);
+    if (!t.cut) continue;
+    cutting_ms.push_back(t.whole_ms());
+    surface_ms.push_back(t.surface_ms);
+    bvh_ms.push_back(t.bvh_ms);
   }
 
   std::ostringstream command;
   command << "liversim-cli bench-cut --tets " << o.tets << " --step-mm " << o.step_mm
-          << " --stroke-mm " << o.stroke_mm << " --threads " << o.threads;
+          << " --stroke-mm " << o.stroke_mm << " --threads " << o.threads << " --repeats "
+          << o.repeats;
   std::ostringstream doc;
   doc << "# Cutting: cost of a stroke's updates\n\n"
       << "Measured by `" << command.str() << "` (release build; the state's loops on " << o.threads
@@ -101,7 +136,12 @@ int run(const CutBenchOptions& o) {
       << "read again (`boundary_surface`) and the contact hierarchy rebuilt. The cutting threshold "
          "is 0 (the blade "
          "cuts\n"
-      << "whatever it passes through). Target (issue 7): one update within a frame, 16 ms.\n\n"
+      << "whatever it passes through). The stroke is drawn " << o.repeats
+      << " times from the same start (the same cuts each time); each update's times are its "
+         "fastest of\n"
+      << "those, so that other work on this shared machine does not count. Target (issue 7): one "
+         "update\n"
+      << "within a frame, 16 ms.\n\n"
       << std::fixed << std::setprecision(2)
       << "| part | updates | median (ms) | 95th percentile (ms) | max (ms) |\n"
       << "|---|---:|---:|---:|---:|\n";
@@ -149,6 +189,11 @@ std::function<std::optional<int>()> add_cut_bench_command(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--threads", options->threads, "Threads of the state's loops")
       ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  command
+      ->add_option("--repeats", options->repeats,
+                   "Times the stroke is drawn; each update counts its fastest")
+      ->check(CLI::Range(1, 100))
       ->capture_default_str();
   command->add_option("--output-dir", options->output_dir, "Where cutting-performance.md goes")
       ->capture_default_str();
