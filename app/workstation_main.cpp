@@ -1,8 +1,9 @@
-// liversim: the workstation. Builds the default scene and opens the main window.
+// liversim: the workstation. Builds the default scene (or a scenario's) and opens the main window.
 #include "main_window.h"
 #include "vtk_viewport.h"
 
 #include "liversim/core/default_scene.h"
+#include "liversim/core/scenario.h"
 
 #include <QApplication>
 #include <QCommandLineParser>
@@ -12,14 +13,18 @@
 #include <cmath>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <iostream>
 #include <optional>
+#include <string>
 
 namespace {
 
 struct Options {
   int tet_count = liversim::kDefaultLiverTetCount;
   std::optional<double> quit_after_s;  // close this long after the window is shown (unattended)
+  std::optional<liversim::Scenario> scenario;  // validated
+  std::string scenario_file;
 };
 
 // Parsed under a plain QCoreApplication, so --help, --version and bad options work without a
@@ -46,6 +51,13 @@ Options parse_options(int argc, char** argv) {
                                   "is shown (for unattended runs)."),
       "seconds");
   parser.addOption(quit_after);
+  const QCommandLineOption scenario(
+      "scenario",
+      QCoreApplication::translate("main",
+                                  "Run this scenario file (JSON, docs/scenario-format.md) instead "
+                                  "of free practice on the built-in liver."),
+      "file");
+  parser.addOption(scenario);
   parser.process(app);
 
   Options options;
@@ -67,6 +79,21 @@ Options parse_options(int argc, char** argv) {
     }
     options.quit_after_s = seconds;
   }
+  if (parser.isSet(scenario)) {
+    if (parser.isSet(tets)) {
+      std::cerr << "liversim: --tets and --scenario cannot go together: the scenario sets the "
+                   "element count (organ.target_tet_count)\n";
+      std::exit(2);
+    }
+    options.scenario_file = parser.value(scenario).toStdString();
+    liversim::ScenarioReading reading = liversim::read_scenario_file(options.scenario_file);
+    if (!reading.scenario) {
+      std::cerr << "liversim: cannot open the scenario " << options.scenario_file << ":\n";
+      for (const auto& error : reading.errors) std::cerr << "  " << error.text() << '\n';
+      std::exit(2);
+    }
+    options.scenario = std::move(reading.scenario);
+  }
   return options;
 }
 
@@ -81,10 +108,28 @@ bool has_display() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Options options = parse_options(argc, argv);
+  Options options = parse_options(argc, argv);
   if (!has_display()) {
     std::cerr << "liversim: no display found (DISPLAY and WAYLAND_DISPLAY are unset). Run it on a "
                  "desktop, or try the headless demo: xvfb-run -a liversim-cli demo\n";
+    return 2;
+  }
+  // The scene before the window: a scenario whose mesh cannot be built is refused here.
+  std::optional<liversim::SceneSetup> setup;
+  std::optional<liversim::OpenedScenario> opened;
+  try {
+    if (options.scenario) {
+      const std::filesystem::path file = std::filesystem::absolute(options.scenario_file);
+      setup = liversim::build_scene(*options.scenario, file.parent_path());
+      opened = liversim::OpenedScenario{std::move(*options.scenario),
+                                        QString::fromStdString(file.string())};
+    } else {
+      setup = liversim::default_scene(options.tet_count);
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "liversim: cannot build the scene"
+              << (options.scenario_file.empty() ? std::string() : " of " + options.scenario_file)
+              << ": " << e.what() << '\n';
     return 2;
   }
   liversim::VtkViewport::setDefaultSurfaceFormat();  // before QApplication, for every GL context
@@ -93,7 +138,7 @@ int main(int argc, char** argv) {
   QApplication::setOrganizationName("LiverSim");
   QApplication::setApplicationVersion(LIVERSIM_VERSION);
   try {
-    liversim::MainWindow window(liversim::default_scene(options.tet_count));
+    liversim::MainWindow window(std::move(*setup), std::move(opened));
     window.show();
     if (options.quit_after_s)
       QTimer::singleShot(static_cast<int>(std::lround(*options.quit_after_s * 1e3)), &app,

@@ -4,6 +4,7 @@
 #include "calibration_dialog.h"
 #include "device_panel.h"
 #include "render/liver_scene.h"
+#include "scenario_panel.h"
 #include "tool_panel.h"
 #include "vtk_viewport.h"
 
@@ -16,11 +17,18 @@
 #include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
+#include <QAction>
+#include <QApplication>
+#include <QDir>
 #include <QDockWidget>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QGuiApplication>
+#include <QKeySequence>
 #include <QLabel>
+#include <QMenu>
+#include <QMenuBar>
+#include <QMessageBox>
 #include <QSettings>
 #include <QStatusBar>
 
@@ -44,23 +52,10 @@ QString formatAmount(double value) {
 
 }  // namespace
 
-MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
-    : QMainWindow(parent), setup_(std::move(setup)) {
-  setWindowTitle(tr("LiverSim — %1").arg(QString::fromStdString(setup_.description)));
-  auto model = std::make_shared<const SimModel>(build_model(setup_.mesh, setup_.model_options));
-  simulation_ =
-      std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
-  // The visual surface's triangles are the physics boundary's (its vertex i is node nodes[i]).
-  simulation_->enable_tools(setup_.visual.surface);
-  simulation_->enable_cutting();
-  scene_ = std::make_unique<LiverScene>(setup_.mesh, setup_.visual);
-  std::vector<double> smooth_xyz;
-  map_visual_positions(setup_.visual, setup_.mesh.rest_position_m, smooth_xyz);
-  for (std::size_t v = 0; v < setup_.visual.vertex_count(); ++v) {
-    const Eigen::Vector3d node = setup_.mesh.rest_position_m.at(setup_.visual.surface.nodes[v]);
-    smoothVertexAt_[{node.x(), node.y(), node.z()}] =
-        Eigen::Vector3d(smooth_xyz[3 * v], smooth_xyz[3 * v + 1], smooth_xyz[3 * v + 2]);
-  }
+MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario, QWidget* parent)
+    : QMainWindow(parent), scenario_(std::move(scenario)) {
+  auto model = std::make_shared<const SimModel>(build_model(setup.mesh, setup.model_options));
+  installScene(std::move(setup), std::move(model));
 
   viewport_ = new VtkViewport(this);
   viewport_->setObjectName("liverViewport");
@@ -79,6 +74,10 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   });
   connect(viewport_, &QOpenGLWidget::frameSwapped, this, [this] { ++framesInWindow_; });
   setCentralWidget(viewport_);
+
+  scenarioPanel_ = new ScenarioPanel(this);
+  scenarioPanel_->setObjectName("scenarioPanel");
+  addPanelDock(tr("Scenario"), "scenarioDock", scenarioPanel_);
 
   accuracyPanel_ = new AccuracyPanel(this);
   accuracyPanel_->setObjectName("accuracyPanel");
@@ -114,6 +113,10 @@ MainWindow::MainWindow(SceneSetup setup, QWidget* parent)
   });
   connect(devicePanel_, &DevicePanel::calibrateRequested, this, [this] { openCalibration(); });
 
+  if (scenario_) rememberScenario(scenario_->file);
+  buildMenus();
+  showScenarioDetails();
+
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("simulationStatus");
   statusBar()->addPermanentWidget(statusLabel_, 1);
@@ -146,6 +149,170 @@ void MainWindow::addPanelDock(const QString& title, const char* name, QWidget* p
   addDockWidget(Qt::RightDockWidgetArea, dock);
 }
 
+void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> model) {
+  auto simulation =
+      std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
+  // The visual surface's triangles are the physics boundary's (its vertex i is node nodes[i]).
+  simulation->enable_tools(setup.visual.surface);
+  simulation->enable_cutting();
+  auto scene = std::make_unique<LiverScene>(setup.mesh, setup.visual);
+  smoothVertexAt_.clear();
+  std::vector<double> smooth_xyz;
+  map_visual_positions(setup.visual, setup.mesh.rest_position_m, smooth_xyz);
+  for (std::size_t v = 0; v < setup.visual.vertex_count(); ++v) {
+    const Eigen::Vector3d node = setup.mesh.rest_position_m.at(setup.visual.surface.nodes[v]);
+    smoothVertexAt_[{node.x(), node.y(), node.z()}] =
+        Eigen::Vector3d(smooth_xyz[3 * v], smooth_xyz[3 * v + 1], smooth_xyz[3 * v + 2]);
+  }
+  if (simulation_) {
+    // The hand and the mouse's tool let go of the old liver; a device stays attached.
+    if (grab_) endGrab();
+    if (tool_) endTool();
+    simulation_->stop();
+  }
+  if (viewport_) {
+    if (scene_) viewport_->renderWindow()->RemoveRenderer(scene_->renderer());
+    viewport_->renderWindow()->AddRenderer(scene->renderer());
+  }
+  simulation_ = std::move(simulation);
+  scene_ = std::move(scene);
+  setup_ = std::move(setup);
+  shownTopology_ = 0;
+}
+
+bool MainWindow::openScenario(const QString& file) {
+  if (changingIntegrator_ || openingScenario_) return false;
+  const ScenarioReading reading = read_scenario_file(file.toStdString());
+  if (!reading.scenario) {
+    QStringList errors;
+    for (const ScenarioError& error : reading.errors)
+      errors << QString::fromStdString(error.text());
+    refuseScenario(file, errors.join('\n'));
+    return true;
+  }
+  if (modelBuilder_.joinable()) modelBuilder_.join();  // the last one has reported back
+  openingScenario_ = true;
+  accuracyPanel_->setBusy(true);
+  statusBar()->showMessage(tr("Building the scene of %1…").arg(QFileInfo(file).fileName()));
+  OpenedScenario opened{*reading.scenario, QFileInfo(file).absoluteFilePath()};
+  modelBuilder_ = std::thread([this, opened = std::move(opened)] {
+    std::shared_ptr<SceneSetup> setup;
+    std::shared_ptr<const SimModel> model;
+    QString error;
+    try {
+      setup = std::make_shared<SceneSetup>(build_scene(
+          opened.scenario, std::filesystem::path(opened.file.toStdString()).parent_path()));
+      model = std::make_shared<const SimModel>(build_model(setup->mesh, setup->model_options));
+    } catch (const std::exception& e) {
+      error = QString::fromUtf8(e.what());
+    }
+    // As in applyIntegratorSettings: dropped if the window is gone.
+    QMetaObject::invokeMethod(
+        this,
+        [this, opened, setup, model, error] { finishScenarioOpen(opened, setup, model, error); },
+        Qt::QueuedConnection);
+  });
+  return true;
+}
+
+void MainWindow::finishScenarioOpen(const OpenedScenario& opened, std::shared_ptr<SceneSetup> setup,
+                                    std::shared_ptr<const SimModel> model, const QString& error) {
+  modelBuilder_.join();  // it ends right after posting this
+  openingScenario_ = false;
+  accuracyPanel_->setBusy(false);
+  if (!model) return refuseScenario(opened.file, error);
+  try {
+    installScene(std::move(*setup), std::move(model));
+  } catch (const std::exception& e) {
+    simulation_->start();  // nothing was replaced: the old scene goes on
+    return refuseScenario(opened.file, QString::fromUtf8(e.what()));
+  }
+  scenario_ = opened;
+  attachDevice();
+  simulation_->start();
+  accuracyPanel_->setSettings(setup_.model_options.integrator);
+  showScenarioDetails();
+  rememberScenario(opened.file);
+  updateRecentMenu();
+  statusBar()->showMessage(tr("Opened %1.").arg(QFileInfo(opened.file).fileName()));
+  viewport_->scheduleRender();
+  emit scenarioOpenFinished(true);
+}
+
+void MainWindow::refuseScenario(const QString& file, const QString& why) {
+  const QString text =
+      tr("Cannot open the scenario %1:\n%2\nThe scene that was running goes on.").arg(file, why);
+  scenarioPanel_->showProblem(text);
+  statusBar()->showMessage(tr("Cannot open the scenario %1.").arg(QFileInfo(file).fileName()));
+  // Window-modal but not blocking, so that the simulation and the caller go on.
+  auto* box = new QMessageBox(QMessageBox::Warning, tr("Cannot open the scenario"), text,
+                              QMessageBox::Ok, this);
+  box->setObjectName("scenarioErrorBox");
+  box->setAttribute(Qt::WA_DeleteOnClose);
+  box->open();
+  emit scenarioOpenFinished(false);
+}
+
+void MainWindow::showScenarioDetails() {
+  const QString name = scenario_ ? QString::fromStdString(scenario_->scenario.title)
+                                 : QString::fromStdString(setup_.description);
+  setWindowTitle(tr("LiverSim — %1").arg(name));
+  scenarioPanel_->showScenario(scenario_ ? &scenario_->scenario : nullptr,
+                               scenario_ ? scenario_->file : QString());
+  toolPanel_->setAvailableTools(
+      scenario_ ? scenario_->scenario.tools
+                : std::vector<ToolKind>{ToolKind::probe, ToolKind::forceps, ToolKind::scalpel});
+}
+
+QStringList MainWindow::recentScenarios() {
+  return QSettings().value("scenarios/recent").toStringList();
+}
+
+void MainWindow::rememberScenario(const QString& file) {
+  QStringList recent = recentScenarios();
+  recent.removeAll(file);
+  recent.prepend(file);
+  while (recent.size() > kRecentScenarioCount) recent.removeLast();
+  QSettings().setValue("scenarios/recent", recent);
+}
+
+void MainWindow::buildMenus() {
+  QMenu* file = menuBar()->addMenu(tr("&File"));
+  file->setObjectName("fileMenu");
+  QAction* open = file->addAction(tr("&Open Scenario…"), this, [this] {
+    const QStringList recent = recentScenarios();
+    const QString folder =
+        recent.isEmpty() ? QDir::currentPath() : QFileInfo(recent.front()).absolutePath();
+    const QString chosen = QFileDialog::getOpenFileName(
+        this, tr("Open a scenario"), folder, tr("LiverSim scenarios (*.json);;All files (*)"));
+    if (!chosen.isEmpty() && !openScenario(chosen))
+      statusBar()->showMessage(tr("A scene is still being built; open the scenario after it."));
+  });
+  open->setObjectName("openScenarioAction");
+  open->setShortcut(QKeySequence::Open);
+  recentMenu_ = file->addMenu(tr("Open &Recent"));
+  recentMenu_->setObjectName("recentScenariosMenu");
+  updateRecentMenu();
+  file->addSeparator();
+  QAction* quit = file->addAction(tr("&Quit"), this, &QWidget::close);
+  quit->setObjectName("quitAction");
+  quit->setShortcut(QKeySequence::Quit);
+}
+
+void MainWindow::updateRecentMenu() {
+  recentMenu_->clear();
+  const QStringList recent = recentScenarios();
+  for (const QString& file : recent) {
+    QAction* action = recentMenu_->addAction(QFileInfo(file).fileName(), this, [this, file] {
+      if (!openScenario(file))
+        statusBar()->showMessage(tr("A scene is still being built; open the scenario after it."));
+    });
+    action->setToolTip(file);
+    action->setData(file);
+  }
+  recentMenu_->setEnabled(!recent.isEmpty());
+}
+
 MainWindow::~MainWindow() {
   if (modelBuilder_.joinable()) modelBuilder_.join();
   simulation_->stop();
@@ -153,7 +320,7 @@ MainWindow::~MainWindow() {
 }
 
 bool MainWindow::applyIntegratorSettings(const IntegratorSettings& settings) {
-  if (changingIntegrator_) return false;
+  if (changingIntegrator_ || openingScenario_) return false;
   if (modelBuilder_.joinable()) modelBuilder_.join();  // the last one has reported back
   changingIntegrator_ = true;
   accuracyPanel_->setBusy(true);

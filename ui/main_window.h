@@ -1,7 +1,7 @@
 #pragma once
-// The workstation's main window: the liver viewport in the middle, the accuracy setting (time
-// integrator and step) beside it, live statistics in the status bar. The simulation runs on its own
-// thread; the viewport renders from its newest snapshot.
+// The workstation's main window: the liver viewport in the middle, the scenario, the accuracy
+// setting (time integrator and step), the tool and the device beside it, live statistics in the
+// status bar. The simulation runs on its own thread; the viewport renders from its newest snapshot.
 
 #include "haptic_preferences.h"
 
@@ -9,11 +9,13 @@
 #include "liversim/core/grab.h"
 #include "liversim/core/haptic_device.h"
 #include "liversim/core/realtime_simulation.h"
+#include "liversim/core/scenario.h"
 #include "liversim/core/servo_loop.h"
 
 #include <QElapsedTimer>
 #include <QMainWindow>
 #include <QPointer>
+#include <QStringList>
 #include <QTimer>
 
 #include <array>
@@ -24,6 +26,7 @@
 #include <thread>
 
 class QLabel;
+class QMenu;
 
 namespace liversim {
 
@@ -31,14 +34,23 @@ class AccuracyPanel;
 class CalibrationDialog;
 class DevicePanel;
 class LiverScene;
+class ScenarioPanel;
 class ToolPanel;
 class VtkViewport;
+
+// A scenario as the window runs it, and the file it came from.
+struct OpenedScenario {
+  Scenario scenario;
+  QString file;
+};
 
 class MainWindow : public QMainWindow {
   Q_OBJECT
 
  public:
-  explicit MainWindow(SceneSetup setup, QWidget* parent = nullptr);
+  // The scene to run, and the scenario it was built from (none: free practice).
+  explicit MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario = std::nullopt,
+                      QWidget* parent = nullptr);
   ~MainWindow() override;
 
   VtkViewport* viewport() const { return viewport_; }
@@ -57,6 +69,19 @@ class MainWindow : public QMainWindow {
   // an earlier change is still being built.
   bool applyIntegratorSettings(const IntegratorSettings& settings);
   bool changingIntegrator() const { return changingIntegrator_; }
+
+  // Opens a scenario file. It is read and validated at once: a bad file is refused with its
+  // errors (field, value, what is expected) in the Scenario panel and a message box, and the
+  // running scene stays. Otherwise its scene is built on a worker thread (meshing takes seconds)
+  // and then runs in place of the current one; a scene that cannot be built is refused the same
+  // way. scenarioOpenFinished tells which. Returns false, and does nothing, while a model is being
+  // built.
+  bool openScenario(const QString& file);
+  const std::optional<OpenedScenario>& scenario() const { return scenario_; }
+  ScenarioPanel* scenarioPanel() const { return scenarioPanel_; }
+  // Scenario files opened before, newest first (kept in the settings).
+  static QStringList recentScenarios();
+  static constexpr int kRecentScenarioCount = 8;
 
   // Haptic devices (Device panel). The mouse moves the tool directly; any other device drives it
   // through the 1 kHz servo, holding the tool chosen in the Tool panel (the hand: none). The
@@ -78,10 +103,21 @@ class MainWindow : public QMainWindow {
 
  signals:
   void integratorChangeFinished(bool applied);
+  void scenarioOpenFinished(bool opened);
 
  private:
   // A panel docked on the right, movable and floatable.
   void addPanelDock(const QString& title, const char* name, QWidget* panel);
+  // Runs `model` of `setup` from rest, in place of the scene shown (if any): a new simulation,
+  // liver picture and tool interaction; the device in use stays attached.
+  void installScene(SceneSetup setup, std::shared_ptr<const SimModel> model);
+  void finishScenarioOpen(const OpenedScenario& opened, std::shared_ptr<SceneSetup> setup,
+                          std::shared_ptr<const SimModel> model, const QString& error);
+  void refuseScenario(const QString& file, const QString& why);
+  void showScenarioDetails();  // title, panel and allowed tools of scenario_
+  static void rememberScenario(const QString& file);
+  void buildMenus();
+  void updateRecentMenu();
   bool beginGrab(QPoint vtkDisplayPos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers);
   void moveGrab(QPoint vtkDisplayPos);
   void endGrab();
@@ -116,6 +152,8 @@ class MainWindow : public QMainWindow {
   AccuracyPanel* accuracyPanel_ = nullptr;
   ToolPanel* toolPanel_ = nullptr;
   DevicePanel* devicePanel_ = nullptr;
+  ScenarioPanel* scenarioPanel_ = nullptr;
+  QMenu* recentMenu_ = nullptr;
   QPointer<CalibrationDialog> calibration_;
   QLabel* statusLabel_ = nullptr;
   QTimer frameTimer_;
@@ -143,9 +181,13 @@ class MainWindow : public QMainWindow {
   std::unique_ptr<HapticDevice> scripted_;
   std::unique_ptr<ServoLoop> servo_;  // runs while a device other than the mouse is in use
 
-  // Builds the model of an integrator change; reads setup_.mesh, which never changes.
+  std::optional<OpenedScenario> scenario_;
+
+  // Builds the model of an integrator change (reading setup_.mesh, which changes only when no
+  // model is being built) or the scene of a scenario being opened.
   std::thread modelBuilder_;
   bool changingIntegrator_ = false;
+  bool openingScenario_ = false;
 };
 
 }  // namespace liversim

@@ -95,8 +95,8 @@ ToolPanel::ToolPanel(QWidget* parent) : QWidget(parent) {
       tr("Press the left mouse button on the liver to close the jaws on it, drag to pull, release "
          "to let go"));
   add(tr("&Scalpel"), "toolScalpel", static_cast<int>(ToolKind::scalpel),
-      tr("Press the left mouse button on the liver to put the blade on it and drag (it touches; "
-         "cutting is not built yet)"));
+      tr("Press the left mouse button on the liver to put the blade on it and drag: it breaks in "
+         "where the tissue is stressed past its cutting threshold and cuts along its path"));
   force_ = new QLabel(this);
   force_->setObjectName("toolForce");
   layout->addWidget(force_);
@@ -118,6 +118,19 @@ void ToolPanel::setTool(std::optional<ToolKind> tool) {
   if (QAbstractButton* button = tools_->button(tool ? static_cast<int>(*tool) : kHandId))
     button->setChecked(true);
   emit toolChanged(this->tool());
+}
+
+void ToolPanel::setAvailableTools(const std::vector<ToolKind>& tools) {
+  for (const ToolKind kind : {ToolKind::probe, ToolKind::forceps, ToolKind::scalpel})
+    if (QAbstractButton* button = tools_->button(static_cast<int>(kind)))
+      button->setVisible(std::find(tools.begin(), tools.end(), kind) != tools.end());
+  // A tool the scene does not offer is put down: the hand takes over.
+  if (const auto held = tool(); held && !offers(*held)) setTool(std::nullopt);
+}
+
+bool ToolPanel::offers(ToolKind kind) const {
+  const QAbstractButton* button = tools_->button(static_cast<int>(kind));
+  return button && !button->isHidden();
 }
 
 void ToolPanel::showForce(double time_s, const Eigen::Vector3d& force_n, bool holding) {

@@ -45,6 +45,9 @@ class ToolPanel : public QWidget {
   // The chosen tool; nothing: the hand.
   std::optional<ToolKind> tool() const;
   void setTool(std::optional<ToolKind> tool);
+  // The tools a scenario allows (the hand always is); a held tool no longer offered is put down.
+  void setAvailableTools(const std::vector<ToolKind>& tools);
+  bool offers(ToolKind kind) const;
 
   // The tissue's force on the tool at simulated time t (N); the label shows its magnitude.
   void showForce(double time_s, const Eigen::Vector3d& force_n, bool holding);
