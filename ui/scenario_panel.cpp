@@ -4,6 +4,7 @@
 
 #include <QFileInfo>
 #include <QLabel>
+#include <QScrollArea>
 #include <QStringList>
 #include <QVBoxLayout>
 
@@ -57,7 +58,18 @@ QString describeTask(const TaskSpec& task) {
 }
 
 ScenarioPanel::ScenarioPanel(QWidget* parent) : QWidget(parent) {
-  auto* layout = new QVBoxLayout(this);
+  // In a scroll area: a dock squeezed by the others would otherwise clip the wrapped lines.
+  auto* outer = new QVBoxLayout(this);
+  outer->setContentsMargins(0, 0, 0, 0);
+  auto* scroll = new QScrollArea(this);
+  scroll->setFrameShape(QFrame::NoFrame);
+  scroll->setWidgetResizable(true);
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  scroll->setMinimumHeight(160);
+  outer->addWidget(scroll);
+  auto* content = new QWidget(scroll);
+  scroll->setWidget(content);
+  auto* layout = new QVBoxLayout(content);
   title_ = addLabel(layout, this, "scenarioTitle");
   QFont bold = title_->font();
   bold.setBold(true);
