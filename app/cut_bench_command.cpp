@@ -61,10 +61,10 @@ int run(const CutBenchOptions& o) {
   CuttingSettings settings;
   settings.cutting_stress_pa = 0.0;
   const int steps = static_cast<int>(o.stroke_mm / o.step_mm);
+  // The whole update's fastest is its own minimum, not the sum of its parts' fastest.
   struct UpdateTimes {
     bool cut = false;
-    double cut_ms = 0.0, surface_ms = 0.0, bvh_ms = 0.0;
-    double whole_ms() const { return cut_ms + surface_ms + bvh_ms; }
+    double whole_ms = 0.0, cut_ms = 0.0, surface_ms = 0.0, bvh_ms = 0.0;
   };
   std::vector<UpdateTimes> fastest;
   std::shared_ptr<const SimModel> model;
@@ -82,7 +82,7 @@ int run(const CutBenchOptions& o) {
       const auto t0 = clock::now();
       CutResult cut = cut_tissue(*model, state, stroke, settings);
       const auto t1 = clock::now();
-      times.cut_ms = ms(t0, t1);
+      times.cut_ms = times.whole_ms = ms(t0, t1);
       if ((times.cut = cut.cut())) {
         const BoundarySurface surface = boundary_surface(*cut.model);
         const auto t2 = clock::now();
@@ -90,6 +90,7 @@ int run(const CutBenchOptions& o) {
         const auto t3 = clock::now();
         times.surface_ms = ms(t1, t2);
         times.bvh_ms = ms(t2, t3);
+        times.whole_ms = ms(t0, t3);
         separated += cut.report.separated_faces;
         duplicated += cut.report.duplicated_nodes;
         snapped += cut.report.snapped_nodes;
@@ -105,6 +106,7 @@ int run(const CutBenchOptions& o) {
         std::cerr << "bench-cut: update " << k << " cut on one repeat and not on another\n";
         return 1;
       }
+      best.whole_ms = std::min(best.whole_ms, times.whole_ms);
       best.cut_ms = std::min(best.cut_ms, times.cut_ms);
       best.surface_ms = std::min(best.surface_ms, times.surface_ms);
       best.bvh_ms = std::min(best.bvh_ms, times.bvh_ms);
@@ -112,10 +114,10 @@ int run(const CutBenchOptions& o) {
   }
   std::vector<double> all_ms, cutting_ms, cut_ms, surface_ms, bvh_ms;
   for (const UpdateTimes& t : fastest) {
-    all_ms.push_back(t.whole_ms());
+    all_ms.push_back(t.whole_ms);
     cut_ms.push_back(t.cut_ms);
     if (!t.cut) continue;
-    cutting_ms.push_back(t.whole_ms());
+    cutting_ms.push_back(t.whole_ms);
     surface_ms.push_back(t.surface_ms);
     bvh_ms.push_back(t.bvh_ms);
   }

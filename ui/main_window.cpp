@@ -18,7 +18,6 @@
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
 #include <QAction>
-#include <QApplication>
 #include <QDir>
 #include <QDockWidget>
 #include <QFileDialog>
@@ -259,9 +258,8 @@ void MainWindow::showScenarioDetails() {
   setWindowTitle(tr("LiverSim — %1").arg(name));
   scenarioPanel_->showScenario(scenario_ ? &scenario_->scenario : nullptr,
                                scenario_ ? scenario_->file : QString());
-  toolPanel_->setAvailableTools(
-      scenario_ ? scenario_->scenario.tools
-                : std::vector<ToolKind>{ToolKind::probe, ToolKind::forceps, ToolKind::scalpel});
+  // Free practice offers what a scenario does by default: every tool.
+  toolPanel_->setAvailableTools(scenario_ ? scenario_->scenario.tools : Scenario{}.tools);
 }
 
 QStringList MainWindow::recentScenarios() {
@@ -285,8 +283,7 @@ void MainWindow::buildMenus() {
         recent.isEmpty() ? QDir::currentPath() : QFileInfo(recent.front()).absolutePath();
     const QString chosen = QFileDialog::getOpenFileName(
         this, tr("Open a scenario"), folder, tr("LiverSim scenarios (*.json);;All files (*)"));
-    if (!chosen.isEmpty() && !openScenario(chosen))
-      statusBar()->showMessage(tr("A scene is still being built; open the scenario after it."));
+    if (!chosen.isEmpty()) openScenarioFromMenu(chosen);
   });
   open->setObjectName("openScenarioAction");
   open->setShortcut(QKeySequence::Open);
@@ -299,14 +296,17 @@ void MainWindow::buildMenus() {
   quit->setShortcut(QKeySequence::Quit);
 }
 
+void MainWindow::openScenarioFromMenu(const QString& file) {
+  if (!openScenario(file))
+    statusBar()->showMessage(tr("A scene is still being built; open the scenario after it."));
+}
+
 void MainWindow::updateRecentMenu() {
   recentMenu_->clear();
   const QStringList recent = recentScenarios();
   for (const QString& file : recent) {
-    QAction* action = recentMenu_->addAction(QFileInfo(file).fileName(), this, [this, file] {
-      if (!openScenario(file))
-        statusBar()->showMessage(tr("A scene is still being built; open the scenario after it."));
-    });
+    QAction* action = recentMenu_->addAction(QFileInfo(file).fileName(), this,
+                                             [this, file] { openScenarioFromMenu(file); });
     action->setToolTip(file);
     action->setData(file);
   }

@@ -117,6 +117,7 @@ class MainWindow : public QMainWindow {
   void showScenarioDetails();  // title, panel and allowed tools of scenario_
   static void rememberScenario(const QString& file);
   void buildMenus();
+  void openScenarioFromMenu(const QString& file);  // says so when a scene is still being built
   void updateRecentMenu();
   bool beginGrab(QPoint vtkDisplayPos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers);
   void moveGrab(QPoint vtkDisplayPos);

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
@@ -310,6 +311,15 @@ bool element_has_node(const SimModel& model, std::size_t e, NodeIndex n) {
   for (int c = 0; c < 4; ++c)
     if (model.corner[c][e] == n) return true;
   return false;
+}
+
+// The copy of node n that element e (one of n's elements) has in `corner`, its corners after the
+// split; -1 if e does not have n.
+NodeIndex copy_in(const SimModel& model, const std::array<std::vector<NodeIndex>, 4>& corner,
+                  std::size_t e, NodeIndex n) {
+  for (int c = 0; c < 4; ++c)
+    if (model.corner[c][e] == n) return corner[c][e];
+  return -1;
 }
 
 // The element across face `face` of element e, if the face is interior.
@@ -638,6 +648,7 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
         .maxCoeff();
   };
   double previous_beta = 0.0, checked = 0.0;
+  std::optional<double> settled;
   for (int step = 0; step < kMaxSteps && step < static_cast<int>(dofs); ++step) {
     apply(current, next);
     next -= previous_beta * previous;
@@ -647,14 +658,17 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
     if (!(previous_beta > 1e-12 * std::abs(alpha.back()))) break;
     if ((step + 1) % kCheckEvery == 0) {
       const double now = largest_ritz_value();
-      if (std::abs(now - checked) <= kSettled * std::abs(now)) break;
+      if (std::abs(now - checked) <= kSettled * std::abs(now)) {
+        settled = now;
+        break;
+      }
       checked = now;
     }
     beta.push_back(previous_beta);
     previous.swap(current);
     current = next / previous_beta;
   }
-  return std::sqrt(std::max(largest_ritz_value(), 0.0));
+  return std::sqrt(std::max(settled ? *settled : largest_ritz_value(), 0.0));
 }
 
 bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
@@ -905,8 +919,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
           copy = static_cast<NodeIndex>(node_origin.size());
           node_origin.push_back(n);
         } else {
-          for (int c = 0; c < 4; ++c)
-            if (model.corner[c][around[first]] == n) copy = corner[c][around[first]];
+          copy = copy_in(model, corner, around[first], n);
         }
         for (int c = 0; c < 4; ++c)
           if (model.corner[c][around[i]] == n) corner[c][around[i]] = copy;
@@ -921,13 +934,8 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
         if (found < 2 && element_has_node(model, e, key[1]) && element_has_node(model, e, key[2]))
           pair[found++] = e;
       });
-      for (NodeIndex n : key) {
-        NodeIndex copy[2] = {-1, -1};
-        for (int k = 0; k < 2; ++k)
-          for (int c = 0; c < 4; ++c)
-            if (model.corner[c][pair[k]] == n) copy[k] = corner[c][pair[k]];
-        if (copy[0] != copy[1]) return false;
-      }
+      for (NodeIndex n : key)
+        if (copy_in(model, corner, pair[0], n) != copy_in(model, corner, pair[1], n)) return false;
       return true;
     });
     // Each copy's boundary around it, as the arcs b → c of its boundary faces (copy, b, c).
@@ -938,8 +946,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
       // first element that has it on.
       copy_of.resize(around.size());
       for (std::size_t i = 0; i < around.size(); ++i)
-        for (int c = 0; c < 4; ++c)
-          if (model.corner[c][around[i]] == n) copy_of[i] = corner[c][around[i]];
+        copy_of[i] = copy_in(model, corner, around[i], n);
       bool is_pinched = false;
       for (std::size_t first = 0; first < around.size() && !is_pinched; ++first) {
         const NodeIndex copy = copy_of[first];
