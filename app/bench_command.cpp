@@ -39,6 +39,9 @@ namespace {
 // disturbed).
 constexpr int kRepetitions = 5;
 constexpr int kSteppingRepetitions = 3;
+// The effect-off comparison: many short back-to-back pairs (compare_force_builds).
+constexpr int kEffectOffRounds = 41;
+constexpr double kEffectOffRunS = 0.05;  // or --min-time, if shorter
 
 struct BenchOptions {
   std::vector<int> tet_counts{std::begin(kSeedMeshSizes), std::end(kSeedMeshSizes)};
@@ -372,12 +375,13 @@ int run_bench(const BenchOptions& o) {
   effect_off << "| effect left off | scene | normal build (ns/tet) | build without it (ns/tet) | "
                 "difference |\n|---|---|---:|---:|---:|\n";
   double worst_difference = -std::numeric_limits<double>::infinity();
+  const double effect_off_run_s = std::min(o.min_time_s, kEffectOffRunS);
   for (const EffectOffCase& c : effect_off_cases()) {
     const EffectSet set{c.scene, c.average_nodal_pressure, c.laws};
     const SimModel model = model_for(default_size, set);
     const SimState state = make_rest_state(model);
-    const BuildComparison comparison =
-        compare_force_builds(model, state, build_without(c.without), 1e-3, o.min_time_s, 11);
+    const BuildComparison comparison = compare_force_builds(
+        model, state, build_without(c.without), 1e-3, effect_off_run_s, kEffectOffRounds);
     worst_difference = std::max(worst_difference, comparison.relative_difference);
     std::cout << c.effect << " off: " << format(comparison.normal_ns_per_tet) << " ns/tet against "
               << format(comparison.other_ns_per_tet) << " without it" << std::endl;
@@ -525,8 +529,11 @@ int run_bench(const BenchOptions& o) {
      << "The force loops are also compiled without one effect each (`forces_variants.h`: the "
         "effect's branches and kernels are not in that build at all). Each row times the same "
         "scene, with that effect off, on the normal build and on the build without it, back to "
-        "back, 11 rounds (alternating which goes first); the times are each build's best, the "
-        "difference the median over the rounds of the ratio of the two runs; one thread, "
+        "back, "
+     << kEffectOffRounds << " rounds of runs of at least " << number(effect_off_run_s * 1e3)
+     << " ms (alternating which goes first; many short pairs: a pair seldom straddles a change "
+        "in this machine's speed); the times are each build's best, the difference the median "
+        "over the rounds of the ratio of the two runs; one thread, "
      << default_size.description << ".\n\n"
      << effect_off.str()
      << "\nGravity, lesions, cutting and haptics are not effects of the force loops: the engine "

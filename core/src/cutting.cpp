@@ -1172,9 +1172,8 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   }
   if (m.effects.viscous)
     for (std::size_t i = 0; i < m.tet_count; ++i)
-      for (int k = 0; k < ViscousHistory::kComponents; ++k)
-        next_state.viscous_history.value(k, i) =
-            state.viscous_history.value(k, static_cast<std::size_t>(element_origin[i]));
+      next_state.viscous_history.copy_element(state.viscous_history,
+                                              static_cast<std::size_t>(element_origin[i]), i);
   next_state.time_s = state.time_s;
   next_state.step_count = state.step_count;
   next_state.last_step_s = state.last_step_s;

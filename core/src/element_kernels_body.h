@@ -274,8 +274,9 @@ inline Matrix3 load_matrix(const double (&m)[9][kViscousBlock], std::size_t i) {
 // The law of elements [block, block + count): viscous_tissue_stress (viscous_tissue.cpp) without
 // its two rare branches. An element that yields or has collapsed is flagged, keeps its history
 // untouched here, and is updated by the general code afterwards. kUniform: every element of the
-// block is in the region `uniform_region` (its constants are then loaded once).
-template <bool kUniform>
+// block is in the region `uniform_region` (its constants are then loaded once). kPlastic: an
+// element of the block has Fp ≠ I; without, Fe = F and the products with Fp⁻¹ are skipped.
+template <bool kUniform, bool kPlastic>
 void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t count,
                  std::int32_t uniform_region, ViscousBlock& b, double& min_j_out, double& max_j_out,
                  double& dissipated_out) {
@@ -291,8 +292,10 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
   };
 
   // Fe = F·Fp⁻¹ (Fp⁻¹ stored column-major).
+  const double(&elastic_deformation)[9][kViscousBlock] =
+      kPlastic ? b.elastic_deformation : b.deformation;
 #pragma omp simd
-  for (std::size_t i = 0; i < count; ++i) {
+  for (std::size_t i = 0; i < (kPlastic ? count : 0); ++i) {
     const Matrix3 F = load_matrix(b.deformation, i);
 #pragma GCC unroll 3
     for (int a = 0; a < 3; ++a)
@@ -309,7 +312,7 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
   double min_j = min_j_out, max_j = max_j_out;
 #pragma omp simd reduction(min : min_j) reduction(max : max_j)
   for (std::size_t i = 0; i < count; ++i) {
-    const Matrix3 fe = load_matrix(b.elastic_deformation, i);
+    const Matrix3 fe = load_matrix(elastic_deformation, i);
     const Matrix3 cof = cofactor(fe);
     const double J = fe.m[0][0] * cof.m[0][0] + fe.m[1][0] * cof.m[1][0] + fe.m[2][0] * cof.m[2][0];
     min_j = min_of(min_j, J);
@@ -339,7 +342,7 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
   // S = g0·S_e + g1·H; the yield check on τ = Fe·S·Feᵀ; P = Fe·S·Fp⁻ᵀ.
 #pragma omp simd
   for (std::size_t i = 0; i < count; ++i) {
-    const Matrix3 fe = load_matrix(b.elastic_deformation, i);
+    const Matrix3 fe = load_matrix(elastic_deformation, i);
     const double g0 = constant(v.relaxed_fraction, i), g1 = constant(v.arm_fraction, i);
     double pk2[6];
 #pragma GCC unroll 6
@@ -373,9 +376,10 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
     for (int a = 0; a < 3; ++a)
 #pragma GCC unroll 3
       for (int j = 0; j < 3; ++j)
-        b.stress[3 * a + j][i] = feS[a][0] * history[(12 + j) * kViscousBlock + i] +
-                                 feS[a][1] * history[(15 + j) * kViscousBlock + i] +
-                                 feS[a][2] * history[(18 + j) * kViscousBlock + i];
+        b.stress[3 * a + j][i] = kPlastic ? feS[a][0] * history[(12 + j) * kViscousBlock + i] +
+                                                feS[a][1] * history[(15 + j) * kViscousBlock + i] +
+                                                feS[a][2] * history[(18 + j) * kViscousBlock + i]
+                                          : feS[a][j];
   }
 
   // The dashpots' work over the step: V·Δt/τ·(ψ(H before) + ψ(H)) (trapezoid of 2ψ/τ), with
@@ -433,10 +437,15 @@ void viscous_forces(const ViscousKernelData& data, std::size_t begin, std::size_
     const std::int32_t first_region = data.region[block];
     bool uniform = true;
     for (std::size_t i = 1; i < count; ++i) uniform &= data.region[block + i] == first_region;
-    if (uniform)
-      viscous_law<true>(data, block, count, first_region, b, min_j, max_j, dissipated);
+    const bool plastic = data.plastic_block[block / kViscousBlock] != 0;
+    if (uniform && !plastic)
+      viscous_law<true, false>(data, block, count, first_region, b, min_j, max_j, dissipated);
+    else if (uniform)
+      viscous_law<true, true>(data, block, count, first_region, b, min_j, max_j, dissipated);
+    else if (!plastic)
+      viscous_law<false, false>(data, block, count, first_region, b, min_j, max_j, dissipated);
     else
-      viscous_law<false>(data, block, count, first_region, b, min_j, max_j, dissipated);
+      viscous_law<false, true>(data, block, count, first_region, b, min_j, max_j, dissipated);
     if constexpr (kFibreFamilies > 0) {
 #pragma omp simd reduction(max : max_fibre)
       for (std::size_t i = 0; i < count; ++i) {

@@ -359,6 +359,7 @@ ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& positio
   data.elastic = elastic;
   data.region = model.region.data();
   data.history = viscous.history->block(0);
+  data.plastic_block = viscous.history->plastic_blocks();
   const double** fields[10] = {&data.mu_pa,
                                &data.lambda_pa,
                                &data.relaxed_fraction,

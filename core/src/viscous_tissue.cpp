@@ -255,10 +255,12 @@ Eigen::Matrix3d viscous_tissue_update(const Eigen::Matrix3d& F, const ViscousTis
 // ---------------------------------------------------------------- history of a mesh
 
 ViscousHistory::ViscousHistory(std::size_t elements)
-    : elements_(elements), values_((elements + kBlock - 1) / kBlock * kBlock * kComponents, 0.0) {
+    : elements_(elements),
+      values_((elements + kBlock - 1) / kBlock * kBlock * kComponents, 0.0),
+      plastic_blocks_((elements + kBlock - 1) / kBlock, 0) {
   for (std::size_t e = 0; e < elements; ++e)
     for (int k : {0, 4, 8})  // the diagonal of Fp⁻¹, column-major
-      value(kInversePlasticDeformation + k, e) = 1.0;
+      slot(kInversePlasticDeformation + k, e) = 1.0;
 }
 
 ViscousTissueState ViscousHistory::load(std::size_t e) const {
@@ -275,13 +277,22 @@ ViscousTissueState ViscousHistory::load(std::size_t e) const {
 
 void ViscousHistory::store(std::size_t e, const ViscousTissueState& history) {
   for (int k = 0; k < 6; ++k) {
-    value(kMaxwellStress + k, e) = history.maxwell_stress_pa[k];
-    value(kElasticStress + k, e) = history.elastic_stress_pa[k];
+    slot(kMaxwellStress + k, e) = history.maxwell_stress_pa[k];
+    slot(kElasticStress + k, e) = history.elastic_stress_pa[k];
   }
   for (int k = 0; k < 9; ++k)
-    value(kInversePlasticDeformation + k, e) = history.inverse_plastic_deformation.data()[k];
-  value(kEquivalentPlasticStrain, e) = history.equivalent_plastic_strain;
-  value(kYieldClock, e) = history.yield_clock_s;
+    slot(kInversePlasticDeformation + k, e) = history.inverse_plastic_deformation.data()[k];
+  slot(kEquivalentPlasticStrain, e) = history.equivalent_plastic_strain;
+  slot(kYieldClock, e) = history.yield_clock_s;
+  if (history.inverse_plastic_deformation != Eigen::Matrix3d::Identity())
+    plastic_blocks_[e / kBlock] = 1;
+}
+
+void ViscousHistory::copy_element(const ViscousHistory& from, std::size_t from_e,
+                                  std::size_t to_e) {
+  for (int k = 0; k < kComponents; ++k) slot(k, to_e) = from.value(k, from_e);
+  if (from.inverse_plastic_deformation(from_e) != Eigen::Matrix3d::Identity())
+    plastic_blocks_[to_e / kBlock] = 1;
 }
 
 Eigen::Matrix3d ViscousHistory::inverse_plastic_deformation(std::size_t e) const {

@@ -404,8 +404,10 @@ TEST(Cutting, CuttingThroughALesionBoundaryKeepsEachElementsRegionAndHistory) {
   SimState state = make_rest_state(model);
   // A history to carry: a different plastic strain and Maxwell stress in every element.
   for (std::size_t e = 0; e < model.tet_count; ++e) {
-    state.viscous_history.value(ViscousHistory::kEquivalentPlasticStrain, e) = 1e-3 * e;
-    state.viscous_history.value(ViscousHistory::kMaxwellStress + 2, e) = 0.5 * e;
+    ViscousTissueState history = state.viscous_history.load(e);
+    history.equivalent_plastic_strain = 1e-3 * e;
+    history.maxwell_stress_pa[2] = 0.5 * e;
+    state.viscous_history.store(e, history);
   }
   // Through the lesion's middle, down past it.
   const CutResult cut = cut_tissue(model, state, vertical_cut(0.031, 0.005), cut_anything());

@@ -180,5 +180,67 @@ TEST(Kernels, EverySpecialisedKernelEqualsTheGeneralOne) {
   EXPECT_EQ(combinations, 20);
 }
 
+// Blocks of the viscous loop whose elements have all kept Fp = I skip the products with Fp⁻¹;
+// blocks where one has flowed keep them. Both must give the general law's forces and history,
+// for tissue that flowed and has unloaded below the yield limit (updated by the loop itself).
+TEST(Kernels, ViscousLoopSkipsThePlasticProductsOnlyInBlocksThatNeverFlowed) {
+  // 480 tets in four layers of 120 along z, in blocks of 64: only the top layer (the last blocks,
+  // and elements of the layer below that touch a jittered node above 15 mm) is strained.
+  const TetMesh mesh = testing::block_mesh(5, 4, 4, {0.03, 0.02, 0.02}, 0.2);
+  ModelOptions options;
+  options.regions.resize(1);
+  options.regions[0].tissue = TissueMaterial{7000.0, 0.45, 1060.0};
+  options.regions[0].viscoelastic = ViscoelasticParameters{4000.0, 3000.0, 400.0};
+  options.regions[0].viscoplastic = ViscoplasticParameters{20.0, 500.0, 0.5};
+  const SimModel model = build_model(mesh, options);
+  SimState state = make_rest_state(model);
+  const std::size_t blocks =
+      (model.tet_count + ViscousHistory::kBlock - 1) / ViscousHistory::kBlock;
+  // A shear of the top layer (z above 15 mm), loaded past the yield limit, then half unloaded.
+  for (const double shear : {0.3, 0.15}) {
+    for (std::size_t n = 0; n < model.node_count; ++n) {
+      const Eigen::Vector3d rest = model.rest_position_m.at(n);
+      state.position_m.set(
+          n, rest + Eigen::Vector3d(shear * std::max(0.0, rest.z() - 0.015), 0.0, 0.0));
+    }
+    ViscousHistory expected_history = state.viscous_history;
+    const NodeArray expected = reference_forces(model, state.position_m, expected_history, 0.01);
+    const ViscousHistory before = state.viscous_history;
+    compute_internal_forces(model, state, 0.01);
+    double scale = 0.0, difference = 0.0;
+    for (std::size_t n = 0; n < model.node_count; ++n) {
+      scale = std::max(scale, expected.at(n).norm());
+      difference = std::max(difference, (state.force_n.at(n) - expected.at(n)).norm());
+    }
+    ASSERT_GT(scale, 0.0);
+    EXPECT_LE(difference, 1e-12 * scale) << "shear " << shear;
+    // Round-off relative to each component's largest value (stresses of kPa; Fp⁻¹ of 1).
+    for (int k = 0; k < ViscousHistory::kComponents; ++k) {
+      double component_scale = 0.0, component_difference = 0.0;
+      for (std::size_t e = 0; e < model.tet_count; ++e) {
+        const double value = expected_history.value(k, e);
+        component_scale = std::max(component_scale, std::abs(value));
+        component_difference =
+            std::max(component_difference, std::abs(state.viscous_history.value(k, e) - value));
+      }
+      EXPECT_LE(component_difference, 1e-12 * component_scale)
+          << "history component " << k << ", shear " << shear;
+    }
+    const long plastic_blocks =
+        std::count(state.viscous_history.plastic_blocks(),
+                   state.viscous_history.plastic_blocks() + blocks, std::uint8_t{1});
+    EXPECT_GT(plastic_blocks, 0) << "shear " << shear;
+    EXPECT_LT(plastic_blocks, static_cast<long>(blocks)) << "shear " << shear;
+    if (shear < 0.3) {
+      // The unloading step: flowed elements that the loop itself updated, with their Fp⁻¹.
+      long updated_after_flow = 0;
+      for (std::size_t e = 0; e < model.tet_count; ++e)
+        updated_after_flow += !state.force_scratch.needs_general[e] &&
+                              before.inverse_plastic_deformation(e) != Eigen::Matrix3d::Identity();
+      EXPECT_GT(updated_after_flow, 0);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace liversim

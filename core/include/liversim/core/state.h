@@ -89,6 +89,9 @@ struct IntegratorScratch {
   bool factorisation_valid = false;  // implicit: the last factorisation may be reused
   double factorised_beta_s = 0.0;
   int last_newton_iterations = 0;
+  // Krylov iterations of the first Newton solve on the current factorisation (0: none yet): the
+  // count that the factorisation's own tangent mismatch costs, whatever its age.
+  int fresh_krylov_iterations = 0;
   // Error estimate of the fixed-step schemes: the velocity at the end of the last steps.
   std::array<NodeArray, 3> velocity_history;
   int history_count = 0;

@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -140,18 +141,25 @@ class ViscousHistory {
     return value(kEquivalentPlasticStrain, e);
   }
 
-  double& value(int k, std::size_t e) { return block(e)[k * kBlock + e % kBlock]; }
   double value(int k, std::size_t e) const {
     return values_[(e / kBlock * kComponents + k) * kBlock + e % kBlock];
   }
+  // Element from_e's whole history in `from` becomes element to_e's here.
+  void copy_element(const ViscousHistory& from, std::size_t from_e, std::size_t to_e);
   // The block holding element e.
   double* block(std::size_t e) { return values_.data() + e / kBlock * kComponents * kBlock; }
+  // Per block of kBlock elements: 1 once an element of it has stored Fp ≠ I. Blocks with 0 skip
+  // the products with Fp⁻¹ (most tissue never yields).
+  const std::uint8_t* plastic_blocks() const { return plastic_blocks_.data(); }
 
   bool operator==(const ViscousHistory&) const = default;
 
  private:
+  double& slot(int k, std::size_t e) { return block(e)[k * kBlock + e % kBlock]; }
+
   std::size_t elements_ = 0;
   std::vector<double> values_;
+  std::vector<std::uint8_t> plastic_blocks_;
 };
 
 // First Piola–Kirchhoff stress P (Pa) at deformation gradient F, `step.dt_s` after the state
