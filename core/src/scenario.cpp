@@ -89,6 +89,8 @@ constexpr MetricInfo kMetrics[] = {
     {"mean_force_n", "N", "mean force while in contact"},
     {"rms_force_n", "N", "root mean square force while in contact"},
     {"time_above_safe_force_s", "s", "time the force exceeded the safe threshold"},
+    {"force_integral_n_s", "N·s", "force on the tissue integrated over the session"},
+    {"peak_force_rate_n_per_s", "N/s", "fastest change of the force between servo frames"},
     {"tissue_damage_mm3", "mm³", "volume of tissue strained beyond the damage strain"},
     {"resected_volume_mm3", "mm³", "volume of the pieces cut free"},
     {"lesion_margin_mm", "mm", "least distance from the cut surface to the lesion"},
