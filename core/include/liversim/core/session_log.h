@@ -1,0 +1,114 @@
+#pragma once
+// What a training session leaves behind: the servo's frames at ~1 kHz, the events (grasp, cut,
+// excessive force...) and, at its end, the servo's statistics; and the storage they go to, behind
+// a small interface (SqliteSessionStore is the embedded one). docs/session-storage.md describes
+// the schema and the layout of the frame chunks.
+
+#include "liversim/core/haptics.h"
+#include "liversim/core/servo_loop.h"
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace liversim {
+
+// A storage failure: names the database file and what is wrong with it (read-only, damaged, full,
+// written by a newer version...).
+class StorageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class SessionEventKind {
+  grasp,
+  release,
+  cut,
+  excessive_force,
+  lesion_breach,
+  simulation_recovery,
+  device_fault,
+  tool_selected,  // detail: the tool's name
+};
+std::string_view session_event_name(SessionEventKind kind);
+std::optional<SessionEventKind> session_event_kind(std::string_view name);
+
+struct SessionEvent {
+  double time_s = 0.0;  // servo clock, as the frames
+  SessionEventKind kind = SessionEventKind::grasp;
+  std::string detail;
+  bool operator==(const SessionEvent&) const = default;
+};
+
+// recording: a writer has it open (or had, until it was killed: the next writer to open the
+// database marks it incomplete); complete: ended normally.
+enum class SessionStatus { recording, complete, incomplete };
+std::string_view session_status_name(SessionStatus status);
+
+struct SessionStart {
+  std::string trainee;  // a person of role trainee, added on first use
+  std::string scenario_title;
+  std::string scenario_text;  // the exact scenario file content the session runs
+  std::string device;         // the haptic device's name
+  std::int64_t started_unix_ms = 0;
+};
+
+// The servo's figures of a session (ServoStats reduced to what is kept).
+struct SessionServoFigures {
+  std::uint64_t ticks = 0;
+  double rate_hz = 0.0;
+  double period_p50_ms = 0.0, period_p99_ms = 0.0, period_max_ms = 0.0;
+  std::uint64_t missed_deadlines = 0, force_clamps = 0, stiffness_clamps = 0, rate_limited = 0,
+                watchdog_trips = 0, device_faults = 0, dropped_frames = 0;
+  bool operator==(const SessionServoFigures&) const = default;
+};
+SessionServoFigures servo_figures(const ServoStats& stats, std::uint64_t dropped_frames);
+
+struct SessionSummary {
+  std::int64_t id = 0;
+  std::string trainee;
+  std::string scenario_title;
+  std::string scenario_sha256;
+  std::string device;
+  std::int64_t started_unix_ms = 0;
+  std::optional<std::int64_t> ended_unix_ms;
+  SessionStatus status = SessionStatus::recording;
+  std::int64_t frame_count = 0;
+  std::optional<SessionServoFigures> servo;  // set when the session ended normally
+};
+
+// Frames travel and are stored in chunks (one per commit): a documented, versioned byte layout
+// (docs/session-storage.md), little-endian whatever the machine. Exact: doubles keep every bit.
+inline constexpr int kFrameChunkLayout = 1;
+std::vector<std::uint8_t> encode_frame_chunk(std::span<const ServoFrame> frames);
+// Throws StorageError when the bytes are not a layout-1 chunk (wrong magic, size or count).
+std::vector<ServoFrame> decode_frame_chunk(std::span<const std::uint8_t> bytes);
+
+// Where sessions go. One writer: the recorder's thread calls the writing functions; a writer's
+// appends become durable together at commit(). Every function may throw StorageError.
+class SessionStore {
+ public:
+  virtual ~SessionStore() = default;
+
+  // A new session, status recording, committed at once; returns its id.
+  virtual std::int64_t begin_session(const SessionStart& start) = 0;
+  // The session's next frames (in order, after those appended before) and events.
+  virtual void append_frames(std::int64_t session, std::span<const ServoFrame> frames) = 0;
+  virtual void append_events(std::int64_t session, std::span<const SessionEvent> events) = 0;
+  virtual void commit() = 0;
+  // Ends the session normally: status complete, end time and servo figures; commits.
+  virtual void end_session(std::int64_t session, std::int64_t ended_unix_ms,
+                           const SessionServoFigures& servo) = 0;
+
+  virtual std::vector<SessionSummary> sessions() = 0;
+  virtual std::vector<ServoFrame> frames(std::int64_t session) = 0;
+  virtual std::vector<SessionEvent> events(std::int64_t session) = 0;
+  // The exact scenario text the session ran.
+  virtual std::string scenario_text(std::int64_t session) = 0;
+};
+
+}  // namespace liversim

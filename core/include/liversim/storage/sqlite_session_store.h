@@ -1,0 +1,66 @@
+#pragma once
+// The embedded session store: one SQLite file (WAL, prepared statements, bound parameters only).
+// Schema and frame layout: docs/session-storage.md. A separate library from the engine
+// (liversim_storage) so that the engine itself needs no database.
+
+#include "liversim/core/session_log.h"
+
+#include <filesystem>
+#include <memory>
+
+struct sqlite3;
+
+namespace liversim {
+
+class SqliteSessionStore final : public SessionStore {
+ public:
+  enum class Access { read_write, read_only };
+
+  // The schema version this build writes; files at older versions are migrated on opening.
+  static constexpr int kSchemaVersion = 1;
+
+  // Opens the file, creating it (read_write) if it does not exist. Throws StorageError naming the
+  // file when it cannot be opened, is not a LiverSim database, is damaged, is read-only while
+  // read_write was asked for, or was written by a newer version. Opened for writing, sessions
+  // left recording by a writer that was killed are marked incomplete.
+  explicit SqliteSessionStore(const std::filesystem::path& file,
+                              Access access = Access::read_write);
+  ~SqliteSessionStore() override;
+  SqliteSessionStore(const SqliteSessionStore&) = delete;
+  SqliteSessionStore& operator=(const SqliteSessionStore&) = delete;
+
+  const std::filesystem::path& file() const { return file_; }
+  int schema_version();
+  // PRAGMA integrity_check: "ok", or what SQLite found.
+  std::string integrity_check();
+  // Caps the file at this many pages (SQLite's max_page_count): what a full disk does.
+  void limit_pages_for_testing(std::int64_t pages);
+
+  std::int64_t begin_session(const SessionStart& start) override;
+  void append_frames(std::int64_t session, std::span<const ServoFrame> frames) override;
+  void append_events(std::int64_t session, std::span<const SessionEvent> events) override;
+  void commit() override;
+  void end_session(std::int64_t session, std::int64_t ended_unix_ms,
+                   const SessionServoFigures& servo) override;
+
+  std::vector<SessionSummary> sessions() override;
+  std::vector<ServoFrame> frames(std::int64_t session) override;
+  std::vector<SessionEvent> events(std::int64_t session) override;
+  std::string scenario_text(std::int64_t session) override;
+
+ private:
+  class Statement;
+  void execute(const char* sql, const char* doing);
+  void begin_if_needed();
+  // An error about this file: "sessions database FILE: what".
+  StorageError error(const std::string& what) const;
+  [[noreturn]] void fail(const std::string& doing);
+  Statement& prepared(int which, const char* sql);
+
+  std::filesystem::path file_;
+  sqlite3* db_ = nullptr;
+  bool in_transaction_ = false;
+  std::vector<std::unique_ptr<Statement>> statements_;
+};
+
+}  // namespace liversim

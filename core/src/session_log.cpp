@@ -1,0 +1,127 @@
+#include "liversim/core/session_log.h"
+
+#include <array>
+#include <bit>
+#include <cstring>
+
+namespace liversim {
+
+namespace {
+
+constexpr std::array<std::string_view, 8> kEventNames = {"grasp",         "release",
+                                                         "cut",           "excessive_force",
+                                                         "lesion_breach", "simulation_recovery",
+                                                         "device_fault",  "tool_selected"};
+
+// Layout 1: "LSF1", the frame count (u32), then one column per quantity, frame by frame: time,
+// position x, y, z, velocity x, y, z, force x, y, z (IEEE doubles), buttons (u32). Columns keep
+// like values together, which is what a compressing layout 2 would want.
+constexpr std::array<char, 4> kMagic = {'L', 'S', 'F', '1'};
+constexpr std::size_t kHeaderBytes = 8;
+constexpr std::size_t kBytesPerFrame = 10 * 8 + 4;
+
+void put_u32(std::uint8_t* out, std::uint32_t value) {
+  for (int b = 0; b < 4; ++b) out[b] = static_cast<std::uint8_t>(value >> (8 * b));
+}
+void put_f64(std::uint8_t* out, double value) {
+  const auto bits = std::bit_cast<std::uint64_t>(value);
+  for (int b = 0; b < 8; ++b) out[b] = static_cast<std::uint8_t>(bits >> (8 * b));
+}
+std::uint32_t get_u32(const std::uint8_t* in) {
+  std::uint32_t value = 0;
+  for (int b = 0; b < 4; ++b) value |= static_cast<std::uint32_t>(in[b]) << (8 * b);
+  return value;
+}
+double get_f64(const std::uint8_t* in) {
+  std::uint64_t bits = 0;
+  for (int b = 0; b < 8; ++b) bits |= static_cast<std::uint64_t>(in[b]) << (8 * b);
+  return std::bit_cast<double>(bits);
+}
+
+// The ten double columns of a frame, in layout order.
+template <typename Frame, typename Visit>
+void for_each_double(Frame& frame, Visit&& visit) {
+  visit(frame.time_s);
+  for (int k = 0; k < 3; ++k) visit(frame.sample.position_mm[k]);
+  for (int k = 0; k < 3; ++k) visit(frame.sample.velocity_mm_per_s[k]);
+  for (int k = 0; k < 3; ++k) visit(frame.force_n[k]);
+}
+
+}  // namespace
+
+std::string_view session_event_name(SessionEventKind kind) {
+  return kEventNames[static_cast<std::size_t>(kind)];
+}
+
+std::optional<SessionEventKind> session_event_kind(std::string_view name) {
+  for (std::size_t k = 0; k < kEventNames.size(); ++k)
+    if (kEventNames[k] == name) return static_cast<SessionEventKind>(k);
+  return std::nullopt;
+}
+
+std::string_view session_status_name(SessionStatus status) {
+  switch (status) {
+    case SessionStatus::recording:
+      return "recording";
+    case SessionStatus::complete:
+      return "complete";
+    case SessionStatus::incomplete:
+      return "incomplete";
+  }
+  return "incomplete";
+}
+
+SessionServoFigures servo_figures(const ServoStats& stats, std::uint64_t dropped_frames) {
+  SessionServoFigures f;
+  f.ticks = stats.ticks;
+  f.rate_hz = stats.rate_hz();
+  f.period_p50_ms = stats.period_percentile_s(0.5) * 1e3;
+  f.period_p99_ms = stats.period_percentile_s(0.99) * 1e3;
+  f.period_max_ms = stats.max_period_s * 1e3;
+  f.missed_deadlines = stats.missed_deadlines;
+  f.force_clamps = stats.force_clamps;
+  f.stiffness_clamps = stats.stiffness_clamps;
+  f.rate_limited = stats.rate_limited;
+  f.watchdog_trips = stats.watchdog_trips;
+  f.device_faults = stats.device_faults;
+  f.dropped_frames = dropped_frames;
+  return f;
+}
+
+std::vector<std::uint8_t> encode_frame_chunk(std::span<const ServoFrame> frames) {
+  const std::size_t n = frames.size();
+  std::vector<std::uint8_t> bytes(kHeaderBytes + n * kBytesPerFrame);
+  std::memcpy(bytes.data(), kMagic.data(), kMagic.size());
+  put_u32(bytes.data() + 4, static_cast<std::uint32_t>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t column = 0;
+    for_each_double(frames[i], [&](double value) {
+      put_f64(bytes.data() + kHeaderBytes + (column * n + i) * 8, value);
+      ++column;
+    });
+    put_u32(bytes.data() + kHeaderBytes + 80 * n + i * 4, frames[i].sample.buttons);
+  }
+  return bytes;
+}
+
+std::vector<ServoFrame> decode_frame_chunk(std::span<const std::uint8_t> bytes) {
+  if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0)
+    throw StorageError("a frame chunk does not start with the layout-1 mark \"LSF1\"");
+  const std::size_t n = get_u32(bytes.data() + 4);
+  if (bytes.size() != kHeaderBytes + n * kBytesPerFrame)
+    throw StorageError("a frame chunk of " + std::to_string(n) + " frames has " +
+                       std::to_string(bytes.size()) + " bytes, expected " +
+                       std::to_string(kHeaderBytes + n * kBytesPerFrame));
+  std::vector<ServoFrame> frames(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t column = 0;
+    for_each_double(frames[i], [&](double& value) {
+      value = get_f64(bytes.data() + kHeaderBytes + (column * n + i) * 8);
+      ++column;
+    });
+    frames[i].sample.buttons = get_u32(bytes.data() + kHeaderBytes + 80 * n + i * 4);
+  }
+  return frames;
+}
+
+}  // namespace liversim

@@ -1,0 +1,529 @@
+#include "liversim/storage/sqlite_session_store.h"
+
+#include "liversim/core/sha256.h"
+
+#include <sqlite3.h>
+
+#include <array>
+
+namespace liversim {
+
+namespace {
+
+// Version 1. Each later version adds its step to kMigrations (and a test that opens a file of
+// every earlier version).
+constexpr const char* kSchemaV1 = R"sql(
+CREATE TABLE people (
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL,
+  role TEXT NOT NULL CHECK (role IN ('trainee', 'instructor')),
+  UNIQUE (name, role)
+);
+CREATE TABLE scenarios (
+  id INTEGER PRIMARY KEY,
+  sha256 TEXT NOT NULL UNIQUE,
+  title TEXT NOT NULL,
+  content TEXT NOT NULL
+);
+CREATE TABLE sessions (
+  id INTEGER PRIMARY KEY,
+  trainee_id INTEGER NOT NULL REFERENCES people (id),
+  scenario_id INTEGER NOT NULL REFERENCES scenarios (id),
+  device TEXT NOT NULL,
+  started_unix_ms INTEGER NOT NULL,
+  ended_unix_ms INTEGER,
+  status TEXT NOT NULL CHECK (status IN ('recording', 'complete', 'incomplete')),
+  frame_count INTEGER NOT NULL DEFAULT 0,
+  servo_ticks INTEGER,
+  servo_rate_hz REAL,
+  servo_period_p50_ms REAL,
+  servo_period_p99_ms REAL,
+  servo_period_max_ms REAL,
+  missed_deadlines INTEGER,
+  force_clamps INTEGER,
+  stiffness_clamps INTEGER,
+  rate_limited INTEGER,
+  watchdog_trips INTEGER,
+  device_faults INTEGER,
+  dropped_frames INTEGER
+);
+CREATE TABLE frame_chunks (
+  session_id INTEGER NOT NULL REFERENCES sessions (id),
+  first_frame INTEGER NOT NULL,
+  frame_count INTEGER NOT NULL,
+  first_time_s REAL NOT NULL,
+  last_time_s REAL NOT NULL,
+  layout INTEGER NOT NULL,
+  data BLOB NOT NULL,
+  PRIMARY KEY (session_id, first_frame)
+) WITHOUT ROWID;
+CREATE TABLE events (
+  id INTEGER PRIMARY KEY,
+  session_id INTEGER NOT NULL REFERENCES sessions (id),
+  time_s REAL NOT NULL,
+  kind TEXT NOT NULL,
+  detail TEXT NOT NULL
+);
+CREATE INDEX events_by_session ON events (session_id, time_s);
+CREATE TABLE metrics (
+  session_id INTEGER NOT NULL REFERENCES sessions (id),
+  name TEXT NOT NULL,
+  value REAL NOT NULL,
+  PRIMARY KEY (session_id, name)
+);
+CREATE TABLE grades (
+  id INTEGER PRIMARY KEY,
+  session_id INTEGER NOT NULL REFERENCES sessions (id),
+  instructor_id INTEGER NOT NULL REFERENCES people (id),
+  graded_unix_ms INTEGER NOT NULL,
+  score REAL,
+  grade TEXT NOT NULL,
+  comment TEXT NOT NULL
+);
+)sql";
+
+// kMigrations[v] takes a file from version v to v + 1 (version 0: a new, empty file).
+constexpr std::array<const char*, 1> kMigrations = {kSchemaV1};
+static_assert(kMigrations.size() == SqliteSessionStore::kSchemaVersion);
+
+enum StatementId {
+  kFindPerson,
+  kAddPerson,
+  kFindScenario,
+  kAddScenario,
+  kAddSession,
+  kFrameCount,
+  kAddChunk,
+  kCountFrames,
+  kAddEvent,
+  kEndSession,
+  kSessions,
+  kChunks,
+  kEvents,
+  kScenarioText,
+  kStatementCount
+};
+
+}  // namespace
+
+// A prepared statement, reset after each use.
+class SqliteSessionStore::Statement {
+ public:
+  Statement(SqliteSessionStore& store, const char* sql) : store_(store) {
+    if (sqlite3_prepare_v2(store.db_, sql, -1, &statement_, nullptr) != SQLITE_OK)
+      store.fail("preparing a query");
+  }
+  ~Statement() { sqlite3_finalize(statement_); }
+  Statement& bind(int index, std::int64_t value) {
+    check(sqlite3_bind_int64(statement_, index, value));
+    return *this;
+  }
+  Statement& bind(int index, double value) {
+    check(sqlite3_bind_double(statement_, index, value));
+    return *this;
+  }
+  Statement& bind(int index, std::string_view text) {
+    check(sqlite3_bind_text(statement_, index, text.data(), static_cast<int>(text.size()),
+                            SQLITE_TRANSIENT));
+    return *this;
+  }
+  Statement& bind(int index, std::span<const std::uint8_t> bytes) {
+    check(sqlite3_bind_blob(statement_, index, bytes.data(), static_cast<int>(bytes.size()),
+                            SQLITE_TRANSIENT));
+    return *this;
+  }
+  // True while there is a row; throws on an error.
+  bool step(const char* doing) {
+    const int result = sqlite3_step(statement_);
+    if (result == SQLITE_ROW) return true;
+    if (result == SQLITE_DONE) return false;
+    sqlite3_reset(statement_);  // keeps the error for fail() to read
+    store_.fail(doing);
+  }
+  void run(const char* doing) {
+    while (step(doing)) {
+    }
+    reset();
+  }
+  void reset() {
+    sqlite3_reset(statement_);
+    sqlite3_clear_bindings(statement_);
+  }
+  std::int64_t integer(int column) const { return sqlite3_column_int64(statement_, column); }
+  double real(int column) const { return sqlite3_column_double(statement_, column); }
+  bool is_null(int column) const { return sqlite3_column_type(statement_, column) == SQLITE_NULL; }
+  std::string text(int column) const {
+    const auto* data = sqlite3_column_text(statement_, column);
+    return data ? std::string(reinterpret_cast<const char*>(data),
+                              static_cast<std::size_t>(sqlite3_column_bytes(statement_, column)))
+                : std::string();
+  }
+  std::span<const std::uint8_t> blob(int column) const {
+    const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(statement_, column));
+    return {data, static_cast<std::size_t>(sqlite3_column_bytes(statement_, column))};
+  }
+
+ private:
+  void check(int result) {
+    if (result != SQLITE_OK) store_.fail("binding a query parameter");
+  }
+  SqliteSessionStore& store_;
+  sqlite3_stmt* statement_ = nullptr;
+};
+
+SqliteSessionStore::SqliteSessionStore(const std::filesystem::path& file, Access access)
+    : file_(file) {
+  const int flags = access == Access::read_write ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE
+                                                 : SQLITE_OPEN_READONLY;
+  if (sqlite3_open_v2(file.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
+    const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw error("cannot open it (" + message + ")");
+  }
+  statements_.resize(kStatementCount);
+  try {
+    sqlite3_extended_result_codes(db_, 1);
+    sqlite3_busy_timeout(db_, 2000);
+    // Reading the version reads the header: a file that is no database fails here.
+    const int version = schema_version();
+    if (version > kSchemaVersion)
+      throw error("written by a newer LiverSim (schema version " + std::to_string(version) +
+                  "; this one reads up to " + std::to_string(kSchemaVersion) + ")");
+    if (access == Access::read_write && sqlite3_db_readonly(db_, "main") == 1)
+      throw error("cannot write to it (the file is read-only)");
+    if (version == 0) {
+      Statement tables(*this, "SELECT count(*) FROM sqlite_master");
+      tables.step("reading the tables");
+      if (tables.integer(0) != 0)
+        throw error("not a LiverSim sessions database (it holds other tables)");
+    }
+    if (access == Access::read_write) {
+      execute("PRAGMA journal_mode = WAL", "opening it for writing");
+      // With WAL: durable against a killed process (not against a power cut).
+      execute("PRAGMA synchronous = NORMAL", "opening it for writing");
+      execute("PRAGMA foreign_keys = ON", "opening it for writing");
+      for (int v = version; v < kSchemaVersion; ++v) {
+        const std::string doing = "migrating it to schema version " + std::to_string(v + 1);
+        execute("BEGIN IMMEDIATE", doing.c_str());
+        execute(kMigrations[static_cast<std::size_t>(v)], doing.c_str());
+        execute(("PRAGMA user_version = " + std::to_string(v + 1)).c_str(), doing.c_str());
+        execute("COMMIT", doing.c_str());
+      }
+      // A writer killed mid-session left it recording: it is over, not lost.
+      execute("UPDATE sessions SET status = 'incomplete' WHERE status = 'recording'",
+              "closing sessions left recording");
+    } else if (version < kSchemaVersion) {
+      throw error("schema version " + std::to_string(version) +
+                  " needs migrating; open it for writing once");
+    }
+  } catch (...) {
+    statements_.clear();
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw;
+  }
+}
+
+SqliteSessionStore::~SqliteSessionStore() {
+  if (in_transaction_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  statements_.clear();
+  sqlite3_close(db_);
+}
+
+StorageError SqliteSessionStore::error(const std::string& what) const {
+  return StorageError("sessions database " + file_.string() + ": " + what);
+}
+
+void SqliteSessionStore::fail(const std::string& doing) {
+  const int code = sqlite3_extended_errcode(db_);
+  std::string what = sqlite3_errmsg(db_);
+  switch (code & 0xff) {
+    case SQLITE_FULL:
+      what = "the disk or the database is full (" + what + ")";
+      break;
+    case SQLITE_CORRUPT:
+      what = "the file is damaged (" + what + ")";
+      break;
+    case SQLITE_NOTADB:
+      what = "not a database file (" + what + ")";
+      break;
+    case SQLITE_READONLY:
+      what = "the file is read-only (" + what + ")";
+      break;
+    case SQLITE_IOERR:
+      what = "the file could not be read or written (" + what + ")";
+      break;
+    default:
+      break;
+  }
+  throw error(doing + " failed: " + what);
+}
+
+void SqliteSessionStore::execute(const char* sql, const char* doing) {
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, nullptr) != SQLITE_OK) fail(doing);
+}
+
+SqliteSessionStore::Statement& SqliteSessionStore::prepared(int which, const char* sql) {
+  auto& slot = statements_[static_cast<std::size_t>(which)];
+  if (!slot) slot = std::make_unique<Statement>(*this, sql);
+  return *slot;
+}
+
+int SqliteSessionStore::schema_version() {
+  Statement version(*this, "PRAGMA user_version");
+  version.step("reading it");
+  return static_cast<int>(version.integer(0));
+}
+
+std::string SqliteSessionStore::integrity_check() {
+  Statement check(*this, "PRAGMA integrity_check");
+  std::string result;
+  while (check.step("checking integrity")) result += (result.empty() ? "" : "; ") + check.text(0);
+  return result;
+}
+
+void SqliteSessionStore::limit_pages_for_testing(std::int64_t pages) {
+  execute(("PRAGMA max_page_count = " + std::to_string(pages)).c_str(), "capping its size");
+}
+
+void SqliteSessionStore::begin_if_needed() {
+  if (in_transaction_) return;
+  if (sqlite3_exec(db_, "BEGIN", nullptr, nullptr, nullptr) != SQLITE_OK)
+    fail("starting a transaction");
+  in_transaction_ = true;
+}
+
+void SqliteSessionStore::commit() {
+  if (!in_transaction_) return;
+  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
+    const std::string doing = "committing";
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    in_transaction_ = false;
+    fail(doing);
+  }
+  in_transaction_ = false;
+}
+
+std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
+  begin_if_needed();
+  Statement& find_person =
+      prepared(kFindPerson, "SELECT id FROM people WHERE name = ?1 AND role = 'trainee'");
+  find_person.bind(1, std::string_view(start.trainee));
+  std::int64_t trainee = 0;
+  if (find_person.step("looking up the trainee")) {
+    trainee = find_person.integer(0);
+    find_person.reset();
+  } else {
+    find_person.reset();
+    prepared(kAddPerson, "INSERT INTO people (name, role) VALUES (?1, 'trainee')")
+        .bind(1, std::string_view(start.trainee))
+        .run("adding the trainee");
+    trainee = sqlite3_last_insert_rowid(db_);
+  }
+  const std::string hash = sha256_hex(start.scenario_text);
+  Statement& find_scenario = prepared(kFindScenario, "SELECT id FROM scenarios WHERE sha256 = ?1");
+  find_scenario.bind(1, std::string_view(hash));
+  std::int64_t scenario = 0;
+  if (find_scenario.step("looking up the scenario")) {
+    scenario = find_scenario.integer(0);
+    find_scenario.reset();
+  } else {
+    find_scenario.reset();
+    prepared(kAddScenario, "INSERT INTO scenarios (sha256, title, content) VALUES (?1, ?2, ?3)")
+        .bind(1, std::string_view(hash))
+        .bind(2, std::string_view(start.scenario_title))
+        .bind(3, std::string_view(start.scenario_text))
+        .run("storing the scenario");
+    scenario = sqlite3_last_insert_rowid(db_);
+  }
+  prepared(kAddSession,
+           "INSERT INTO sessions (trainee_id, scenario_id, device, started_unix_ms, status) "
+           "VALUES (?1, ?2, ?3, ?4, 'recording')")
+      .bind(1, trainee)
+      .bind(2, scenario)
+      .bind(3, std::string_view(start.device))
+      .bind(4, start.started_unix_ms)
+      .run("adding the session");
+  const std::int64_t session = sqlite3_last_insert_rowid(db_);
+  commit();
+  return session;
+}
+
+void SqliteSessionStore::append_frames(std::int64_t session, std::span<const ServoFrame> frames) {
+  if (frames.empty()) return;
+  begin_if_needed();
+  Statement& count = prepared(kFrameCount, "SELECT frame_count FROM sessions WHERE id = ?1");
+  count.bind(1, session);
+  if (!count.step("reading the session's frame count")) {
+    count.reset();
+    throw error("there is no session " + std::to_string(session));
+  }
+  const std::int64_t first = count.integer(0);
+  count.reset();
+  const std::vector<std::uint8_t> bytes = encode_frame_chunk(frames);
+  prepared(kAddChunk,
+           "INSERT INTO frame_chunks (session_id, first_frame, frame_count, first_time_s, "
+           "last_time_s, layout, data) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)")
+      .bind(1, session)
+      .bind(2, first)
+      .bind(3, static_cast<std::int64_t>(frames.size()))
+      .bind(4, frames.front().time_s)
+      .bind(5, frames.back().time_s)
+      .bind(6, std::int64_t{kFrameChunkLayout})
+      .bind(7, std::span<const std::uint8_t>(bytes))
+      .run("storing frames");
+  prepared(kCountFrames, "UPDATE sessions SET frame_count = frame_count + ?2 WHERE id = ?1")
+      .bind(1, session)
+      .bind(2, static_cast<std::int64_t>(frames.size()))
+      .run("counting frames");
+}
+
+void SqliteSessionStore::append_events(std::int64_t session, std::span<const SessionEvent> events) {
+  if (events.empty()) return;
+  begin_if_needed();
+  Statement& add = prepared(
+      kAddEvent, "INSERT INTO events (session_id, time_s, kind, detail) VALUES (?1, ?2, ?3, ?4)");
+  for (const SessionEvent& event : events)
+    add.bind(1, session)
+        .bind(2, event.time_s)
+        .bind(3, session_event_name(event.kind))
+        .bind(4, std::string_view(event.detail))
+        .run("storing an event");
+}
+
+void SqliteSessionStore::end_session(std::int64_t session, std::int64_t ended_unix_ms,
+                                     const SessionServoFigures& servo) {
+  begin_if_needed();
+  auto count = [](std::uint64_t value) { return static_cast<std::int64_t>(value); };
+  prepared(kEndSession,
+           "UPDATE sessions SET status = 'complete', ended_unix_ms = ?2, servo_ticks = ?3, "
+           "servo_rate_hz = ?4, servo_period_p50_ms = ?5, servo_period_p99_ms = ?6, "
+           "servo_period_max_ms = ?7, missed_deadlines = ?8, force_clamps = ?9, "
+           "stiffness_clamps = ?10, rate_limited = ?11, watchdog_trips = ?12, "
+           "device_faults = ?13, dropped_frames = ?14 WHERE id = ?1")
+      .bind(1, session)
+      .bind(2, ended_unix_ms)
+      .bind(3, count(servo.ticks))
+      .bind(4, servo.rate_hz)
+      .bind(5, servo.period_p50_ms)
+      .bind(6, servo.period_p99_ms)
+      .bind(7, servo.period_max_ms)
+      .bind(8, count(servo.missed_deadlines))
+      .bind(9, count(servo.force_clamps))
+      .bind(10, count(servo.stiffness_clamps))
+      .bind(11, count(servo.rate_limited))
+      .bind(12, count(servo.watchdog_trips))
+      .bind(13, count(servo.device_faults))
+      .bind(14, count(servo.dropped_frames))
+      .run("ending the session");
+  if (sqlite3_changes(db_) != 1) throw error("there is no session " + std::to_string(session));
+  commit();
+}
+
+std::vector<SessionSummary> SqliteSessionStore::sessions() {
+  Statement& rows = prepared(
+      kSessions,
+      "SELECT s.id, p.name, c.title, c.sha256, s.device, s.started_unix_ms, s.ended_unix_ms, "
+      "s.status, s.frame_count, s.servo_ticks, s.servo_rate_hz, s.servo_period_p50_ms, "
+      "s.servo_period_p99_ms, s.servo_period_max_ms, s.missed_deadlines, s.force_clamps, "
+      "s.stiffness_clamps, s.rate_limited, s.watchdog_trips, s.device_faults, s.dropped_frames "
+      "FROM sessions s JOIN people p ON p.id = s.trainee_id "
+      "JOIN scenarios c ON c.id = s.scenario_id ORDER BY s.id");
+  std::vector<SessionSummary> result;
+  while (rows.step("listing sessions")) {
+    SessionSummary s;
+    s.id = rows.integer(0);
+    s.trainee = rows.text(1);
+    s.scenario_title = rows.text(2);
+    s.scenario_sha256 = rows.text(3);
+    s.device = rows.text(4);
+    s.started_unix_ms = rows.integer(5);
+    if (!rows.is_null(6)) s.ended_unix_ms = rows.integer(6);
+    const std::string status = rows.text(7);
+    s.status = status == "complete"    ? SessionStatus::complete
+               : status == "recording" ? SessionStatus::recording
+                                       : SessionStatus::incomplete;
+    s.frame_count = rows.integer(8);
+    if (!rows.is_null(9)) {
+      auto count = [&](int column) { return static_cast<std::uint64_t>(rows.integer(column)); };
+      SessionServoFigures f;
+      f.ticks = count(9);
+      f.rate_hz = rows.real(10);
+      f.period_p50_ms = rows.real(11);
+      f.period_p99_ms = rows.real(12);
+      f.period_max_ms = rows.real(13);
+      f.missed_deadlines = count(14);
+      f.force_clamps = count(15);
+      f.stiffness_clamps = count(16);
+      f.rate_limited = count(17);
+      f.watchdog_trips = count(18);
+      f.device_faults = count(19);
+      f.dropped_frames = count(20);
+      s.servo = f;
+    }
+    result.push_back(std::move(s));
+  }
+  rows.reset();
+  return result;
+}
+
+std::vector<ServoFrame> SqliteSessionStore::frames(std::int64_t session) {
+  Statement& chunks = prepared(kChunks,
+                               "SELECT first_frame, layout, data FROM frame_chunks "
+                               "WHERE session_id = ?1 ORDER BY first_frame");
+  chunks.bind(1, session);
+  std::vector<ServoFrame> result;
+  try {
+    while (chunks.step("reading frames")) {
+      if (chunks.integer(0) != static_cast<std::int64_t>(result.size()))
+        throw StorageError("frames " + std::to_string(result.size()) + " to " +
+                           std::to_string(chunks.integer(0)) + " are missing");
+      if (chunks.integer(1) != kFrameChunkLayout)
+        throw StorageError("a chunk has layout " + std::to_string(chunks.integer(1)) +
+                           ", which this version cannot read");
+      const std::vector<ServoFrame> part = decode_frame_chunk(chunks.blob(2));
+      result.insert(result.end(), part.begin(), part.end());
+    }
+  } catch (const StorageError& e) {
+    chunks.reset();
+    throw error("session " + std::to_string(session) + ": " + e.what());
+  }
+  chunks.reset();
+  return result;
+}
+
+std::vector<SessionEvent> SqliteSessionStore::events(std::int64_t session) {
+  Statement& rows = prepared(
+      kEvents, "SELECT time_s, kind, detail FROM events WHERE session_id = ?1 ORDER BY time_s, id");
+  rows.bind(1, session);
+  std::vector<SessionEvent> result;
+  while (rows.step("reading events")) {
+    const std::string kind = rows.text(1);
+    const std::optional<SessionEventKind> known = session_event_kind(kind);
+    if (!known) {
+      rows.reset();
+      throw error("session " + std::to_string(session) + " has an event of unknown kind \"" + kind +
+                  "\"");
+    }
+    result.push_back({rows.real(0), *known, rows.text(2)});
+  }
+  rows.reset();
+  return result;
+}
+
+std::string SqliteSessionStore::scenario_text(std::int64_t session) {
+  Statement& row = prepared(kScenarioText,
+                            "SELECT c.content FROM sessions s JOIN scenarios c "
+                            "ON c.id = s.scenario_id WHERE s.id = ?1");
+  row.bind(1, session);
+  if (!row.step("reading the scenario")) {
+    row.reset();
+    throw error("there is no session " + std::to_string(session));
+  }
+  std::string text = row.text(0);
+  row.reset();
+  return text;
+}
+
+}  // namespace liversim

@@ -1,0 +1,391 @@
+// The embedded session store on real SQLite files: sessions written and read back exactly, a
+// writer killed mid-session, and files that are damaged, foreign, newer, read-only or full.
+#include "liversim/core/session_recorder.h"
+#include "liversim/storage/sqlite_session_store.h"
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+extern char** environ;
+
+namespace liversim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh path in the test output directory (the file and its WAL side files removed).
+fs::path fresh_database(const std::string& name) {
+  const fs::path file = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "storage" / (name + ".sqlite");
+  fs::create_directories(file.parent_path());
+  for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(file.string() + suffix);
+  return file;
+}
+
+// Frames of a 1 kHz servo with every field distinct, not round numbers: an exact read-back
+// cannot pass by accident.
+std::vector<ServoFrame> synthetic_frames(std::size_t count, unsigned seed) {
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> value(-50.0, 50.0);
+  std::vector<ServoFrame> frames(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    ServoFrame& f = frames[i];
+    f.time_s = 1e-3 * static_cast<double>(i) + 1e-7 * value(random);
+    f.sample.position_mm = {value(random), value(random), value(random)};
+    f.sample.velocity_mm_per_s = {value(random), value(random), value(random)};
+    f.force_n = {0.01 * value(random), 0.01 * value(random), 0.01 * value(random)};
+    f.sample.buttons = static_cast<std::uint32_t>(random() & 3u);
+  }
+  return frames;
+}
+
+void expect_same_frames(const std::vector<ServoFrame>& read,
+                        const std::vector<ServoFrame>& written) {
+  ASSERT_EQ(read.size(), written.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    ASSERT_EQ(read[i].time_s, written[i].time_s) << "frame " << i;
+    ASSERT_EQ(read[i].sample.position_mm, written[i].sample.position_mm) << "frame " << i;
+    ASSERT_EQ(read[i].sample.velocity_mm_per_s, written[i].sample.velocity_mm_per_s) << i;
+    ASSERT_EQ(read[i].force_n, written[i].force_n) << "frame " << i;
+    ASSERT_EQ(read[i].sample.buttons, written[i].sample.buttons) << "frame " << i;
+  }
+}
+
+SessionStart start_of(const std::string& trainee, const std::string& scenario_text) {
+  return {trainee, "Palpation", scenario_text, "Scripted", 1'795'000'000'000};
+}
+
+// Runs SQL on a file directly, outside the store (to make files the store must refuse).
+void run_sql(const fs::path& file, const char* sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  char* error = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql, nullptr, nullptr, &error), SQLITE_OK) << (error ? error : "");
+  sqlite3_free(error);
+  sqlite3_close(db);
+}
+
+// The StorageError message of opening `file`, or "" when it opened.
+std::string open_error(const fs::path& file,
+                       SqliteSessionStore::Access access = SqliteSessionStore::Access::read_write) {
+  try {
+    SqliteSessionStore store(file, access);
+  } catch (const StorageError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// open_error in a child process running as the user "nobody" (uid 65534).
+std::string open_error_as_nobody(const fs::path& file) {
+  int channel[2];
+  if (pipe(channel) != 0) return "pipe failed";
+  const pid_t child = fork();
+  if (child == 0) {
+    close(channel[0]);
+    std::string message = "could not become nobody";
+    if (setgid(65534) == 0 && setuid(65534) == 0) message = open_error(file);
+    if (write(channel[1], message.data(), message.size()) < 0) _exit(2);
+    _exit(0);
+  }
+  close(channel[1]);
+  std::string message;
+  char buffer[512];
+  for (ssize_t n; (n = read(channel[0], buffer, sizeof buffer)) > 0;)
+    message.append(buffer, static_cast<std::size_t>(n));
+  close(channel[0]);
+  waitpid(child, nullptr, 0);
+  return message;
+}
+
+TEST(FrameChunk, RoundTripsEveryBitAndRefusesBytesOfAnotherLayout) {
+  const std::vector<ServoFrame> frames = synthetic_frames(37, 3);
+  std::vector<std::uint8_t> bytes = encode_frame_chunk(frames);
+  EXPECT_EQ(bytes.size(), 8u + 37u * 84u);  // the documented layout's size
+  expect_same_frames(decode_frame_chunk(bytes), frames);
+  // Little-endian whatever the machine: the count 37 in the header's second word.
+  EXPECT_EQ(bytes[4], 37);
+  EXPECT_EQ(bytes[5], 0);
+  std::vector<std::uint8_t> short_chunk(bytes.begin(), bytes.end() - 1);
+  EXPECT_THROW(decode_frame_chunk(short_chunk), StorageError);
+  bytes[3] = '2';
+  EXPECT_THROW(decode_frame_chunk(bytes), StorageError);
+}
+
+TEST(SessionStore, SixtySecondsAtOneKilohertzReadBackExactly) {
+  const fs::path file = fresh_database("sixty-seconds");
+  const std::vector<ServoFrame> frames = synthetic_frames(60'000, 1);
+  std::int64_t session = 0;
+  {
+    SqliteSessionStore store(file);
+    session = store.begin_session(start_of("Trainee A", "{\"title\": \"Palpation\"}"));
+    // One chunk per 50 ms commit, as the recorder writes them.
+    for (std::size_t first = 0; first < frames.size(); first += 50) {
+      store.append_frames(session, std::span(frames).subspan(first, 50));
+      store.commit();
+    }
+    store.end_session(session, 1'795'000'060'000, SessionServoFigures{.ticks = 60'000});
+  }
+  SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
+  EXPECT_EQ(store.integrity_check(), "ok");
+  const std::vector<SessionSummary> sessions = store.sessions();
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_EQ(sessions[0].status, SessionStatus::complete);
+  EXPECT_EQ(sessions[0].frame_count, 60'000);
+  EXPECT_EQ(sessions[0].ended_unix_ms, 1'795'000'060'000);
+  expect_same_frames(store.frames(session), frames);
+  // 84 bytes a frame in the chunks, plus SQLite's pages: well under a row per frame's cost.
+  std::printf("60 s at 1 kHz: %.1f MB on disk\n", static_cast<double>(fs::file_size(file)) / 1e6);
+}
+
+TEST(SessionStore, KeepsTheExactScenarioOnceAndTheEventsInOrder) {
+  const fs::path file = fresh_database("scenarios-and-events");
+  SqliteSessionStore store(file);
+  const std::string first_text = "{\"title\": \"Palpation\", \"x\": 1}";
+  const std::string second_text = "{\"title\": \"Palpation\", \"x\": 2}";
+  const std::int64_t a = store.begin_session(start_of("Trainee A", first_text));
+  const std::int64_t b = store.begin_session(start_of("Trainee B", first_text));
+  const std::int64_t c = store.begin_session(start_of("Trainee A", second_text));
+  EXPECT_EQ(store.scenario_text(a), first_text);
+  EXPECT_EQ(store.scenario_text(c), second_text);
+  const std::vector<SessionSummary> sessions = store.sessions();
+  ASSERT_EQ(sessions.size(), 3u);
+  // The same text is one scenario (one hash); a changed text another.
+  EXPECT_EQ(sessions[0].scenario_sha256, sessions[1].scenario_sha256);
+  EXPECT_NE(sessions[0].scenario_sha256, sessions[2].scenario_sha256);
+  EXPECT_EQ(sessions[0].scenario_sha256.size(), 64u);
+  EXPECT_EQ(sessions[1].trainee, "Trainee B");
+  const std::vector<SessionEvent> events = {{0.5, SessionEventKind::grasp, ""},
+                                            {0.75, SessionEventKind::excessive_force, "2.6 N"},
+                                            {1.25, SessionEventKind::tool_selected, "scalpel"},
+                                            {2.0, SessionEventKind::cut, "12 faces"}};
+  store.append_events(b, std::span(events).subspan(0, 2));
+  store.append_events(b, std::span(events).subspan(2));
+  store.commit();
+  EXPECT_EQ(store.events(b), events);
+  EXPECT_TRUE(store.events(a).empty());
+  EXPECT_THROW(store.scenario_text(99), StorageError);
+}
+
+TEST(SessionRecorder, WritesFramesAndEventsAndEndsTheSessionComplete) {
+  const fs::path file = fresh_database("recorder");
+  const std::vector<ServoFrame> frames = synthetic_frames(3000, 2);
+  SqliteSessionStore store(file);
+  // The frames arrive as a servo queues them: a thousand a second, in real time.
+  std::atomic<std::size_t> produced{0};
+  std::size_t consumed = 0;
+  SessionRecorder recorder(store, start_of("Trainee A", "{}"), [&](ServoFrame& frame) {
+    if (consumed >= produced.load()) return false;
+    frame = frames[consumed++];
+    return true;
+  });
+  recorder.record_event({0.1, SessionEventKind::grasp, ""});
+  const auto begin = std::chrono::steady_clock::now();
+  while (produced.load() < frames.size()) {
+    const double elapsed_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+    produced = std::min(frames.size(), static_cast<std::size_t>(elapsed_s * 1000.0));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  recorder.record_event({2.9, SessionEventKind::release, ""});
+  SessionServoFigures figures;
+  figures.ticks = 3000;
+  figures.rate_hz = 999.5;
+  figures.period_p99_ms = 1.2;
+  figures.dropped_frames = 0;
+  ASSERT_TRUE(recorder.finish(1'795'000'003'000, figures)) << recorder.error();
+  EXPECT_EQ(recorder.frames_written(), 3000);
+  expect_same_frames(store.frames(recorder.session()), frames);
+  const std::vector<SessionEvent> events = store.events(recorder.session());
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[1].kind, SessionEventKind::release);
+  const SessionSummary summary = store.sessions().at(0);
+  EXPECT_EQ(summary.status, SessionStatus::complete);
+  ASSERT_TRUE(summary.servo.has_value());
+  EXPECT_EQ(*summary.servo, figures);
+}
+
+// The writer process is killed (SIGKILL) mid-session: the file passes integrity_check, the
+// session is there, marked incomplete, and it lost at most the last commit period of frames
+// (the recorder commits every 50 ms; the bound asked for is 200 ms).
+TEST(SessionRecorder, AWriterKilledMidSessionLosesAtMostTheLastCommitPeriod) {
+  const fs::path file = fresh_database("killed-writer");
+  int out[2];
+  ASSERT_EQ(pipe(out), 0);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+  posix_spawn_file_actions_addclose(&actions, out[0]);
+  std::string child_path = LIVERSIM_SESSION_WRITER_CHILD, file_arg = file.string();
+  char* child_argv[] = {child_path.data(), file_arg.data(), nullptr};
+  pid_t child = 0;
+  ASSERT_EQ(posix_spawn(&child, child_path.c_str(), &actions, nullptr, child_argv, environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  close(out[1]);
+  FILE* lines = fdopen(out[0], "r");
+  long long epoch_ns = 0, session = 0;
+  const bool started = std::fscanf(lines, "epoch_ns %lld\nsession %lld", &epoch_ns, &session) == 2;
+  if (!started) kill(child, SIGKILL);
+  ASSERT_TRUE(started) << "the writer did not start";
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  const auto kill_time = std::chrono::steady_clock::now();
+  ASSERT_EQ(kill(child, SIGKILL), 0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  std::fclose(lines);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the writer ended by itself, status " << status;
+  const double killed_at_s =
+      1e-9 * static_cast<double>(
+                 std::chrono::duration_cast<std::chrono::nanoseconds>(kill_time.time_since_epoch())
+                     .count() -
+                 epoch_ns);
+
+  SqliteSessionStore store(file);  // opening for writing marks the session incomplete
+  EXPECT_EQ(store.integrity_check(), "ok");
+  const std::vector<SessionSummary> sessions = store.sessions();
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_EQ(sessions[0].id, session);
+  EXPECT_EQ(sessions[0].status, SessionStatus::incomplete);
+  EXPECT_FALSE(sessions[0].ended_unix_ms.has_value());
+  const std::vector<ServoFrame> frames = store.frames(session);
+  ASSERT_FALSE(frames.empty());
+  EXPECT_EQ(static_cast<std::int64_t>(frames.size()), sessions[0].frame_count);
+  for (std::size_t i = 1; i < frames.size(); ++i)
+    ASSERT_GT(frames[i].time_s, frames[i - 1].time_s) << "frame " << i;
+  const double lost_s = killed_at_s - frames.back().time_s;
+  std::printf("killed at %.3f s on the servo clock; last frame kept %.3f s; lost %.1f ms\n",
+              killed_at_s, frames.back().time_s, 1e3 * lost_s);
+  EXPECT_GE(lost_s, 0.0);
+  EXPECT_LE(lost_s, 0.2);
+  // The servo ran ~1.5 s at ~1 kHz: loose bounds only (the machine is shared).
+  EXPECT_GT(frames.size(), 300u);
+}
+
+TEST(SessionStore, RefusesFilesItCannotUseWithTheFileAndTheReasonNamed) {
+  // Not a database at all.
+  const fs::path text = fresh_database("plain-text");
+  std::ofstream(text) << "this is a scenario note, not a database\n";
+  std::string message = open_error(text);
+  EXPECT_NE(message.find(text.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("not a database"), std::string::npos) << message;
+  // Another program's database.
+  const fs::path foreign = fresh_database("foreign");
+  run_sql(foreign, "CREATE TABLE invoices (id INTEGER PRIMARY KEY)");
+  message = open_error(foreign);
+  EXPECT_NE(message.find("not a LiverSim sessions database"), std::string::npos) << message;
+  // Written by a newer LiverSim.
+  const fs::path newer = fresh_database("newer");
+  { SqliteSessionStore store(newer); }
+  run_sql(newer, "PRAGMA user_version = 7");
+  message = open_error(newer);
+  EXPECT_NE(message.find("newer LiverSim (schema version 7"), std::string::npos) << message;
+  // A file its user may not write: root may write any file, so as root the attempt is made by a
+  // child process that has become the unprivileged user "nobody".
+  const fs::path locked = fresh_database("read-only-file");
+  { SqliteSessionStore store(locked); }
+  fs::permissions(locked, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  message = geteuid() == 0 ? open_error_as_nobody(locked) : open_error(locked);
+  fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_NE(message.find(locked.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("read-only"), std::string::npos) << message;
+  // A file opened for reading only: browsing works, recording is refused.
+  const fs::path browse = fresh_database("browse");
+  { SqliteSessionStore store(browse); }
+  SqliteSessionStore reader(browse, SqliteSessionStore::Access::read_only);
+  EXPECT_TRUE(reader.sessions().empty());
+  try {
+    reader.begin_session(start_of("Trainee A", "{}"));
+    ADD_FAILURE() << "a read-only store began a session";
+  } catch (const StorageError& e) {
+    EXPECT_NE(std::string(e.what()).find("read-only"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SessionStore, ADamagedFileGivesAClearMessageAndNoCrash) {
+  const fs::path file = fresh_database("damaged");
+  {
+    SqliteSessionStore store(file);
+    const std::int64_t session = store.begin_session(start_of("Trainee A", "{}"));
+    const std::vector<ServoFrame> frames = synthetic_frames(5000, 4);
+    store.append_frames(session, frames);
+    store.commit();
+  }
+  run_sql(file, "PRAGMA wal_checkpoint(TRUNCATE)");
+  // Overwrite everything after the first page (the header stays: the file still looks like a
+  // database) with junk.
+  {
+    std::fstream bytes(file, std::ios::in | std::ios::out | std::ios::binary);
+    bytes.seekp(4096);
+    std::mt19937 random(5);
+    for (int i = 0; i < 64 * 1024; ++i) bytes.put(static_cast<char>(random()));
+  }
+  std::string message;
+  try {
+    SqliteSessionStore store(file);
+    const std::string check = store.integrity_check();
+    if (check != "ok") message = "integrity: " + check;
+    store.frames(1);
+    store.sessions();
+  } catch (const StorageError& e) {
+    message = e.what();
+  }
+  ASSERT_FALSE(message.empty()) << "the damage went unnoticed";
+  if (message.rfind("integrity: ", 0) != 0) {
+    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+    EXPECT_NE(message.find("damaged"), std::string::npos) << message;
+  }
+}
+
+// A file that cannot grow (SQLite's page cap stands in for a full disk): the recorder stops with a
+// message naming the file and the cause, and every frame it committed before stays readable.
+TEST(SessionRecorder, AFullDiskStopsTheRecordingAndKeepsWhatWasCommitted) {
+  const fs::path file = fresh_database("full-disk");
+  SqliteSessionStore store(file);
+  const std::vector<ServoFrame> frames = synthetic_frames(200'000, 6);
+  std::size_t next = 0;
+  SessionRecorder::Options options;
+  options.commit_period_s = 0.01;
+  // 500 frames a commit, until the file is full.
+  std::atomic<std::size_t> released{0};
+  SessionRecorder recorder(
+      store, start_of("Trainee A", "{}"),
+      [&](ServoFrame& frame) {
+        if (next >= released.load()) return false;
+        frame = frames[next++];
+        return true;
+      },
+      options);
+  store.limit_pages_for_testing(64);  // 256 KiB at 4 KiB pages
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (recorder.error().empty() && std::chrono::steady_clock::now() < deadline &&
+         released.load() < frames.size()) {
+    released = std::min(frames.size(), released.load() + 500);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const std::string error = recorder.error();
+  ASSERT_FALSE(error.empty()) << "the file never filled";
+  EXPECT_NE(error.find(file.string()), std::string::npos) << error;
+  EXPECT_NE(error.find("full"), std::string::npos) << error;
+  EXPECT_FALSE(recorder.finish(0, {}));
+  const std::int64_t kept = recorder.frames_written();
+  EXPECT_GT(kept, 0);
+  SqliteSessionStore reader(file, SqliteSessionStore::Access::read_only);
+  EXPECT_EQ(reader.integrity_check(), "ok");
+  const std::vector<ServoFrame> read = reader.frames(recorder.session());
+  ASSERT_EQ(static_cast<std::int64_t>(read.size()), kept);
+  expect_same_frames(read, std::vector<ServoFrame>(frames.begin(), frames.begin() + kept));
+}
+
+}  // namespace
+}  // namespace liversim
