@@ -7,7 +7,9 @@
 
 #include <QApplication>
 #include <QCommandLineParser>
+#include <QDir>
 #include <QMessageBox>
+#include <QStandardPaths>
 #include <QTimer>
 
 #include <cmath>
@@ -25,6 +27,7 @@ struct Options {
   std::optional<double> quit_after_s;  // close this long after the window is shown (unattended)
   std::optional<liversim::Scenario> scenario;  // validated
   std::string scenario_file;
+  QString sessions_database;  // empty: sessions.sqlite in the user's data directory
 };
 
 // Parsed under a plain QCoreApplication, so --help, --version and bad options work without a
@@ -58,6 +61,13 @@ Options parse_options(int argc, char** argv) {
                                   "of free practice on the built-in liver."),
       "file");
   parser.addOption(scenario);
+  const QCommandLineOption database(
+      "database",
+      QCoreApplication::translate("main",
+                                  "Record sessions to this SQLite file (default: sessions.sqlite "
+                                  "in the user's data directory)."),
+      "file");
+  parser.addOption(database);
   parser.process(app);
 
   Options options;
@@ -94,6 +104,7 @@ Options parse_options(int argc, char** argv) {
     }
     options.scenario = std::move(reading.scenario);
   }
+  if (parser.isSet(database)) options.sessions_database = parser.value(database);
   return options;
 }
 
@@ -139,6 +150,14 @@ int main(int argc, char** argv) {
   QApplication::setApplicationVersion(LIVERSIM_VERSION);
   try {
     liversim::MainWindow window(std::move(*setup), std::move(opened));
+    QString database = options.sessions_database;
+    if (database.isEmpty()) {
+      const QString folder = QStandardPaths::writableLocation(QStandardPaths::AppDataLocation);
+      QDir().mkpath(folder);  // if it cannot be made, opening the file below says so
+      database = folder + "/sessions.sqlite";
+    }
+    if (!window.setSessionsDatabase(database))
+      std::cerr << "liversim: " << window.sessionsProblem().toStdString() << '\n';
     window.show();
     if (options.quit_after_s)
       QTimer::singleShot(static_cast<int>(std::lround(*options.quit_after_s * 1e3)), &app,

@@ -13,13 +13,16 @@
 #include "liversim/core/integrator.h"
 #include "liversim/core/openhaptics_device.h"
 #include "liversim/core/surface.h"
+#include "liversim/storage/sqlite_session_store.h"
 
 #include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
 #include <QAction>
+#include <QDateTime>
 #include <QDir>
 #include <QDockWidget>
+#include <QFile>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QGuiApplication>
@@ -90,6 +93,11 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   addPanelDock(tr("Tool"), "toolDock", toolPanel_);
   connect(toolPanel_, &ToolPanel::toolChanged, this, [this] {
     if (servo_) simulation_->set_device_tool(deviceToolSettings());
+    if (recorder_ && servo_) {
+      const auto tool = toolPanel_->tool();
+      recorder_->record_event({servo_->now_s(), SessionEventKind::tool_selected,
+                               tool ? std::string(tool_name(*tool)) : "hand"});
+    }
   });
 
   devicePanel_ = new DevicePanel(this);
@@ -229,6 +237,10 @@ void MainWindow::finishScenarioOpen(const OpenedScenario& opened, std::shared_pt
   scenario_ = opened;
   attachDevice();
   simulation_->start();
+  if (recorder_) {  // the device stays; its session was of the old scene
+    endRecording();
+    beginRecording();
+  }
   accuracyPanel_->setSettings(setup_.model_options.integrator);
   showScenarioDetails();
   rememberScenario(opened.file);
@@ -679,8 +691,92 @@ void MainWindow::detachDevice() {
     simulation_->set_haptic_servo(nullptr);
     simulation_->set_device_tool(std::nullopt);
   }
-  servo_.reset();  // stops: the last command is a zero force
+  if (servo_) servo_->stop();  // the last command is a zero force; its last frames are logged
+  endRecording();
+  servo_.reset();
   scripted_.reset();
+}
+
+bool MainWindow::setSessionsDatabase(const QString& file) {
+  endRecording();
+  sessions_.reset();
+  sessionsProblem_.clear();
+  try {
+    sessions_ = std::make_unique<SqliteSessionStore>(std::filesystem::path(file.toStdString()));
+  } catch (const StorageError& e) {
+    sessionsProblem_ = tr("Sessions are not recorded: %1").arg(QString::fromUtf8(e.what()));
+    statusBar()->showMessage(sessionsProblem_);
+    return false;
+  }
+  if (servo_) beginRecording();
+  return true;
+}
+
+std::optional<std::int64_t> MainWindow::recordingSession() const {
+  if (!recorder_) return std::nullopt;
+  return recorder_->session();
+}
+
+void MainWindow::beginRecording() {
+  if (!sessions_ || !servo_ || recorder_) return;
+  SessionStart start;
+  start.trainee = QSettings()
+                      .value("sessions/trainee", qEnvironmentVariable("USER", tr("Trainee")))
+                      .toString()
+                      .toStdString();
+  if (scenario_) {
+    QFile file(scenario_->file);
+    start.scenario_title = scenario_->scenario.title;
+    if (file.open(QIODevice::ReadOnly)) start.scenario_text = file.readAll().toStdString();
+  } else {
+    // Free practice has no file: the text names the scene it ran.
+    start.scenario_title = tr("Free practice").toStdString();
+    start.scenario_text = "free practice on the built-in liver, " +
+                          std::to_string(setup_.mesh.tet_count()) + " tetrahedra";
+  }
+  start.device = haptics_.device == DeviceChoice::openhaptics && omni_ ? omni_->name()
+                 : scripted_                                           ? scripted_->name()
+                                                                       : "haptic device";
+  start.started_unix_ms = QDateTime::currentMSecsSinceEpoch();
+  ServoLoop* servo = servo_.get();
+  try {
+    recorder_ = std::make_unique<SessionRecorder>(
+        *sessions_, start, [servo](ServoFrame& frame) { return servo->next_logged_frame(frame); });
+  } catch (const StorageError& e) {
+    sessionsProblem_ = tr("Sessions are not recorded: %1").arg(QString::fromUtf8(e.what()));
+    statusBar()->showMessage(sessionsProblem_);
+    return;
+  }
+  const auto tool = toolPanel_->tool();
+  recorder_->record_event({servo_->now_s(), SessionEventKind::tool_selected,
+                           tool ? std::string(tool_name(*tool)) : "hand"});
+}
+
+void MainWindow::endRecording() {
+  if (!recorder_) return;
+  const ServoStats stats = servo_ ? servo_->stats() : ServoStats{};
+  const std::uint64_t dropped = servo_ ? servo_->dropped_log_frames() : 0;
+  const std::int64_t session = recorder_->session();
+  if (!recorder_->finish(QDateTime::currentMSecsSinceEpoch(), servo_figures(stats, dropped))) {
+    sessionsProblem_ =
+        tr("The session was not saved whole: %1").arg(QString::fromStdString(recorder_->error()));
+    statusBar()->showMessage(sessionsProblem_);
+    recorder_.reset();
+    return;
+  }
+  recorder_.reset();
+  // The metrics of its trace, from what was stored (docs/session-metrics.md).
+  try {
+    const std::vector<ServoFrame> frames = sessions_->frames(session);
+    if (frames.empty()) return;
+    const TraceMetrics metrics = compute_trace_metrics(
+        frames, tool_intervals(sessions_->events(session)), haptics_.mapping, {});
+    sessions_->store_metrics(session, trace_metric_values(metrics));
+  } catch (const std::exception& e) {
+    sessionsProblem_ =
+        tr("The session's metrics were not stored: %1").arg(QString::fromUtf8(e.what()));
+    statusBar()->showMessage(sessionsProblem_);
+  }
 }
 
 void MainWindow::openOmni() {
@@ -755,6 +851,7 @@ bool MainWindow::useDevice(DeviceChoice choice, const QString& trajectoryFile) {
   attachDevice();
   simulation_->start();
   if (servo_) servo_->start();
+  beginRecording();
   if (!servo_) showTool(std::nullopt);
   saveHapticPreferences();
   devicePanel_->showDevice(choice);

@@ -11,6 +11,7 @@
 #include "liversim/core/realtime_simulation.h"
 #include "liversim/core/scenario.h"
 #include "liversim/core/servo_loop.h"
+#include "liversim/core/session_recorder.h"
 
 #include <QElapsedTimer>
 #include <QMainWindow>
@@ -97,6 +98,15 @@ class MainWindow : public QMainWindow {
   // the new mapping.
   CalibrationDialog* openCalibration();
 
+  // Sessions (docs/session-storage.md): while a device drives the tool through the servo, its
+  // frames and events are recorded to the sessions database, one session per device and scene.
+  // Opens (or creates) the database; false, with the reason in sessionsProblem() and the status
+  // bar, when it cannot: the workstation then runs without recording.
+  bool setSessionsDatabase(const QString& file);
+  QString sessionsProblem() const { return sessionsProblem_; }
+  // The session being recorded, if any.
+  std::optional<std::int64_t> recordingSession() const;
+
   // Spring stiffness of a mouse grab and the radius of tissue it holds.
   static constexpr double kGrabStiffnessNPerM = 300.0;
   static constexpr double kGrabRadiusM = 0.02;
@@ -137,7 +147,9 @@ class MainWindow : public QMainWindow {
   void detachDevice();  // stops the servo; the simulation must be stopped
   void checkDevice();   // servo statistics and faults, with the status
   void saveHapticPreferences();
-  void openOmni();  // looks for the Phantom Omni: omni_, or why not in omniProblem_
+  void beginRecording();  // a session of servo_ on the scene now shown
+  void endRecording();    // stops servo_ first: its last frames and figures are in the session
+  void openOmni();        // looks for the Phantom Omni: omni_, or why not in omniProblem_
   void finishIntegratorChange(const IntegratorSettings& settings,
                               std::shared_ptr<const SimModel> model, const QString& error);
   void showNewestSnapshot();
@@ -183,6 +195,10 @@ class MainWindow : public QMainWindow {
   std::unique_ptr<ServoLoop> servo_;  // runs while a device other than the mouse is in use
 
   std::optional<OpenedScenario> scenario_;
+
+  std::unique_ptr<SessionStore> sessions_;
+  QString sessionsProblem_;
+  std::unique_ptr<SessionRecorder> recorder_;  // while servo_ runs and sessions_ is open
 
   // Builds the model of an integrator change (reading setup_.mesh, which changes only when no
   // model is being built) or the scene of a scenario being opened.

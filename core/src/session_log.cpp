@@ -88,6 +88,34 @@ SessionServoFigures servo_figures(const ServoStats& stats, std::uint64_t dropped
   return f;
 }
 
+std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events) {
+  std::vector<ToolInterval> intervals;
+  for (const SessionEvent& event : events) {
+    if (event.kind != SessionEventKind::tool_selected) continue;
+    ToolInterval interval{event.time_s, std::nullopt};  // the hand, or a name no tool has
+    for (ToolKind kind : {ToolKind::probe, ToolKind::forceps, ToolKind::scalpel})
+      if (tool_name(kind) == event.detail) interval.tool = kind;
+    // Two choices at one instant (the servo clock's resolution): the later one holds.
+    if (!intervals.empty() && !(interval.start_s > intervals.back().start_s))
+      intervals.back() = interval;
+    else
+      intervals.push_back(interval);
+  }
+  return intervals;
+}
+
+std::vector<MetricValue> trace_metric_values(const TraceMetrics& m) {
+  return {{"task_time_s", m.task_time_s},
+          {"path_length_mm", m.path_length_mm},
+          {"movements", static_cast<double>(m.movements)},
+          {"peak_force_n", m.peak_force_n},
+          {"mean_force_n", m.mean_force_n},
+          {"rms_force_n", m.rms_force_n},
+          {"time_above_safe_force_s", m.time_above_safe_force_s},
+          {"force_integral_n_s", m.force_integral_n_s},
+          {"peak_force_rate_n_per_s", m.peak_force_rate_n_per_s}};
+}
+
 std::vector<std::uint8_t> encode_frame_chunk(std::span<const ServoFrame> frames) {
   const std::size_t n = frames.size();
   std::vector<std::uint8_t> bytes(kHeaderBytes + n * kBytesPerFrame);

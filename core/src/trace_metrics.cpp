@@ -97,8 +97,9 @@ TraceMetrics compute_trace_metrics(std::span<const ServoFrame> frames,
   const double first_s = frames.front().time_s, last_s = frames.back().time_s;
   // Tools in use at some instant of [first_s, last_s] appear, even with nothing to count.
   for (std::size_t k = 0; k < tools.size(); ++k)
-    if (tools[k].start_s <= last_s && (k + 1 == tools.size() || tools[k + 1].start_s > first_s))
-      metrics.per_tool.try_emplace(tools[k].tool);
+    if (tools[k].tool && tools[k].start_s <= last_s &&
+        (k + 1 == tools.size() || tools[k + 1].start_s > first_s))
+      metrics.per_tool.try_emplace(*tools[k].tool);
 
   // The force device = scale·Rᵀ·F_tissue, and a scene distance = scale × the device distance.
   auto tissue_force_n = [&](const ServoFrame& frame) {
@@ -155,8 +156,8 @@ TraceMetrics compute_trace_metrics(std::span<const ServoFrame> frames,
       const bool changes =
           tool_index + 1 < std::ssize(tools) && tools[tool_index + 1].start_s < end_s;
       const double until_s = changes ? tools[tool_index + 1].start_s : end_s;
-      if (tool_index >= 0)
-        metrics.per_tool[tools[tool_index].tool].path_length_mm +=
+      if (tool_index >= 0 && tools[tool_index].tool)
+        metrics.per_tool[*tools[tool_index].tool].path_length_mm +=
             from_s == start_s && !changes ? length_mm : length_mm * (until_s - from_s) / dt_s;
       if (changes) ++tool_index;
       from_s = until_s;
@@ -166,7 +167,8 @@ TraceMetrics compute_trace_metrics(std::span<const ServoFrame> frames,
       if (!moved || start_s - last_motion_end_s >= settings.pause_s) {
         ++metrics.movements;
         // A movement counts for the tool in use when it began.
-        if (tool_at_start >= 0) ++metrics.per_tool[tools[tool_at_start].tool].movements;
+        if (tool_at_start >= 0 && tools[tool_at_start].tool)
+          ++metrics.per_tool[*tools[tool_at_start].tool].movements;
       }
       moved = true;
       last_motion_end_s = end_s;

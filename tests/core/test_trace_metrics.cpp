@@ -1,6 +1,8 @@
 // Trace metrics (docs/session-metrics.md) on synthetic servo traces whose answers follow by hand:
 // the frames are samples of piecewise-linear position and force, so a straight line's length, a
 // square wave's integrals and its crossing times are known in closed form.
+#include "liversim/core/scenario.h"
+#include "liversim/core/session_log.h"
 #include "liversim/core/trace_metrics.h"
 
 #include <gtest/gtest.h>
@@ -290,6 +292,36 @@ TEST(TraceMetrics, BadInputIsRefusedNamingTheFrame) {
   TraceMetricSettings negative_pause;
   negative_pause.pause_s = -0.1;
   expect_refused(good, kProbeThroughout, mapping, negative_pause, "pause_s");
+}
+
+// The hand holds no tool: a session's tool_selected events ("forceps", then "hand") become
+// intervals whose hand part counts for no tool, though the tip's path still counts in all.
+TEST(TraceMetrics, TheHandsStretchCountsForNoTool) {
+  const double speed_mm_per_s = 10.0;
+  const int intervals = 1000;
+  std::vector<ServoFrame> frames;
+  for (int i = 0; i <= intervals; ++i)
+    frames.push_back(frame_at(i * kFrameS, Eigen::Vector3d(speed_mm_per_s * i * kFrameS, 0, 0)));
+  const std::vector<SessionEvent> events = {{0.0, SessionEventKind::tool_selected, "forceps"},
+                                            {0.2, SessionEventKind::grasp, ""},
+                                            {0.25, SessionEventKind::tool_selected, "hand"}};
+  const std::vector<ToolInterval> tools = tool_intervals(events);
+  ASSERT_EQ(tools.size(), 2u);
+  EXPECT_EQ(tools[0].tool, ToolKind::forceps);
+  EXPECT_FALSE(tools[1].tool.has_value());
+
+  const TraceMetrics metrics = compute_trace_metrics(frames, tools, WorkspaceMapping{}, {});
+  const double tolerance_mm = relative_tolerance(intervals) * 10.0 + intervals * 2.0 * kEps * 10.0;
+  EXPECT_NEAR(metrics.path_length_mm, 10.0, tolerance_mm);
+  ASSERT_EQ(metrics.per_tool.size(), 1u);
+  EXPECT_NEAR(metrics.per_tool.at(ToolKind::forceps).path_length_mm, 2.5, tolerance_mm);
+  EXPECT_EQ(metrics.per_tool.at(ToolKind::forceps).movements, 1);
+  // Under the gradable names, in the units scenario rubrics use.
+  const std::vector<MetricValue> values = trace_metric_values(metrics);
+  for (const MetricValue& value : values)
+    EXPECT_NE(find_metric(value.name), nullptr) << value.name << " is not a gradable metric";
+  EXPECT_EQ(values.at(1).name, "path_length_mm");
+  EXPECT_EQ(values.at(1).value, metrics.path_length_mm);
 }
 
 }  // namespace

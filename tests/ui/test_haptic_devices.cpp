@@ -22,6 +22,7 @@
 #include "haptic_preferences.h"
 #include "liversim/core/default_scene.h"
 #include "liversim/core/emulated_devices.h"
+#include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
 #include "tool_panel.h"
 
@@ -172,6 +173,77 @@ TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
   EXPECT_EQ(window_->servo(), nullptr);
   EXPECT_TRUE(window_->devicePanel()->servoText().contains("not running"));
   ASSERT_TRUE(QTest::qWaitFor([&] { return !snapshot().tool.has_value(); }, kTimeoutMs));
+}
+
+// A device session is recorded to the sessions database: from choosing the device to choosing
+// the mouse again, its servo frames (the scripted trajectory's positions), the tool chosen and the
+// servo's figures; the session reads back complete. A file that cannot be a database is refused
+// with its name, and the workstation goes on without recording.
+TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
+  openWindow();
+  const QString database = folder_.filePath("sessions.sqlite");
+  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
+  EXPECT_FALSE(window_->recordingSession().has_value()) << "the mouse is not recorded";
+  const Eigen::Vector3d start_mm(5.0, 6.0, 40.0), end_mm(15.0, 6.0, 40.0);
+  const QString file = writeTrajectory({{0.0, start_mm, 0}, {0.4, end_mm, 1}, {600.0, end_mm, 1}});
+  window_->toolPanel()->setTool(ToolKind::forceps);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
+  ASSERT_TRUE(window_->recordingSession().has_value()) << window_->sessionsProblem().toStdString();
+  const std::int64_t session = *window_->recordingSession();
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 600; }, kTimeoutMs));
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  EXPECT_FALSE(window_->recordingSession().has_value());
+  EXPECT_TRUE(window_->sessionsProblem().isEmpty()) << window_->sessionsProblem().toStdString();
+
+  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
+  const std::vector<SessionSummary> sessions = store.sessions();
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_EQ(sessions[0].id, session);
+  EXPECT_EQ(sessions[0].status, SessionStatus::complete);
+  EXPECT_EQ(sessions[0].scenario_title, "Free practice");
+  EXPECT_NE(sessions[0].device.find("trajectory.txt"), std::string::npos) << sessions[0].device;
+  ASSERT_TRUE(sessions[0].servo.has_value());
+  const std::vector<ServoFrame> frames = store.frames(session);
+  // Every tick of the servo is a frame of the session; the figures are those the servo published
+  // last, up to 50 ms (about 50 ticks) before it stopped.
+  EXPECT_GE(frames.size(), sessions[0].servo->ticks);
+  EXPECT_LE(frames.size(), sessions[0].servo->ticks + 100);
+  EXPECT_EQ(sessions[0].servo->dropped_frames, 0u);
+  ASSERT_GT(frames.size(), 600u);
+  // The frames are the trajectory's: at the start point, then at the end point with the button.
+  EXPECT_LT((frames.back().sample.position_mm - end_mm).norm(), 1e-9);
+  EXPECT_EQ(frames.back().sample.buttons, 1u);
+  for (const ServoFrame& frame : frames) {
+    const double along =
+        (frame.sample.position_mm - start_mm).dot((end_mm - start_mm).normalized());
+    ASSERT_GE(along, -1e-9);
+    ASSERT_LE(along, 10.0 + 1e-9);
+  }
+  const std::vector<SessionEvent> events = store.events(session);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events[0].kind, SessionEventKind::tool_selected);
+  EXPECT_EQ(events[0].detail, "forceps");
+  // The trace's metrics, stored at the end: the tip went straight, one way, so its path is the
+  // distance from the first frame to the last, times the workspace scale in the scene.
+  const std::vector<MetricValue> metrics = store.metrics(session);
+  const auto path = std::find_if(metrics.begin(), metrics.end(),
+                                 [](const MetricValue& m) { return m.name == "path_length_mm"; });
+  ASSERT_NE(path, metrics.end());
+  const double straight_mm =
+      window_->hapticPreferences().mapping.scale *
+      (frames.back().sample.position_mm - frames.front().sample.position_mm).norm();
+  EXPECT_GT(straight_mm, 0.0);
+  EXPECT_NEAR(path->value, straight_mm, 1e-9 * straight_mm);
+  EXPECT_EQ(metrics.size(), trace_metric_values(TraceMetrics{}).size());
+
+  const QString not_a_database = folder_.filePath("notes.txt");
+  std::ofstream(not_a_database.toStdString()) << "not a database\n";
+  EXPECT_FALSE(window_->setSessionsDatabase(not_a_database));
+  EXPECT_TRUE(window_->sessionsProblem().contains("notes.txt"))
+      << window_->sessionsProblem().toStdString();
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
+  EXPECT_FALSE(window_->recordingSession().has_value());
+  EXPECT_NE(window_->servo(), nullptr) << "the device runs without recording";
 }
 
 TEST_F(DeviceTest, ABadTrajectoryFileIsNamedWithItsLineAndTheDeviceInUseStays) {

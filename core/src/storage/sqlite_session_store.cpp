@@ -101,6 +101,8 @@ enum StatementId {
   kChunks,
   kEvents,
   kScenarioText,
+  kStoreMetric,
+  kMetrics,
   kStatementCount
 };
 
@@ -419,6 +421,28 @@ void SqliteSessionStore::end_session(std::int64_t session, std::int64_t ended_un
       .run("ending the session");
   if (sqlite3_changes(db_) != 1) throw error("there is no session " + std::to_string(session));
   commit();
+}
+
+void SqliteSessionStore::store_metrics(std::int64_t session, std::span<const MetricValue> metrics) {
+  begin_if_needed();
+  Statement& store = prepared(
+      kStoreMetric, "INSERT OR REPLACE INTO metrics (session_id, name, value) VALUES (?1, ?2, ?3)");
+  for (const MetricValue& metric : metrics)
+    store.bind(1, session)
+        .bind(2, std::string_view(metric.name))
+        .bind(3, metric.value)
+        .run("storing a metric");
+  commit();
+}
+
+std::vector<MetricValue> SqliteSessionStore::metrics(std::int64_t session) {
+  Statement& rows =
+      prepared(kMetrics, "SELECT name, value FROM metrics WHERE session_id = ?1 ORDER BY name");
+  rows.bind(1, session);
+  std::vector<MetricValue> result;
+  while (rows.step("reading metrics")) result.push_back({rows.text(0), rows.real(1)});
+  rows.reset();
+  return result;
 }
 
 std::vector<SessionSummary> SqliteSessionStore::sessions() {

@@ -6,6 +6,7 @@
 
 #include "liversim/core/haptics.h"
 #include "liversim/core/servo_loop.h"
+#include "liversim/core/trace_metrics.h"
 
 #include <cstdint>
 #include <optional>
@@ -81,6 +82,19 @@ struct SessionSummary {
   std::optional<SessionServoFigures> servo;  // set when the session ended normally
 };
 
+// A gradable metric's value (gradable_metrics() in scenario.h names them and their units).
+struct MetricValue {
+  std::string name;
+  double value = 0.0;
+  bool operator==(const MetricValue&) const = default;
+};
+
+// The tools in use over a session, from its tool_selected events ("hand" or an unknown name ends
+// the tool before).
+std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events);
+// The metrics of the session's trace (trace_metrics.h), under their gradable names.
+std::vector<MetricValue> trace_metric_values(const TraceMetrics& metrics);
+
 // Frames travel and are stored in chunks (one per commit): a documented, versioned byte layout
 // (docs/session-storage.md), little-endian whatever the machine. Exact: doubles keep every bit.
 inline constexpr int kFrameChunkLayout = 1;
@@ -104,7 +118,11 @@ class SessionStore {
   virtual void end_session(std::int64_t session, std::int64_t ended_unix_ms,
                            const SessionServoFigures& servo) = 0;
 
+  // The session's metrics, computed at its end (a name stored again replaces its value); commits.
+  virtual void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) = 0;
+
   virtual std::vector<SessionSummary> sessions() = 0;
+  virtual std::vector<MetricValue> metrics(std::int64_t session) = 0;  // by name
   virtual std::vector<ServoFrame> frames(std::int64_t session) = 0;
   virtual std::vector<SessionEvent> events(std::int64_t session) = 0;
   // The exact scenario text the session ran.

@@ -9,14 +9,16 @@
 #include "liversim/core/tools.h"
 
 #include <map>
+#include <optional>
 #include <span>
 
 namespace liversim {
 
-// The tool in use from `start_s` (servo clock) on, until the next interval's start.
+// The tool in use from `start_s` (servo clock) on, until the next interval's start; none: the
+// hand (the device holds no tool).
 struct ToolInterval {
   double start_s = 0.0;
-  ToolKind tool = ToolKind::probe;
+  std::optional<ToolKind> tool = ToolKind::probe;
 };
 
 struct TraceMetricSettings {

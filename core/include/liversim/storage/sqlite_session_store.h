@@ -43,7 +43,10 @@ class SqliteSessionStore final : public SessionStore {
   void end_session(std::int64_t session, std::int64_t ended_unix_ms,
                    const SessionServoFigures& servo) override;
 
+  void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) override;
+
   std::vector<SessionSummary> sessions() override;
+  std::vector<MetricValue> metrics(std::int64_t session) override;
   std::vector<ServoFrame> frames(std::int64_t session) override;
   std::vector<SessionEvent> events(std::int64_t session) override;
   std::string scenario_text(std::int64_t session) override;
