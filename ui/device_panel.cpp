@@ -14,6 +14,7 @@ DevicePanel::DevicePanel(QWidget* parent) : QWidget(parent) {
   devices_->addItem(tr("Mouse and keyboard"), static_cast<int>(DeviceChoice::mouse));
   devices_->addItem(tr("Phantom Omni (OpenHaptics)"), static_cast<int>(DeviceChoice::openhaptics));
   devices_->addItem(tr("Scripted trajectory…"), static_cast<int>(DeviceChoice::scripted));
+  devices_->addItem(tr("Replay of a session…"), static_cast<int>(DeviceChoice::replay));
   devices_->setItemData(0, tr("Move the tool with the mouse in the viewport"), Qt::ToolTipRole);
   devices_->setItemData(2,
                         tr("Play a trajectory file (time s, x y z mm, buttons per line) on the "

@@ -52,6 +52,7 @@ void save_haptic_preferences(QSettings& settings, const HapticPreferences& prefe
   settings.beginGroup("haptics");
   const char* device = preferences.device == DeviceChoice::openhaptics ? "openhaptics"
                        : preferences.device == DeviceChoice::scripted  ? "scripted"
+                       : preferences.device == DeviceChoice::replay    ? "replay"
                                                                        : "mouse";
   settings.setValue("device", device);
   settings.setValue("trajectoryFile", preferences.trajectory_file);

@@ -12,7 +12,8 @@ class QSettings;
 
 namespace liversim {
 
-enum class DeviceChoice { mouse, openhaptics, scripted };
+// replay: the device input of a recorded session (never restored at start, as a script).
+enum class DeviceChoice { mouse, openhaptics, scripted, replay };
 
 struct HapticPreferences {
   DeviceChoice device = DeviceChoice::mouse;

@@ -26,6 +26,7 @@
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QGuiApplication>
+#include <QInputDialog>
 #include <QKeySequence>
 #include <QLabel>
 #include <QMenu>
@@ -109,6 +110,7 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   }
   openOmni();
   connect(devicePanel_, &DevicePanel::deviceChosen, this, [this](DeviceChoice device) {
+    if (device == DeviceChoice::replay) return chooseSessionToReplay();
     if (device != DeviceChoice::scripted) return void(useDevice(device));
     const QString file =
         QFileDialog::getOpenFileName(this, tr("Trajectory to play"), haptics_.trajectory_file,
@@ -717,8 +719,60 @@ std::optional<std::int64_t> MainWindow::recordingSession() const {
   return recorder_->session();
 }
 
+bool MainWindow::replaySession(std::int64_t session) {
+  auto refuse = [&](const QString& why) {
+    devicePanel_->showStatus(why, true);
+    devicePanel_->showDevice(haptics_.device);
+    return false;
+  };
+  if (!sessions_)
+    return refuse(sessionsProblem_.isEmpty() ? tr("There is no sessions database.")
+                                             : sessionsProblem_);
+  std::vector<ServoFrame> frames;
+  try {
+    frames = sessions_->frames(session);
+  } catch (const StorageError& e) {
+    return refuse(tr("Cannot replay session %1: %2").arg(session).arg(QString::fromUtf8(e.what())));
+  }
+  if (frames.empty()) return refuse(tr("Session %1 has no device input to replay.").arg(session));
+  replayPoints_ = trajectory_of_frames(frames);
+  replayName_ = tr("Replay of session %1").arg(session);
+  return useDevice(DeviceChoice::replay);
+}
+
+void MainWindow::chooseSessionToReplay() {
+  std::vector<SessionSummary> sessions;
+  try {
+    if (sessions_) sessions = sessions_->sessions();
+  } catch (const StorageError& e) {
+    sessionsProblem_ = QString::fromUtf8(e.what());
+  }
+  QStringList items;
+  for (auto it = sessions.rbegin(); it != sessions.rend(); ++it)
+    if (it->frame_count > 0)
+      items << tr("%1: %2, %3, %4 (%5)")
+                   .arg(it->id)
+                   .arg(QString::fromStdString(it->trainee),
+                        QString::fromStdString(it->scenario_title),
+                        QDateTime::fromMSecsSinceEpoch(it->started_unix_ms)
+                            .toString("yyyy-MM-dd hh:mm"),
+                        QString::fromUtf8(session_status_name(it->status).data()));
+  if (items.isEmpty()) {
+    devicePanel_->showStatus(
+        sessions_ ? tr("No recorded session has device input to replay.") : sessionsProblem_, true);
+    devicePanel_->showDevice(haptics_.device);
+    return;
+  }
+  bool ok = false;
+  const QString item =
+      QInputDialog::getItem(this, tr("Replay a session"), tr("Session:"), items, 0, false, &ok);
+  if (!ok) return devicePanel_->showDevice(haptics_.device);  // cancelled
+  replaySession(item.section(':', 0, 0).toLongLong());
+}
+
 void MainWindow::beginRecording() {
-  if (!sessions_ || !servo_ || recorder_) return;
+  // A replay is not a new session: its input is already recorded.
+  if (!sessions_ || !servo_ || recorder_ || haptics_.device == DeviceChoice::replay) return;
   SessionStart start;
   start.trainee = QSettings()
                       .value("sessions/trainee", qEnvironmentVariable("USER", tr("Trainee")))
@@ -809,6 +863,11 @@ bool MainWindow::useDevice(DeviceChoice choice, const QString& trajectoryFile) {
       if (!omni_) openOmni();
       if (!omni_) return refuse(tr("The Phantom Omni is not available: %1").arg(omniProblem_));
       device = omni_.get();
+      break;
+    case DeviceChoice::replay:
+      if (replayPoints_.empty()) return refuse(tr("Choose a recorded session to replay."));
+      scripted = std::make_unique<TrajectoryDevice>(replayName_.toStdString(), replayPoints_);
+      device = scripted.get();
       break;
     case DeviceChoice::scripted:
       if (file.isEmpty()) return refuse(tr("Choose a trajectory file to play."));

@@ -6,6 +6,7 @@
 #include "haptic_preferences.h"
 
 #include "liversim/core/default_scene.h"
+#include "liversim/core/emulated_devices.h"
 #include "liversim/core/grab.h"
 #include "liversim/core/haptic_device.h"
 #include "liversim/core/realtime_simulation.h"
@@ -104,6 +105,9 @@ class MainWindow : public QMainWindow {
   // bar, when it cannot: the workstation then runs without recording.
   bool setSessionsDatabase(const QString& file);
   QString sessionsProblem() const { return sessionsProblem_; }
+  // Plays a recorded session's device input through the servo at its original rate (a replay is
+  // not itself recorded). False, saying why in the Device panel, when it cannot be loaded.
+  bool replaySession(std::int64_t session);
   // The session being recorded, if any.
   std::optional<std::int64_t> recordingSession() const;
 
@@ -147,9 +151,10 @@ class MainWindow : public QMainWindow {
   void detachDevice();  // stops the servo; the simulation must be stopped
   void checkDevice();   // servo statistics and faults, with the status
   void saveHapticPreferences();
-  void beginRecording();  // a session of servo_ on the scene now shown
-  void endRecording();    // stops servo_ first: its last frames and figures are in the session
-  void openOmni();        // looks for the Phantom Omni: omni_, or why not in omniProblem_
+  void chooseSessionToReplay();  // asks which recorded session, then replaySession()
+  void beginRecording();         // a session of servo_ on the scene now shown
+  void endRecording();  // stops servo_ first: its last frames and figures are in the session
+  void openOmni();      // looks for the Phantom Omni: omni_, or why not in omniProblem_
   void finishIntegratorChange(const IntegratorSettings& settings,
                               std::shared_ptr<const SimModel> model, const QString& error);
   void showNewestSnapshot();
@@ -199,6 +204,8 @@ class MainWindow : public QMainWindow {
   std::unique_ptr<SessionStore> sessions_;
   QString sessionsProblem_;
   std::unique_ptr<SessionRecorder> recorder_;  // while servo_ runs and sessions_ is open
+  std::vector<TrajectoryPoint> replayPoints_;  // of the session replaySession() loaded
+  QString replayName_;
 
   // Builds the model of an integrator change (reading setup_.mesh, which changes only when no
   // model is being built) or the scene of a scenario being opened.

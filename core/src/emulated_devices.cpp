@@ -92,6 +92,17 @@ void save_trajectory(const std::filesystem::path& file,
   if (!out) throw std::runtime_error("cannot write the trajectory file " + file.string());
 }
 
+std::vector<TrajectoryPoint> trajectory_of_frames(std::span<const ServoFrame> frames) {
+  std::vector<TrajectoryPoint> points;
+  points.reserve(frames.size());
+  for (const ServoFrame& frame : frames) {
+    const double time_s = frame.time_s - frames.front().time_s;
+    if (!points.empty() && !(time_s > points.back().time_s)) continue;
+    points.push_back({time_s, frame.sample.position_mm, frame.sample.buttons});
+  }
+  return points;
+}
+
 TrajectoryDevice::TrajectoryDevice(std::string name, std::vector<TrajectoryPoint> points,
                                    DeviceLimits limits)
     : name_(std::move(name)), points_(std::move(points)), limits_(limits) {

@@ -404,6 +404,29 @@ TEST(Trajectory, FilesRoundTripAndBadLinesAreNamed) {
   std::filesystem::remove_all(dir);
 }
 
+// A session's logged frames replayed: the trajectory starts at 0, and the device gives back each
+// frame's position and buttons exactly at that frame's time after the first.
+TEST(TrajectoryDevice, ReplaysLoggedFramesAtTheirOriginalTimes) {
+  std::vector<ServoFrame> frames(4);
+  const double times_s[] = {12.0004, 12.0013, 12.0013, 12.0031};  // a repeated time is skipped
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    frames[i].time_s = times_s[i];
+    frames[i].sample.position_mm = Eigen::Vector3d(1.5 * i, -2.0 + i, 0.25 * i * i);
+    frames[i].sample.buttons = static_cast<std::uint32_t>(i % 2);
+  }
+  const std::vector<TrajectoryPoint> points = trajectory_of_frames(frames);
+  ASSERT_EQ(points.size(), 3u);
+  EXPECT_EQ(points[0].time_s, 0.0);
+  TrajectoryDevice replay("Replay", points);
+  for (std::size_t i : {0u, 1u, 3u}) {
+    DeviceSample sample;
+    ASSERT_TRUE(replay.read(frames[i].time_s - frames[0].time_s, sample).ok());
+    EXPECT_EQ(sample.position_mm, frames[i].sample.position_mm) << "frame " << i;
+    EXPECT_EQ(sample.buttons, frames[i].sample.buttons) << "frame " << i;
+  }
+  EXPECT_TRUE(trajectory_of_frames({}).empty());
+}
+
 TEST(TrajectoryDevice, PlaysTheTrajectoryOnTheServoClock) {
   TrajectoryDevice device("scripted",
                           {{0.0, {0, 0, 0}, 0}, {1.0, {10, 0, 0}, 1}, {2.0, {10, 20, 0}, 0}});

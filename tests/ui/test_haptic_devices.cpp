@@ -246,6 +246,49 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   EXPECT_NE(window_->servo(), nullptr) << "the device runs without recording";
 }
 
+// A recorded session's device input plays back through the servo, at its original rate, along
+// the recorded line to its end; the replay is not recorded again, and a session that is not there
+// is refused with its number.
+TEST_F(DeviceTest, ARecordedSessionReplaysItsDeviceInputAndIsNotRecordedAgain) {
+  openWindow();
+  const QString database = folder_.filePath("replay.sqlite");
+  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
+  const Eigen::Vector3d start_mm(-5.0, 0.0, 35.0), end_mm(-5.0, 12.0, 35.0);
+  const QString file = writeTrajectory({{0.0, start_mm, 0}, {0.3, end_mm, 1}, {600.0, end_mm, 1}});
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
+  ASSERT_TRUE(window_->recordingSession().has_value());
+  const std::int64_t session = *window_->recordingSession();
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 500; }, kTimeoutMs));
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+
+  ASSERT_TRUE(window_->replaySession(session))
+      << window_->devicePanel()->statusText().toStdString();
+  EXPECT_EQ(window_->device(), DeviceChoice::replay);
+  EXPECT_FALSE(window_->recordingSession().has_value()) << "a replay was recorded";
+  EXPECT_TRUE(window_->devicePanel()->statusText().contains("Replay of session"))
+      << window_->devicePanel()->statusText().toStdString();
+  // The replayed device reaches the recorded end, having stayed on the recorded line.
+  const Eigen::Vector3d along = (end_mm - start_mm).normalized();
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        const auto sample = snapshot().device_sample;
+        if (!sample) return false;
+        const Eigen::Vector3d off = sample->position_mm - start_mm;
+        EXPECT_LT((off - off.dot(along) * along).norm(), 1e-9) << "off the recorded line";
+        return (sample->position_mm - end_mm).norm() < 1e-9;
+      },
+      kTimeoutMs));
+  EXPECT_EQ(snapshot().device_sample->buttons, 1u);
+
+  EXPECT_FALSE(window_->replaySession(session + 40));
+  EXPECT_TRUE(window_->devicePanel()->statusText().contains(QString::number(session + 40)))
+      << window_->devicePanel()->statusText().toStdString();
+  EXPECT_EQ(window_->device(), DeviceChoice::replay) << "the replay in use stays";
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
+  EXPECT_EQ(store.sessions().size(), 1u);
+}
+
 TEST_F(DeviceTest, ABadTrajectoryFileIsNamedWithItsLineAndTheDeviceInUseStays) {
   openWindow();
   const QString file = folder_.filePath("broken.txt");

@@ -4,9 +4,11 @@
 // instructor's replay) and what the tests drive the force path with.
 
 #include "liversim/core/haptic_device.h"
+#include "liversim/core/servo_loop.h"
 #include "liversim/core/triple_buffer.h"
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,11 @@ struct TrajectoryPoint {
 // line and what is wrong.
 std::vector<TrajectoryPoint> load_trajectory(const std::filesystem::path& file);
 void save_trajectory(const std::filesystem::path& file, const std::vector<TrajectoryPoint>& points);
+
+// The device input logged with a session (servo frames), as a trajectory starting at time 0:
+// positions and buttons at the frames' own times, so a TrajectoryDevice replays it at its original
+// rate. Frames whose time does not increase are skipped.
+std::vector<TrajectoryPoint> trajectory_of_frames(std::span<const ServoFrame> frames);
 
 // Plays a trajectory on the servo clock: positions interpolated linearly between points, the
 // velocity the slope there, the buttons of the point before. Before the first point it stays at
