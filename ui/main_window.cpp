@@ -94,11 +94,7 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   addPanelDock(tr("Tool"), "toolDock", toolPanel_);
   connect(toolPanel_, &ToolPanel::toolChanged, this, [this] {
     if (servo_) simulation_->set_device_tool(deviceToolSettings());
-    if (recorder_ && servo_) {
-      const auto tool = toolPanel_->tool();
-      recorder_->record_event({servo_->now_s(), SessionEventKind::tool_selected,
-                               tool ? std::string(tool_name(*tool)) : "hand"});
-    }
+    recordToolChoice();
   });
 
   devicePanel_ = new DevicePanel(this);
@@ -801,7 +797,13 @@ void MainWindow::beginRecording() {
     statusBar()->showMessage(sessionsProblem_);
     return;
   }
+  recordToolChoice();
+}
+
+void MainWindow::recordToolChoice() {
+  if (!recorder_ || !servo_) return;
   const auto tool = toolPanel_->tool();
+  // The hand holds no tool (tool_intervals reads any other name as none).
   recorder_->record_event({servo_->now_s(), SessionEventKind::tool_selected,
                            tool ? std::string(tool_name(*tool)) : "hand"});
 }

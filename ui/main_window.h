@@ -153,8 +153,9 @@ class MainWindow : public QMainWindow {
   void saveHapticPreferences();
   void chooseSessionToReplay();  // asks which recorded session, then replaySession()
   void beginRecording();         // a session of servo_ on the scene now shown
-  void endRecording();  // stops servo_ first: its last frames and figures are in the session
-  void openOmni();      // looks for the Phantom Omni: omni_, or why not in omniProblem_
+  void endRecording();           // (detachDevice stops servo_ first: its last frames are kept)
+  void recordToolChoice();       // the Tool panel's tool as a session event
+  void openOmni();               // looks for the Phantom Omni: omni_, or why not in omniProblem_
   void finishIntegratorChange(const IntegratorSettings& settings,
                               std::shared_ptr<const SimModel> model, const QString& error);
   void showNewestSnapshot();

@@ -121,7 +121,7 @@ void ToolPanel::setTool(std::optional<ToolKind> tool) {
 }
 
 void ToolPanel::setAvailableTools(const std::vector<ToolKind>& tools) {
-  for (const ToolKind kind : {ToolKind::probe, ToolKind::forceps, ToolKind::scalpel})
+  for (const ToolKind kind : kToolKinds)
     if (QAbstractButton* button = tools_->button(static_cast<int>(kind)))
       button->setVisible(std::find(tools.begin(), tools.end(), kind) != tools.end());
   // A tool the scene does not offer is put down: the hand takes over.

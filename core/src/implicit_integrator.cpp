@@ -384,7 +384,8 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
     bool converged = false;
     // The tangent changes slowly, and the Krylov solve below absorbs what it misses: keep a
     // factorisation across iterations and steps, and build a new one for a quite different β,
-    // new springs, or when the Krylov solve needed many iterations.
+    // new springs, or once the Krylov solve needs clearly more iterations than it did on the
+    // fresh factorisation.
     // (BDF2's restarts switch β between Δt and 2Δt/3: GMRES absorbs that much.)
     auto drifted = [&](int krylov) {
       return s.fresh_krylov_iterations > 0 &&

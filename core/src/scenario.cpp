@@ -41,8 +41,7 @@ using NameTable = std::span<const std::pair<Enum, std::string_view>>;
 NameTable<ToolKind> tool_names() {
   static const std::vector<std::pair<ToolKind, std::string_view>> table = [] {
     std::vector<std::pair<ToolKind, std::string_view>> t;
-    for (ToolKind kind : {ToolKind::probe, ToolKind::forceps, ToolKind::scalpel})
-      t.emplace_back(kind, tool_name(kind));
+    for (ToolKind kind : kToolKinds) t.emplace_back(kind, tool_name(kind));
     return t;
   }();
   return table;
@@ -372,31 +371,44 @@ TissueSpec read_tissue(const Json& value, std::vector<ScenarioError>& errors) {
   return tissue;
 }
 
-std::vector<LesionSpec> read_lesions(const Json& value, std::vector<ScenarioError>& errors) {
-  std::vector<LesionSpec> lesions;
+// The list at `path`: each element an object of the `known` keys, read by read_item(fields); a
+// value that is not a list is one error.
+template <class Item, class ReadItem>
+std::vector<Item> read_object_list(const Json& value, const std::string& path,
+                                   std::string_view what,
+                                   std::initializer_list<std::string_view> known,
+                                   std::vector<ScenarioError>& errors, ReadItem read_item) {
+  std::vector<Item> items;
   if (!value.is_array()) {
-    errors.push_back({"lesions", shown(value) + " is invalid: expected a list of lesions"});
-    return lesions;
+    errors.push_back({path, shown(value) + " is invalid: expected a list of " + std::string(what)});
+    return items;
   }
   for (std::size_t i = 0; i < value.size(); ++i) {
-    Fields f(value[i], "lesions[" + std::to_string(i) + "]", errors,
-             {"name", "centre_mm", "radii_mm", "youngs_modulus_pa", "yield_limit_pa",
-              "viscosity_pa_s", "hidden"});
-    if (!f.is_object()) continue;
-    LesionSpec lesion;
-    lesion.name = f.text("name", true, true).value_or("");
-    lesion.centre_mm = f.triple("centre_mm", -kPositionLimitMm, kPositionLimitMm, "mm", true)
-                           .value_or(Millimetres3{});
-    lesion.radii_mm = f.triple("radii_mm", 2.0, 50.0, "mm", true).value_or(lesion.radii_mm);
-    lesion.youngs_modulus_pa =
-        f.number("youngs_modulus_pa", 1000.0, 2e6, "Pa", true, "lesion's Young's modulus")
-            .value_or(lesion.youngs_modulus_pa);
-    lesion.yield_limit_pa = f.parameter("yield_limit_pa", p::yield_limit, false);
-    lesion.viscosity_pa_s = f.parameter("viscosity_pa_s", p::eta1, false);
-    lesion.hidden = f.boolean("hidden", false).value_or(false);
-    lesions.push_back(lesion);
+    Fields f(value[i], path + "[" + std::to_string(i) + "]", errors, known);
+    if (f.is_object()) items.push_back(read_item(f));
   }
-  return lesions;
+  return items;
+}
+
+std::vector<LesionSpec> read_lesions(const Json& value, std::vector<ScenarioError>& errors) {
+  return read_object_list<LesionSpec>(
+      value, "lesions", "lesions",
+      {"name", "centre_mm", "radii_mm", "youngs_modulus_pa", "yield_limit_pa", "viscosity_pa_s",
+       "hidden"},
+      errors, [](Fields& f) {
+        LesionSpec lesion;
+        lesion.name = f.text("name", true, true).value_or("");
+        lesion.centre_mm = f.triple("centre_mm", -kPositionLimitMm, kPositionLimitMm, "mm", true)
+                               .value_or(Millimetres3{});
+        lesion.radii_mm = f.triple("radii_mm", 2.0, 50.0, "mm", true).value_or(lesion.radii_mm);
+        lesion.youngs_modulus_pa =
+            f.number("youngs_modulus_pa", 1000.0, 2e6, "Pa", true, "lesion's Young's modulus")
+                .value_or(lesion.youngs_modulus_pa);
+        lesion.yield_limit_pa = f.parameter("yield_limit_pa", p::yield_limit, false);
+        lesion.viscosity_pa_s = f.parameter("viscosity_pa_s", p::eta1, false);
+        lesion.hidden = f.boolean("hidden", false).value_or(false);
+        return lesion;
+      });
 }
 
 EffectsSpec read_effects(const Json& value, std::vector<ScenarioError>& errors) {
@@ -490,39 +502,32 @@ TaskSpec read_task(const Json& value, std::vector<ScenarioError>& errors) {
 }
 
 std::vector<RubricCriterion> read_rubric(const Json& value, std::vector<ScenarioError>& errors) {
-  std::vector<RubricCriterion> rubric;
-  if (!value.is_array()) {
-    errors.push_back({"rubric", shown(value) + " is invalid: expected a list of criteria"});
-    return rubric;
-  }
-  for (std::size_t i = 0; i < value.size(); ++i) {
-    Fields f(value[i], "rubric[" + std::to_string(i) + "]", errors,
-             {"metric", "weight", "at_most", "at_least"});
-    if (!f.is_object()) continue;
-    RubricCriterion criterion;
-    if (const auto metric = f.text("metric", true)) {
-      if (find_metric(*metric))
-        criterion.metric = *metric;
-      else {
-        std::string list;
-        for (const MetricInfo& m : gradable_metrics())
-          list += (list.empty() ? "" : ", ") + std::string(m.name);
-        f.fail("metric", shown(*f.get("metric")) + " is invalid: expected one of " + list);
-      }
-    }
-    criterion.weight = f.number("weight", 0.0, 100.0, "", true).value_or(0.0);
-    const bool most = f.has("at_most"), least = f.has("at_least");
-    if (most == least) {
-      f.fail_here("needs exactly one of at_most and at_least (the pass threshold)");
-    } else {
-      criterion.rule = most ? PassRule::at_most : PassRule::at_least;
-      criterion.threshold =
-          f.number(most ? "at_most" : "at_least", -1e9, 1e9, "", true, "the pass threshold")
-              .value_or(0.0);
-    }
-    rubric.push_back(criterion);
-  }
-  return rubric;
+  return read_object_list<RubricCriterion>(
+      value, "rubric", "criteria", {"metric", "weight", "at_most", "at_least"}, errors,
+      [](Fields& f) {
+        RubricCriterion criterion;
+        if (const auto metric = f.text("metric", true)) {
+          if (find_metric(*metric))
+            criterion.metric = *metric;
+          else {
+            std::string list;
+            for (const MetricInfo& m : gradable_metrics())
+              list += (list.empty() ? "" : ", ") + std::string(m.name);
+            f.fail("metric", shown(*f.get("metric")) + " is invalid: expected one of " + list);
+          }
+        }
+        criterion.weight = f.number("weight", 0.0, 100.0, "", true).value_or(0.0);
+        const bool most = f.has("at_most"), least = f.has("at_least");
+        if (most == least) {
+          f.fail_here("needs exactly one of at_most and at_least (the pass threshold)");
+        } else {
+          criterion.rule = most ? PassRule::at_most : PassRule::at_least;
+          criterion.threshold =
+              f.number(most ? "at_most" : "at_least", -1e9, 1e9, "", true, "the pass threshold")
+                  .value_or(0.0);
+        }
+        return criterion;
+      });
 }
 
 // Older format versions, step by step up to the current one. Version 1 is the first: nothing to

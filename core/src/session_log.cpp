@@ -92,9 +92,8 @@ std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events) {
   std::vector<ToolInterval> intervals;
   for (const SessionEvent& event : events) {
     if (event.kind != SessionEventKind::tool_selected) continue;
-    ToolInterval interval{event.time_s, std::nullopt};  // the hand, or a name no tool has
-    for (ToolKind kind : {ToolKind::probe, ToolKind::forceps, ToolKind::scalpel})
-      if (tool_name(kind) == event.detail) interval.tool = kind;
+    // The hand, or a name no tool has: no tool.
+    const ToolInterval interval{event.time_s, tool_kind(event.detail)};
     // Two choices at one instant (the servo clock's resolution): the later one holds.
     if (!intervals.empty() && !(interval.start_s > intervals.back().start_s))
       intervals.back() = interval;

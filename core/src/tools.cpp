@@ -22,6 +22,12 @@ std::string_view tool_name(ToolKind kind) {
   return "unknown";
 }
 
+std::optional<ToolKind> tool_kind(std::string_view name) {
+  for (ToolKind kind : kToolKinds)
+    if (tool_name(kind) == name) return kind;
+  return std::nullopt;
+}
+
 namespace {
 
 // Jaw j (0 or 1) of the forceps, from the hinge at the origin, in the tool frame.

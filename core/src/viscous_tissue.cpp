@@ -284,15 +284,18 @@ void ViscousHistory::store(std::size_t e, const ViscousTissueState& history) {
     slot(kInversePlasticDeformation + k, e) = history.inverse_plastic_deformation.data()[k];
   slot(kEquivalentPlasticStrain, e) = history.equivalent_plastic_strain;
   slot(kYieldClock, e) = history.yield_clock_s;
-  if (history.inverse_plastic_deformation != Eigen::Matrix3d::Identity())
-    plastic_blocks_[e / kBlock] = 1;
+  note_flow(e);
 }
 
 void ViscousHistory::copy_element(const ViscousHistory& from, std::size_t from_e,
                                   std::size_t to_e) {
   for (int k = 0; k < kComponents; ++k) slot(k, to_e) = from.value(k, from_e);
-  if (from.inverse_plastic_deformation(from_e) != Eigen::Matrix3d::Identity())
-    plastic_blocks_[to_e / kBlock] = 1;
+  note_flow(to_e);
+}
+
+void ViscousHistory::note_flow(std::size_t e) {
+  if (inverse_plastic_deformation(e) != Eigen::Matrix3d::Identity())
+    plastic_blocks_[e / kBlock] = 1;
 }
 
 Eigen::Matrix3d ViscousHistory::inverse_plastic_deformation(std::size_t e) const {

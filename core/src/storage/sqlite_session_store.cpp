@@ -142,6 +142,16 @@ class SqliteSessionStore::Statement {
     sqlite3_reset(statement_);  // keeps the error for fail() to read
     store_.fail(doing);
   }
+  // Column 0 of the one row it gives; an error when it gives none.
+  std::int64_t single_integer(const char* doing) {
+    if (!step(doing)) {
+      reset();
+      throw store_.error(std::string(doing) + " failed: no such row");
+    }
+    const std::int64_t value = integer(0);
+    reset();
+    return value;
+  }
   void run(const char* doing) {
     while (step(doing)) {
     }
@@ -195,9 +205,7 @@ SqliteSessionStore::SqliteSessionStore(const std::filesystem::path& file, Access
     if (access == Access::read_write && sqlite3_db_readonly(db_, "main") == 1)
       throw error("cannot write to it (the file is read-only)");
     if (version == 0) {
-      Statement tables(*this, "SELECT count(*) FROM sqlite_master");
-      tables.step("reading the tables");
-      if (tables.integer(0) != 0)
+      if (Statement(*this, "SELECT count(*) FROM sqlite_master").single_integer("reading it") != 0)
         throw error("not a LiverSim sessions database (it holds other tables)");
     }
     if (access == Access::read_write) {
@@ -273,9 +281,7 @@ SqliteSessionStore::Statement& SqliteSessionStore::prepared(int which, const cha
 }
 
 int SqliteSessionStore::schema_version() {
-  Statement version(*this, "PRAGMA user_version");
-  version.step("reading it");
-  return static_cast<int>(version.integer(0));
+  return static_cast<int>(Statement(*this, "PRAGMA user_version").single_integer("reading it"));
 }
 
 std::string SqliteSessionStore::integrity_check() {
@@ -309,36 +315,25 @@ void SqliteSessionStore::commit() {
 
 std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
   begin_if_needed();
-  Statement& find_person =
-      prepared(kFindPerson, "SELECT id FROM people WHERE name = ?1 AND role = 'trainee'");
-  find_person.bind(1, std::string_view(start.trainee));
-  std::int64_t trainee = 0;
-  if (find_person.step("looking up the trainee")) {
-    trainee = find_person.integer(0);
-    find_person.reset();
-  } else {
-    find_person.reset();
-    prepared(kAddPerson, "INSERT INTO people (name, role) VALUES (?1, 'trainee')")
-        .bind(1, std::string_view(start.trainee))
-        .run("adding the trainee");
-    trainee = sqlite3_last_insert_rowid(db_);
-  }
+  // Added if new (a name per role and a text's hash are unique), then looked up either way.
+  prepared(kAddPerson, "INSERT OR IGNORE INTO people (name, role) VALUES (?1, 'trainee')")
+      .bind(1, std::string_view(start.trainee))
+      .run("adding the trainee");
+  const std::int64_t trainee =
+      prepared(kFindPerson, "SELECT id FROM people WHERE name = ?1 AND role = 'trainee'")
+          .bind(1, std::string_view(start.trainee))
+          .single_integer("looking up the trainee");
   const std::string hash = sha256_hex(start.scenario_text);
-  Statement& find_scenario = prepared(kFindScenario, "SELECT id FROM scenarios WHERE sha256 = ?1");
-  find_scenario.bind(1, std::string_view(hash));
-  std::int64_t scenario = 0;
-  if (find_scenario.step("looking up the scenario")) {
-    scenario = find_scenario.integer(0);
-    find_scenario.reset();
-  } else {
-    find_scenario.reset();
-    prepared(kAddScenario, "INSERT INTO scenarios (sha256, title, content) VALUES (?1, ?2, ?3)")
-        .bind(1, std::string_view(hash))
-        .bind(2, std::string_view(start.scenario_title))
-        .bind(3, std::string_view(start.scenario_text))
-        .run("storing the scenario");
-    scenario = sqlite3_last_insert_rowid(db_);
-  }
+  prepared(kAddScenario,
+           "INSERT OR IGNORE INTO scenarios (sha256, title, content) VALUES (?1, ?2, ?3)")
+      .bind(1, std::string_view(hash))
+      .bind(2, std::string_view(start.scenario_title))
+      .bind(3, std::string_view(start.scenario_text))
+      .run("storing the scenario");
+  const std::int64_t scenario =
+      prepared(kFindScenario, "SELECT id FROM scenarios WHERE sha256 = ?1")
+          .bind(1, std::string_view(hash))
+          .single_integer("looking up the scenario");
   prepared(kAddSession,
            "INSERT INTO sessions (trainee_id, scenario_id, device, started_unix_ms, status) "
            "VALUES (?1, ?2, ?3, ?4, 'recording')")
@@ -355,14 +350,10 @@ std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
 void SqliteSessionStore::append_frames(std::int64_t session, std::span<const ServoFrame> frames) {
   if (frames.empty()) return;
   begin_if_needed();
-  Statement& count = prepared(kFrameCount, "SELECT frame_count FROM sessions WHERE id = ?1");
-  count.bind(1, session);
-  if (!count.step("reading the session's frame count")) {
-    count.reset();
-    throw error("there is no session " + std::to_string(session));
-  }
-  const std::int64_t first = count.integer(0);
-  count.reset();
+  const std::int64_t first =
+      prepared(kFrameCount, "SELECT frame_count FROM sessions WHERE id = ?1")
+          .bind(1, session)
+          .single_integer(("looking up session " + std::to_string(session)).c_str());
   const std::vector<std::uint8_t> bytes = encode_frame_chunk(frames);
   prepared(kAddChunk,
            "INSERT INTO frame_chunks (session_id, first_frame, frame_count, first_time_s, "

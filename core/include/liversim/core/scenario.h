@@ -134,7 +134,7 @@ struct Scenario {
   std::vector<LesionSpec> lesions;
   EffectsSpec effects;
   IntegratorSettings integrator;
-  std::vector<ToolKind> tools{ToolKind::probe, ToolKind::forceps, ToolKind::scalpel};
+  std::vector<ToolKind> tools = std::vector<ToolKind>(kToolKinds.begin(), kToolKinds.end());
   TaskSpec task;
   std::vector<RubricCriterion> rubric;
   bool operator==(const Scenario&) const;

@@ -20,7 +20,11 @@
 namespace liversim {
 
 enum class ToolKind { probe, forceps, scalpel };
+inline constexpr std::array<ToolKind, 3> kToolKinds = {ToolKind::probe, ToolKind::forceps,
+                                                       ToolKind::scalpel};
 std::string_view tool_name(ToolKind kind);
+// The tool named `name` (as tool_name names it), if any.
+std::optional<ToolKind> tool_kind(std::string_view name);
 
 // A segment swept by a sphere: every tool part is one.
 struct Capsule {

@@ -146,7 +146,8 @@ class ViscousHistory {
   }
   // Element from_e's whole history in `from` becomes element to_e's here.
   void copy_element(const ViscousHistory& from, std::size_t from_e, std::size_t to_e);
-  // The block holding element e.
+  // The block holding element e. The element loops write the arm and elastic stress through it,
+  // never Fp⁻¹ (which goes through store(), for plastic_blocks).
   double* block(std::size_t e) { return values_.data() + e / kBlock * kComponents * kBlock; }
   // Per block of kBlock elements: 1 once an element of it has stored Fp ≠ I. Blocks with 0 skip
   // the products with Fp⁻¹ (most tissue never yields).
@@ -156,6 +157,7 @@ class ViscousHistory {
 
  private:
   double& slot(int k, std::size_t e) { return block(e)[k * kBlock + e % kBlock]; }
+  void note_flow(std::size_t e);  // flags e's block if e's Fp⁻¹ is not the identity
 
   std::size_t elements_ = 0;
   std::vector<double> values_;
