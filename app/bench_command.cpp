@@ -334,6 +334,16 @@ int evaluate_effect_off_case(const BenchOptions& o) {
   return 0;
 }
 
+// The processor as /proc/cpuinfo names it ("unknown processor" elsewhere).
+std::string processor_name() {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpuinfo, line))
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos)
+      return line.substr(line.find(':') + 2);
+  return "unknown processor";
+}
+
 std::string shell_quoted(const std::string& text) {
   std::string quoted = "'";
   for (char ch : text) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
@@ -605,11 +615,13 @@ int run_bench(const BenchOptions& o) {
 
   std::ostringstream md;
   md << "# Performance\n\n"
-     << "Written by `" << line.str() << "` on " << today_utc() << " ("
+     << "Written by `" << line.str() << "` on " << today_utc() << " (" << processor_name() << ", "
      << std::thread::hardware_concurrency() << " hardware threads; element loops built for "
      << element_kernel_instruction_set()
-     << "). Wall-clock time on this machine; each force figure is the best of " << kRepetitions
-     << " runs of at least " << o.min_time_s
+     << "). Wall-clock time on this machine (the same build has run 2 to 3 times slower on "
+        "other virtual machines of this kind: compare figures only within one run); each force "
+        "figure is the best of "
+     << kRepetitions << " runs of at least " << o.min_time_s
      << " s (this virtual machine's run-to-run spread is up to 30 %, so the least disturbed run "
         "is the figure).\n\n"
      << "## Targets\n\n"
