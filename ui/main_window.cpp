@@ -226,19 +226,21 @@ void MainWindow::finishScenarioOpen(const OpenedScenario& opened, std::shared_pt
   openingScenario_ = false;
   accuracyPanel_->setBusy(false);
   if (!model) return refuseScenario(opened.file, error);
+  // The device stays; its session was of the old scene: it ends (with the old scene's outcome)
+  // and another begins on the new one.
+  const bool recording = recorder_ != nullptr;
+  endRecording();
   try {
     installScene(std::move(*setup), std::move(model));
   } catch (const std::exception& e) {
     simulation_->start();  // nothing was replaced: the old scene goes on
+    if (recording) beginRecording();
     return refuseScenario(opened.file, QString::fromUtf8(e.what()));
   }
   scenario_ = opened;
   attachDevice();
   simulation_->start();
-  if (recorder_) {  // the device stays; its session was of the old scene
-    endRecording();
-    beginRecording();
-  }
+  if (recording) beginRecording();
   accuracyPanel_->setSettings(setup_.model_options.integrator);
   showScenarioDetails();
   rememberScenario(opened.file);
@@ -304,6 +306,16 @@ void MainWindow::buildMenus() {
   QAction* quit = file->addAction(tr("&Quit"), this, &QWidget::close);
   quit->setObjectName("quitAction");
   quit->setShortcut(QKeySequence::Quit);
+
+  QMenu* session = menuBar()->addMenu(tr("&Session"));
+  session->setObjectName("sessionMenu");
+  QAction* mark =
+      session->addAction(tr("&Mark the Lesion Here"), this, [this] { markLesionUnderTool(); });
+  mark->setObjectName("markLesionAction");
+  mark->setShortcut(QKeySequence(Qt::Key_M));
+  mark->setToolTip(
+      tr("Palpation: mark the point of the liver under the tool as where the lesion "
+         "is (graded at the session's end)"));
 }
 
 void MainWindow::openScenarioFromMenu(const QString& file) {
@@ -397,9 +409,12 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   state.energy = old.energy;  // the books go on (the guard bounds kinetic energy by them)
   state.time_s = old.time_s;
   state.step_count = old.step_count;
+  // The same mesh: a session's damage and lift tracking go on in the new simulation.
+  std::optional<OutcomeTracking> outcome = simulation_->outcome();
   try {
     auto replacement = std::make_unique<RealtimeSimulation>(model, std::move(state));
     simulation_ = std::move(replacement);
+    if (outcome) simulation_->track_outcome(std::move(*outcome));
   } catch (const std::exception& e) {
     simulation_->start();  // the old one goes on where it stopped
     accuracyPanel_->showError(QString::fromUtf8(e.what()));
@@ -798,6 +813,35 @@ void MainWindow::beginRecording() {
     return;
   }
   recordToolChoice();
+  // Damage, lift and resection need the simulation: tracked while the session runs.
+  std::optional<Eigen::Vector3d> lift_point_m;
+  if (scenario_ && scenario_->scenario.task.kind == TaskKind::retract_lobe) {
+    const Millimetres3& mm = scenario_->scenario.task.grasp_point_mm;
+    lift_point_m = Eigen::Vector3d(mm[0], mm[1], mm[2]) * 1e-3;
+  }
+  simulation_->track_outcome(lift_point_m);
+}
+
+bool MainWindow::markLesionUnderTool() {
+  if (!recorder_ || !servo_) {
+    statusBar()->showMessage(
+        tr("Marks are kept with a recorded session: drive the tool with a "
+           "haptic device to record one."));
+    return false;
+  }
+  const SimulationSnapshot& snapshot = simulation_->snapshot();
+  if (!snapshot.tool || !snapshot.model) {
+    statusBar()->showMessage(tr("Hold a tool over the place to mark."));
+    return false;
+  }
+  const Eigen::Vector3d rest_m =
+      rest_point_nearest(*snapshot.model, snapshot.position_m, snapshot.tool->pose.origin_m);
+  recorder_->record_event({servo_->now_s(), SessionEventKind::lesion_marked, mark_detail(rest_m)});
+  statusBar()->showMessage(tr("Marked the lesion at (%1, %2, %3) mm.")
+                               .arg(rest_m.x() * 1e3, 0, 'f', 0)
+                               .arg(rest_m.y() * 1e3, 0, 'f', 0)
+                               .arg(rest_m.z() * 1e3, 0, 'f', 0));
+  return true;
 }
 
 void MainWindow::recordToolChoice() {
@@ -813,6 +857,11 @@ void MainWindow::endRecording() {
   const ServoStats stats = servo_ ? servo_->stats() : ServoStats{};
   const std::uint64_t dropped = servo_ ? servo_->dropped_log_frames() : 0;
   const std::int64_t session = recorder_->session();
+  std::optional<OutcomeTracking> outcome;
+  if (simulation_) {
+    outcome = simulation_->outcome();
+    simulation_->stop_tracking_outcome();
+  }
   if (!recorder_->finish(QDateTime::currentMSecsSinceEpoch(), servo_figures(stats, dropped))) {
     sessionsProblem_ =
         tr("The session was not saved whole: %1").arg(QString::fromStdString(recorder_->error()));
@@ -821,13 +870,24 @@ void MainWindow::endRecording() {
     return;
   }
   recorder_.reset();
-  // The metrics of its trace, from what was stored (docs/session-metrics.md).
+  // The metrics of its trace, from what was stored, and of its simulation
+  // (docs/session-metrics.md).
   try {
+    std::vector<MetricValue> values;
+    const std::vector<SessionEvent> events = sessions_->events(session);
     const std::vector<ServoFrame> frames = sessions_->frames(session);
-    if (frames.empty()) return;
-    const TraceMetrics metrics = compute_trace_metrics(
-        frames, tool_intervals(sessions_->events(session)), haptics_.mapping, {});
-    sessions_->store_metrics(session, trace_metric_values(metrics));
+    if (!frames.empty())
+      values = trace_metric_values(
+          compute_trace_metrics(frames, tool_intervals(events), haptics_.mapping, {}));
+    if (outcome) {
+      const Scenario* scenario = scenario_ ? &scenario_->scenario : nullptr;
+      const std::vector<MetricValue> simulated = outcome_metric_values(
+          compute_outcome_metrics(*outcome->initial_model, *outcome->model, outcome->tracker,
+                                  scenario, lesion_marks(events)),
+          scenario);
+      values.insert(values.end(), simulated.begin(), simulated.end());
+    }
+    if (!values.empty()) sessions_->store_metrics(session, values);
   } catch (const std::exception& e) {
     sessionsProblem_ =
         tr("The session's metrics were not stored: %1").arg(QString::fromUtf8(e.what()));

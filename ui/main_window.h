@@ -110,6 +110,10 @@ class MainWindow : public QMainWindow {
   bool replaySession(std::int64_t session);
   // The session being recorded, if any.
   std::optional<std::int64_t> recordingSession() const;
+  // Palpation: records the rest point of the liver under the tool as the trainee's mark of the
+  // lesion (a lesion_marked event; Session menu, M). False, saying why in the status bar, when
+  // no session is recorded or no tool is in the scene.
+  bool markLesionUnderTool();
 
   // Spring stiffness of a mouse grab and the radius of tissue it holds.
   static constexpr double kGrabStiffnessNPerM = 300.0;

@@ -155,6 +155,13 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   propagating.cutting_stress_pa = 0.0;
   CutResult cut = cut_tissue(*model_, state_, stroke_, propagating);
   if (!cut.cut()) return;
+  {
+    std::lock_guard lock(outcome_mutex_);
+    if (outcome_) {
+      outcome_->tracker.carry_over(cut);
+      outcome_->model = cut.model;
+    }
+  }
   model_ = std::move(cut.model);
   state_ = std::move(cut.state);
   checkpoint_ = make_checkpoint(*model_);
@@ -169,6 +176,43 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   active_springs_.clear();
   ++topology_version_;
   resected_volume_m3_ += cut.report.resected_volume_m3;
+}
+
+void RealtimeSimulation::track_outcome(std::optional<Eigen::Vector3d> lift_point_m,
+                                       OutcomeSettings settings) {
+  std::lock_guard lock(outcome_mutex_);
+  outcome_.reset();
+  outcome_request_.emplace(lift_point_m, settings);
+}
+
+void RealtimeSimulation::track_outcome(OutcomeTracking carried) {
+  std::lock_guard lock(outcome_mutex_);
+  outcome_request_.reset();
+  outcome_ = std::move(carried);
+}
+
+void RealtimeSimulation::stop_tracking_outcome() {
+  std::lock_guard lock(outcome_mutex_);
+  outcome_request_.reset();
+  outcome_.reset();
+}
+
+std::optional<OutcomeTracking> RealtimeSimulation::outcome() const {
+  std::lock_guard lock(outcome_mutex_);
+  return outcome_;
+}
+
+void RealtimeSimulation::observe_outcome() {
+  std::lock_guard lock(outcome_mutex_);
+  if (outcome_request_) {  // allocates once, when tracking begins
+    outcome_.emplace(
+        OutcomeTracking{OutcomeTracker(*model_, outcome_request_->first, outcome_request_->second),
+                        model_, model_});
+    outcome_request_.reset();
+  }
+  if (!outcome_) return;
+  outcome_->tracker.observe(*model_, state_.position_m);
+  outcome_->model = model_;
 }
 
 void RealtimeSimulation::end_stroke() {
@@ -382,6 +426,7 @@ void RealtimeSimulation::run() {
       out.tool = tool_acts ? active_tool_ : std::nullopt;
       out.device_sample = device_sample_;
       if (haptic_servo_) haptic_servo_->publish(force_model);
+      observe_outcome();
       out.model = model_;
       out.topology_version = topology_version_;
       out.resected_volume_m3 = resected_volume_m3_;

@@ -3,15 +3,16 @@
 #include <array>
 #include <bit>
 #include <cstring>
+#include <sstream>
 
 namespace liversim {
 
 namespace {
 
-constexpr std::array<std::string_view, 8> kEventNames = {"grasp",         "release",
-                                                         "cut",           "excessive_force",
-                                                         "lesion_breach", "simulation_recovery",
-                                                         "device_fault",  "tool_selected"};
+constexpr std::array<std::string_view, 9> kEventNames = {
+    "grasp",           "release",       "cut",
+    "excessive_force", "lesion_breach", "simulation_recovery",
+    "device_fault",    "tool_selected", "lesion_marked"};
 
 // Layout 1: "LSF1", the frame count (u32), then one column per quantity, frame by frame: time,
 // position x, y, z, velocity x, y, z, force x, y, z (IEEE doubles), buttons (u32). Columns keep
@@ -101,6 +102,24 @@ std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events) {
       intervals.push_back(interval);
   }
   return intervals;
+}
+
+std::string mark_detail(const Eigen::Vector3d& rest_point_m) {
+  std::ostringstream text;
+  text.precision(17);
+  text << rest_point_m.x() * 1e3 << ' ' << rest_point_m.y() * 1e3 << ' ' << rest_point_m.z() * 1e3;
+  return text.str();
+}
+
+std::vector<Eigen::Vector3d> lesion_marks(std::span<const SessionEvent> events) {
+  std::vector<Eigen::Vector3d> marks;
+  for (const SessionEvent& event : events) {
+    if (event.kind != SessionEventKind::lesion_marked) continue;
+    std::istringstream text(event.detail);
+    Eigen::Vector3d mm;
+    if (text >> mm.x() >> mm.y() >> mm.z() && mm.allFinite()) marks.push_back(mm * 1e-3);
+  }
+  return marks;
 }
 
 std::vector<MetricValue> trace_metric_values(const TraceMetrics& m) {

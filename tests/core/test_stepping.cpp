@@ -159,7 +159,9 @@ TEST_F(SteppingFixture, ToolIntervalsAllocateNothingEvenWhenTheJawsClose) {
   for (int interval = 0; interval < 40; ++interval) {
     forceps.jaw_opening = interval < 10 ? 1.0 : interval < 30 ? 0.0 : 1.0;
     advance(*model_, state, {{}, hand.update(forceps, state.position_m)}, 1e-3);
-    if (interval == 10) EXPECT_TRUE(hand.grasping());
+    if (interval == 10) {
+      EXPECT_TRUE(hand.grasping());
+    }
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_FALSE(hand.grasping());

@@ -6,15 +6,18 @@
 #include <gtest/gtest.h>
 
 #include <dlfcn.h>
+#include <QAction>
 #include <QComboBox>
 #include <QDir>
 #include <QSettings>
+#include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QTest>
 
 #include <algorithm>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 
 #include "calibration_dialog.h"
@@ -22,6 +25,7 @@
 #include "haptic_preferences.h"
 #include "liversim/core/default_scene.h"
 #include "liversim/core/emulated_devices.h"
+#include "liversim/core/surface.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
 #include "tool_panel.h"
@@ -234,7 +238,14 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
       (frames.back().sample.position_mm - frames.front().sample.position_mm).norm();
   EXPECT_GT(straight_mm, 0.0);
   EXPECT_NEAR(path->value, straight_mm, 1e-9 * straight_mm);
-  EXPECT_EQ(metrics.size(), trace_metric_values(TraceMetrics{}).size());
+  // With the simulation's metrics of free practice: no task, so damage and resected volume only.
+  EXPECT_EQ(metrics.size(), trace_metric_values(TraceMetrics{}).size() + 2);
+  for (const char* name : {"tissue_damage_mm3", "resected_volume_mm3"}) {
+    const auto it = std::find_if(metrics.begin(), metrics.end(),
+                                 [&](const MetricValue& m) { return m.name == name; });
+    ASSERT_NE(it, metrics.end()) << name;
+    EXPECT_EQ(it->value, 0.0) << name << ": the forceps only moved through the air";
+  }
 
   const QString not_a_database = folder_.filePath("notes.txt");
   std::ofstream(not_a_database.toStdString()) << "not a database\n";
@@ -244,6 +255,64 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
   EXPECT_FALSE(window_->recordingSession().has_value());
   EXPECT_NE(window_->servo(), nullptr) << "the device runs without recording";
+}
+
+// Palpation, the shipped scenario: the scripted probe held just off the liver's surface where it is
+// nearest the hidden lesion; the trainee marks it (Session menu, M); the session's end grades the
+// mark: the task succeeded, and the probe, never pressing, damaged nothing.
+TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
+  useSceneMillimetres();
+  openWindow();
+  const QString database = folder_.filePath("sessions.sqlite");
+  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
+  QSignalSpy opened(window_.get(), &MainWindow::scenarioOpenFinished);
+  ASSERT_TRUE(window_->openScenario(QStringLiteral(LIVERSIM_TEST_DATA_DIR) +
+                                    "/../../scenarios/palpation-hidden-lesion.json"));
+  ASSERT_TRUE(opened.wait(kTimeoutMs));
+  ASSERT_TRUE(opened.first().first().toBool());
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return snapshot().model && snapshot().time_s > 0.0; }, kTimeoutMs));
+  const Scenario& scenario = window_->scenario()->scenario;
+  ASSERT_EQ(scenario.task.kind, TaskKind::palpate_lesion);
+  const LesionSpec& lesion = scenario.lesions.at(0);
+  const Eigen::Vector3d centre_m =
+      Eigen::Vector3d(lesion.centre_mm[0], lesion.centre_mm[1], lesion.centre_mm[2]) * 1e-3;
+  // The surface node nearest the (spherical) lesion, and a point 10 mm outside it: the probe's
+  // ball (3 mm) clear of the curved surface around.
+  const SimModel& model = *snapshot().model;
+  const BoundarySurface surface = boundary_surface(model);
+  Eigen::Vector3d nearest = model.rest_position_m.at(surface.nodes.front());
+  for (NodeIndex n : surface.nodes)
+    if ((model.rest_position_m.at(n) - centre_m).norm() < (nearest - centre_m).norm())
+      nearest = model.rest_position_m.at(n);
+  const Eigen::Vector3d hover_mm = (nearest + 0.010 * (nearest - centre_m).normalized()) * 1e3;
+  const QString file = writeTrajectory({{0.0, hover_mm, 0}, {600.0, hover_mm, 0}});
+  window_->toolPanel()->setTool(ToolKind::probe);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
+  ASSERT_TRUE(window_->recordingSession().has_value()) << window_->sessionsProblem().toStdString();
+  const std::int64_t session = *window_->recordingSession();
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        return snapshot().tool && (snapshot().tool->pose.origin_m - hover_mm * 1e-3).norm() < 1e-9;
+      },
+      kTimeoutMs));
+  QAction* mark = window_->findChild<QAction*>("markLesionAction");
+  ASSERT_NE(mark, nullptr);
+  mark->trigger();
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+
+  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
+  const std::vector<Eigen::Vector3d> marks = lesion_marks(store.events(session));
+  ASSERT_EQ(marks.size(), 1u);
+  // The mark is the point of the surface nearest the probe's centre (the liver untouched, at
+  // rest): no farther from it than that node, 10 mm.
+  EXPECT_LE((marks[0] - hover_mm * 1e-3).norm(), 0.010 + 1e-9);
+  std::map<std::string, double> metrics;
+  for (const MetricValue& m : store.metrics(session)) metrics[m.name] = m.value;
+  EXPECT_EQ(metrics.at("task_success"), 1.0);
+  EXPECT_EQ(metrics.at("peak_force_n"), 0.0) << "the probe touched the liver";
+  EXPECT_EQ(metrics.at("tissue_damage_mm3"), 0.0);
+  EXPECT_EQ(metrics.count("lesion_margin_mm"), 0u) << "nothing was cut";
 }
 
 // A recorded session's device input plays back through the servo, at its original rate, along

@@ -12,6 +12,7 @@
 #include "liversim/core/forces.h"
 #include "liversim/core/health.h"
 #include "liversim/core/model.h"
+#include "liversim/core/outcome_metrics.h"
 #include "liversim/core/servo_loop.h"
 #include "liversim/core/state.h"
 #include "liversim/core/tools.h"
@@ -49,6 +50,14 @@ struct SimulationSnapshot {
   std::shared_ptr<const SimModel> model;
   std::uint64_t topology_version = 0;
   double resected_volume_m3 = 0.0;  // taken out by cuts since the start
+};
+
+// A session's outcome tracking (outcome_metrics.h) as it stands: the tracker, the model its
+// elements belong to (the newest it observed), and the model when tracking began.
+struct OutcomeTracking {
+  OutcomeTracker tracker;
+  std::shared_ptr<const SimModel> initial_model;
+  std::shared_ptr<const SimModel> model;
 };
 
 struct RealtimeStats {
@@ -173,6 +182,18 @@ class RealtimeSimulation {
   // (the servo's WorkspaceMapping) and uses device_tool() as the tool; set_tool is then ignored.
   void set_device_tool(const std::optional<DeviceToolSettings>& settings);
 
+  // From any thread: from the next cycle on, each published cycle is observed by an outcome
+  // tracker, and cuts carry it over (a session's tissue damage, lift, resected volume). Off until
+  // asked: a scene without a session pays nothing for it.
+  void track_outcome(std::optional<Eigen::Vector3d> lift_point_m, OutcomeSettings settings = {});
+  // Goes on with tracking carried from another simulation of the same model (an integrator
+  // change): its elements must be this model's.
+  void track_outcome(OutcomeTracking carried);
+  void stop_tracking_outcome();
+  // A copy of the tracking so far; none when off or not yet begun (the first cycle after
+  // track_outcome begins it).
+  std::optional<OutcomeTracking> outcome() const;
+
   // Consumer side (one thread, e.g. the UI): the newest snapshot, if one was published since.
   bool update_snapshot() { return snapshots_.update(); }
   const SimulationSnapshot& snapshot() const { return snapshots_.front(); }
@@ -227,6 +248,12 @@ class RealtimeSimulation {
   void take_inputs();
   void change_tool(const std::optional<Tool>& tool);
   double haptic_servo_period_s() const;
+
+  // Outcome tracking: asked for from any thread, begun and updated by the simulation thread.
+  mutable std::mutex outcome_mutex_;  // UI ↔ simulation only
+  std::optional<std::pair<std::optional<Eigen::Vector3d>, OutcomeSettings>> outcome_request_;
+  std::optional<OutcomeTracking> outcome_;
+  void observe_outcome();  // simulation thread, once per published cycle
 
   std::atomic<bool> stop_requested_{false};
   // Statistics, written by the simulation thread once per window; each field on its own (a reader

@@ -34,6 +34,7 @@ enum class SessionEventKind {
   simulation_recovery,
   device_fault,
   tool_selected,  // detail: the tool's name
+  lesion_marked,  // palpation: the trainee's mark, detail "x y z" (rest, mm)
 };
 std::string_view session_event_name(SessionEventKind kind);
 std::optional<SessionEventKind> session_event_kind(std::string_view name);
@@ -92,6 +93,10 @@ struct MetricValue {
 // The tools in use over a session, from its tool_selected events ("hand" or an unknown name ends
 // the tool before).
 std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events);
+// A lesion_marked event's detail for a rest point, and the marks of a session's events (a detail
+// that is not three finite numbers is skipped).
+std::string mark_detail(const Eigen::Vector3d& rest_point_m);
+std::vector<Eigen::Vector3d> lesion_marks(std::span<const SessionEvent> events);
 // The metrics of the session's trace (trace_metrics.h), under their gradable names.
 std::vector<MetricValue> trace_metric_values(const TraceMetrics& metrics);
 
