@@ -14,6 +14,7 @@
 #include "liversim/core/openhaptics_device.h"
 #include "liversim/core/surface.h"
 #include "liversim/storage/sqlite_session_store.h"
+#include "session_review_window.h"
 
 #include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>
@@ -313,6 +314,9 @@ void MainWindow::buildMenus() {
       session->addAction(tr("&Mark the Lesion Here"), this, [this] { markLesionUnderTool(); });
   mark->setObjectName("markLesionAction");
   mark->setShortcut(QKeySequence(Qt::Key_M));
+  QAction* review =
+      session->addAction(tr("&Review Sessions…"), this, [this] { openSessionReview(); });
+  review->setObjectName("reviewSessionsAction");
   mark->setToolTip(
       tr("Palpation: mark the point of the liver under the tool as where the lesion "
          "is (graded at the session's end)"));
@@ -539,7 +543,9 @@ void MainWindow::showTool(const std::optional<Tool>& tool) {
 void MainWindow::showNewestSnapshot() {
   if (simulation_->update_snapshot()) {
     const SimulationSnapshot& snapshot = simulation_->snapshot();
-    if (snapshot.topology_version != shownTopology_ && snapshot.model) {
+    const bool cut = snapshot.topology_version != shownTopology_ && snapshot.model;
+    recordSimulationEvents(snapshot, cut);
+    if (cut) {
       // Cut: the surface is the cut mesh's boundary now, its cut faces in the interior colour.
       // A node still where a node of the organ's surface was (the same node, or its copy) keeps
       // that node's smooth visual vertex; the others show where they are.
@@ -716,6 +722,7 @@ bool MainWindow::setSessionsDatabase(const QString& file) {
   sessionsProblem_.clear();
   try {
     sessions_ = std::make_unique<SqliteSessionStore>(std::filesystem::path(file.toStdString()));
+    sessionsFile_ = file;
   } catch (const StorageError& e) {
     sessionsProblem_ = tr("Sessions are not recorded: %1").arg(QString::fromUtf8(e.what()));
     statusBar()->showMessage(sessionsProblem_);
@@ -820,6 +827,51 @@ void MainWindow::beginRecording() {
     lift_point_m = Eigen::Vector3d(mm[0], mm[1], mm[2]) * 1e-3;
   }
   simulation_->track_outcome(lift_point_m);
+  eventDetector_.emplace(TraceMetricSettings{}.safe_force_n);
+  breachedLesions_.clear();
+}
+
+void MainWindow::recordSimulationEvents(const SimulationSnapshot& snapshot, bool cut) {
+  if (!recorder_ || !servo_ || !eventDetector_) return;
+  const double now_s = servo_->now_s();
+  std::vector<SessionEvent> events;
+  const RealtimeStats stats = simulation_->stats();
+  eventDetector_->observe(
+      now_s,
+      {snapshot.tool_grasping, snapshot.topology_version, snapshot.tool_force_n.norm(),
+       stats.rollbacks, snapshot.resected_volume_m3},
+      events);
+  // A cut into a lesion: checked against the whole cut surface, each lesion reported once.
+  if (cut && scenario_ && snapshot.model) {
+    const auto surface = cut_surface_at_rest_m(*snapshot.model);
+    for (const LesionSpec& lesion : scenario_->scenario.lesions) {
+      if (breachedLesions_.count(lesion.name)) continue;
+      const auto margin = lesion_margin(surface, lesion_ellipsoid(lesion),
+                                        OutcomeSettings{}.margin_sample_spacing_mm * 1e-3);
+      if (margin && margin->breached) {
+        breachedLesions_.insert(lesion.name);
+        events.push_back({now_s, SessionEventKind::lesion_breach, lesion.name});
+      }
+    }
+  }
+  for (const SessionEvent& event : events) recorder_->record_event(event);
+}
+
+SessionReviewWindow* MainWindow::openSessionReview() {
+  if (!sessions_) {
+    statusBar()->showMessage(sessionsProblem_.isEmpty() ? tr("There is no sessions database.")
+                                                        : sessionsProblem_);
+    return nullptr;
+  }
+  if (!review_) {
+    review_ = new SessionReviewWindow(sessionsFile_, this);
+    review_->setAttribute(Qt::WA_DeleteOnClose);
+  } else {
+    review_->refresh();
+  }
+  review_->show();
+  review_->raise();
+  return review_;
 }
 
 bool MainWindow::markLesionUnderTool() {
@@ -857,6 +909,7 @@ void MainWindow::endRecording() {
   const ServoStats stats = servo_ ? servo_->stats() : ServoStats{};
   const std::uint64_t dropped = servo_ ? servo_->dropped_log_frames() : 0;
   const std::int64_t session = recorder_->session();
+  eventDetector_.reset();
   std::optional<OutcomeTracking> outcome;
   if (simulation_) {
     outcome = simulation_->outcome();
@@ -990,6 +1043,7 @@ void MainWindow::checkDevice() {
   devicePanel_->showServoStats(&stats);
   const std::string fault = servo_->device_fault();
   if (fault.empty()) return;
+  if (recorder_) recorder_->record_event({servo_->now_s(), SessionEventKind::device_fault, fault});
   // A vanished or broken device: its force is off already; the mouse takes over.
   const bool omni = haptics_.device == DeviceChoice::openhaptics;
   const QString name = omni ? QString::fromStdString(omni_->name()) : tr("The device");

@@ -12,6 +12,7 @@
 #include "liversim/core/realtime_simulation.h"
 #include "liversim/core/scenario.h"
 #include "liversim/core/servo_loop.h"
+#include "liversim/core/session_events.h"
 #include "liversim/core/session_recorder.h"
 
 #include <QElapsedTimer>
@@ -25,6 +26,8 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
+#include <string>
 #include <thread>
 
 class QLabel;
@@ -37,6 +40,7 @@ class CalibrationDialog;
 class DevicePanel;
 class LiverScene;
 class ScenarioPanel;
+class SessionReviewWindow;
 class ToolPanel;
 class VtkViewport;
 
@@ -110,6 +114,9 @@ class MainWindow : public QMainWindow {
   bool replaySession(std::int64_t session);
   // The session being recorded, if any.
   std::optional<std::int64_t> recordingSession() const;
+  // The instructor's review of the sessions database's sessions (Session menu), in its own
+  // window; null without a database.
+  SessionReviewWindow* openSessionReview();
   // Palpation: records the rest point of the liver under the tool as the trainee's mark of the
   // lesion (a lesion_marked event; Session menu, M). False, saying why in the status bar, when
   // no session is recorded or no tool is in the scene.
@@ -207,6 +214,12 @@ class MainWindow : public QMainWindow {
   std::optional<OpenedScenario> scenario_;
 
   std::unique_ptr<SessionStore> sessions_;
+  QString sessionsFile_;
+  // While recording: the events the display frames show, and the lesions a cut has breached.
+  std::optional<SessionEventDetector> eventDetector_;
+  std::set<std::string> breachedLesions_;
+  void recordSimulationEvents(const SimulationSnapshot& snapshot, bool cut);
+  QPointer<SessionReviewWindow> review_;
   QString sessionsProblem_;
   std::unique_ptr<SessionRecorder> recorder_;  // while servo_ runs and sessions_ is open
   std::vector<TrajectoryPoint> replayPoints_;  // of the session replaySession() loaded

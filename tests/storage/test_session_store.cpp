@@ -178,6 +178,33 @@ TEST(SessionStore, KeepsTheExactScenarioOnceAndTheEventsInOrder) {
   EXPECT_THROW(store.scenario_text(99), StorageError);
 }
 
+// Grades and comments, with hostile text (quotes, SQL, a NUL-free multi-line comment in another
+// script), survive closing and reopening the file; an instructor and a trainee of the same name
+// are two people.
+TEST(SessionStore, GradesAndCommentsAreKeptPerSessionAndReadBackAfterReopening) {
+  const fs::path file = fresh_database("grades");
+  std::int64_t a = 0, b = 0;
+  const SessionGrade first{"Dr. O'Neil", 1'700'000'000'000, 62.5, "fail",
+                           "Margin too close.\n切缘不足; DROP TABLE grades; --"};
+  const SessionGrade second{"Dr. O'Neil", 1'700'000'100'000, std::nullopt, "pass", ""};
+  {
+    SqliteSessionStore store(file);
+    a = store.begin_session(start_of("Dr. O'Neil", "{}"));
+    b = store.begin_session(start_of("Trainee B", "{}"));
+    store.store_grade(a, first);
+    store.store_grade(a, second);
+    EXPECT_TRUE(store.grades(b).empty());
+  }
+  SqliteSessionStore reopened(file, SqliteSessionStore::Access::read_only);
+  const std::vector<SessionGrade> grades = reopened.grades(a);
+  ASSERT_EQ(grades.size(), 2u);
+  EXPECT_EQ(grades[0], first);
+  EXPECT_EQ(grades[1], second);
+  EXPECT_EQ(reopened.sessions().size(), 2u);
+  EXPECT_EQ(reopened.sessions()[0].trainee, "Dr. O'Neil");
+  EXPECT_EQ(reopened.integrity_check(), "ok");
+}
+
 TEST(SessionRecorder, WritesFramesAndEventsAndEndsTheSessionComplete) {
   const fs::path file = fresh_database("recorder");
   const std::vector<ServoFrame> frames = synthetic_frames(3000, 2);

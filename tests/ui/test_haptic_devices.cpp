@@ -28,6 +28,7 @@
 #include "liversim/core/surface.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
+#include "session_review_window.h"
 #include "tool_panel.h"
 
 namespace liversim {
@@ -259,7 +260,8 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
 
 // Palpation, the shipped scenario: the scripted probe held just off the liver's surface where it is
 // nearest the hidden lesion; the trainee marks it (Session menu, M); the session's end grades the
-// mark: the task succeeded, and the probe, never pressing, damaged nothing.
+// mark: the task succeeded, and the probe, never pressing, damaged nothing. Then the instructor
+// reviews it and grades it.
 TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   useSceneMillimetres();
   openWindow();
@@ -313,6 +315,45 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   EXPECT_EQ(metrics.at("peak_force_n"), 0.0) << "the probe touched the liver";
   EXPECT_EQ(metrics.at("tissue_damage_mm3"), 0.0);
   EXPECT_EQ(metrics.count("lesion_margin_mm"), 0u) << "nothing was cut";
+
+  // The instructor's review: the session against the scenario's rubric (success, no force, task
+  // time 0: every criterion passes), its force curve and events; a grade saved is there when the
+  // window is opened again.
+  QAction* reviewAction = window_->findChild<QAction*>("reviewSessionsAction");
+  ASSERT_NE(reviewAction, nullptr);
+  reviewAction->trigger();
+  auto* review = window_->findChild<SessionReviewWindow*>("sessionReviewWindow");
+  ASSERT_NE(review, nullptr);
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(review));
+  EXPECT_TRUE(review->problem().isEmpty()) << review->problem().toStdString();
+  EXPECT_EQ(review->listedSessionCount(), 1);
+  review->setFilter("nobody of that name");
+  EXPECT_EQ(review->listedSessionCount(), 0);
+  review->setFilter("palpation");
+  ASSERT_EQ(review->listedSessionCount(), 1);
+  ASSERT_TRUE(review->openSession(session));
+  ASSERT_EQ(review->rubricResult().criteria.size(), scenario.rubric.size());
+  EXPECT_EQ(review->rubricResult().score_percent, std::optional<double>(100.0))
+      << review->scoreText().toStdString();
+  EXPECT_TRUE(review->scoreText().contains("100 %")) << review->scoreText().toStdString();
+  EXPECT_GT(review->forcePointCount(), 0);
+  EXPECT_EQ(review->eventCount(), static_cast<int>(store.events(session).size()));
+  review->setGradeForm("", "pass", "");
+  EXPECT_FALSE(review->saveGrade()) << "a grade needs the instructor";
+  review->setGradeForm("Dr. Grey", "pass", "Found it at the first attempt.");
+  ASSERT_TRUE(review->saveGrade());
+  review->close();  // deleted on close
+  QCoreApplication::sendPostedEvents(nullptr, QEvent::DeferredDelete);
+  EXPECT_EQ(window_->findChild<SessionReviewWindow*>("sessionReviewWindow"), nullptr);
+  reviewAction->trigger();
+  review = window_->findChild<SessionReviewWindow*>("sessionReviewWindow");
+  ASSERT_NE(review, nullptr);
+  ASSERT_TRUE(review->openSession(session));
+  EXPECT_TRUE(review->gradesText().contains("Dr. Grey")) << review->gradesText().toStdString();
+  EXPECT_TRUE(review->gradesText().contains("Found it at the first attempt."));
+  EXPECT_TRUE(review->gradesText().contains("score 100 %")) << review->gradesText().toStdString();
+  ASSERT_EQ(store.grades(session).size(), 1u);
+  EXPECT_EQ(store.grades(session)[0].grade, "pass");
 }
 
 // A recorded session's device input plays back through the servo, at its original rate, along

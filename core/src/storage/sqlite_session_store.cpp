@@ -103,6 +103,8 @@ enum StatementId {
   kScenarioText,
   kStoreMetric,
   kMetrics,
+  kStoreGrade,
+  kGrades,
   kStatementCount
 };
 
@@ -127,6 +129,10 @@ class SqliteSessionStore::Statement {
   Statement& bind(int index, std::string_view text) {
     check(sqlite3_bind_text(statement_, index, text.data(), static_cast<int>(text.size()),
                             SQLITE_TRANSIENT));
+    return *this;
+  }
+  Statement& bind_null(int index) {
+    check(sqlite3_bind_null(statement_, index));
     return *this;
   }
   Statement& bind(int index, std::span<const std::uint8_t> bytes) {
@@ -313,16 +319,23 @@ void SqliteSessionStore::commit() {
   in_transaction_ = false;
 }
 
+std::int64_t SqliteSessionStore::person(std::string_view name, std::string_view role) {
+  const std::string doing = "adding the " + std::string(role);
+  prepared(kAddPerson, "INSERT OR IGNORE INTO people (name, role) VALUES (?1, ?2)")
+      .bind(1, name)
+      .bind(2, role)
+      .run(doing.c_str());
+  const std::string looking = "looking up the " + std::string(role);
+  return prepared(kFindPerson, "SELECT id FROM people WHERE name = ?1 AND role = ?2")
+      .bind(1, name)
+      .bind(2, role)
+      .single_integer(looking.c_str());
+}
+
 std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
   begin_if_needed();
   // Added if new (a name per role and a text's hash are unique), then looked up either way.
-  prepared(kAddPerson, "INSERT OR IGNORE INTO people (name, role) VALUES (?1, 'trainee')")
-      .bind(1, std::string_view(start.trainee))
-      .run("adding the trainee");
-  const std::int64_t trainee =
-      prepared(kFindPerson, "SELECT id FROM people WHERE name = ?1 AND role = 'trainee'")
-          .bind(1, std::string_view(start.trainee))
-          .single_integer("looking up the trainee");
+  const std::int64_t trainee = person(start.trainee, "trainee");
   const std::string hash = sha256_hex(start.scenario_text);
   prepared(kAddScenario,
            "INSERT OR IGNORE INTO scenarios (sha256, title, content) VALUES (?1, ?2, ?3)")
@@ -432,6 +445,44 @@ std::vector<MetricValue> SqliteSessionStore::metrics(std::int64_t session) {
   rows.bind(1, session);
   std::vector<MetricValue> result;
   while (rows.step("reading metrics")) result.push_back({rows.text(0), rows.real(1)});
+  rows.reset();
+  return result;
+}
+
+void SqliteSessionStore::store_grade(std::int64_t session, const SessionGrade& grade) {
+  begin_if_needed();
+  const std::int64_t instructor = person(grade.instructor, "instructor");
+  Statement& store = prepared(
+      kStoreGrade,
+      "INSERT INTO grades (session_id, instructor_id, graded_unix_ms, score, grade, comment) "
+      "VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+  store.bind(1, session).bind(2, instructor).bind(3, grade.graded_unix_ms);
+  if (grade.score_percent)
+    store.bind(4, *grade.score_percent);
+  else
+    store.bind_null(4);
+  store.bind(5, std::string_view(grade.grade))
+      .bind(6, std::string_view(grade.comment))
+      .run("storing a grade");
+  commit();
+}
+
+std::vector<SessionGrade> SqliteSessionStore::grades(std::int64_t session) {
+  Statement& rows =
+      prepared(kGrades,
+               "SELECT p.name, g.graded_unix_ms, g.score, g.grade, g.comment FROM grades g "
+               "JOIN people p ON p.id = g.instructor_id WHERE g.session_id = ?1 ORDER BY g.id");
+  rows.bind(1, session);
+  std::vector<SessionGrade> result;
+  while (rows.step("reading grades")) {
+    SessionGrade g;
+    g.instructor = rows.text(0);
+    g.graded_unix_ms = rows.integer(1);
+    if (!rows.is_null(2)) g.score_percent = rows.real(2);
+    g.grade = rows.text(3);
+    g.comment = rows.text(4);
+    result.push_back(std::move(g));
+  }
   rows.reset();
   return result;
 }

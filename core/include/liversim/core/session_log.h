@@ -90,6 +90,16 @@ struct MetricValue {
   bool operator==(const MetricValue&) const = default;
 };
 
+// An instructor's grade of a session.
+struct SessionGrade {
+  std::string instructor;
+  std::int64_t graded_unix_ms = 0;
+  std::optional<double> score_percent;  // the rubric's score when graded (none: no rubric)
+  std::string grade;                    // e.g. "pass", "B+"
+  std::string comment;
+  bool operator==(const SessionGrade&) const = default;
+};
+
 // The tools in use over a session, from its tool_selected events ("hand" or an unknown name ends
 // the tool before).
 std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events);
@@ -125,6 +135,11 @@ class SessionStore {
 
   // The session's metrics, computed at its end (a name stored again replaces its value); commits.
   virtual void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) = 0;
+
+  // An instructor's grade and comment (the instructor is added to the people if new); commits.
+  // A session may be graded more than once: each grade is kept.
+  virtual void store_grade(std::int64_t session, const SessionGrade& grade) = 0;
+  virtual std::vector<SessionGrade> grades(std::int64_t session) = 0;  // oldest first
 
   virtual std::vector<SessionSummary> sessions() = 0;
   virtual std::vector<MetricValue> metrics(std::int64_t session) = 0;  // by name

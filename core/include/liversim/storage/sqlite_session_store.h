@@ -45,6 +45,8 @@ class SqliteSessionStore final : public SessionStore {
 
   void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) override;
 
+  void store_grade(std::int64_t session, const SessionGrade& grade) override;
+  std::vector<SessionGrade> grades(std::int64_t session) override;
   std::vector<SessionSummary> sessions() override;
   std::vector<MetricValue> metrics(std::int64_t session) override;
   std::vector<ServoFrame> frames(std::int64_t session) override;
@@ -59,6 +61,8 @@ class SqliteSessionStore final : public SessionStore {
   StorageError error(const std::string& what) const;
   [[noreturn]] void fail(const std::string& doing);
   Statement& prepared(int which, const char* sql);
+  // The id of the person of that name and role ("trainee", "instructor"), added if new.
+  std::int64_t person(std::string_view name, std::string_view role);
 
   std::filesystem::path file_;
   sqlite3* db_ = nullptr;

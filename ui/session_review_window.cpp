@@ -1,0 +1,391 @@
+#include "session_review_window.h"
+
+#include "liversim/core/scenario.h"
+#include "liversim/storage/sqlite_session_store.h"
+
+#include <QChart>
+#include <QChartView>
+#include <QDateTime>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QLineEdit>
+#include <QLineSeries>
+#include <QListWidget>
+#include <QPlainTextEdit>
+#include <QPushButton>
+#include <QScatterSeries>
+#include <QSplitter>
+#include <QTableWidget>
+#include <QVBoxLayout>
+#include <QValueAxis>
+
+#include <algorithm>
+#include <cmath>
+
+namespace liversim {
+
+namespace {
+
+// The force curve keeps at most about this many points: each bucket of frames gives its largest
+// force, so no peak is lost.
+constexpr std::size_t kMaxForcePoints = 4000;
+
+std::vector<RubricCriterion> rubric_of(SessionStore& store, std::int64_t session) {
+  const ScenarioReading reading = read_scenario(store.scenario_text(session));
+  return reading.scenario ? reading.scenario->rubric : std::vector<RubricCriterion>{};
+}
+
+QString number(double value) {
+  return QString::number(value, 'g', 4);
+}
+
+QTableWidgetItem* cell(const QString& text) {
+  auto* item = new QTableWidgetItem(text);
+  item->setFlags(item->flags() & ~Qt::ItemIsEditable);
+  return item;
+}
+
+}  // namespace
+
+SessionReviewWindow::SessionReviewWindow(const QString& databaseFile, QWidget* parent)
+    : QWidget(parent, Qt::Window) {
+  setObjectName("sessionReviewWindow");
+  setWindowTitle(tr("Sessions — %1").arg(databaseFile));
+  problemLabel_ = new QLabel(this);
+  problemLabel_->setObjectName("reviewProblem");
+  problemLabel_->setWordWrap(true);
+  problemLabel_->setStyleSheet("color: #b00020");
+  filterEdit_ = new QLineEdit(this);
+  filterEdit_->setObjectName("sessionFilter");
+  filterEdit_->setPlaceholderText(tr("Filter by trainee or scenario"));
+  connect(filterEdit_, &QLineEdit::textChanged, this, &SessionReviewWindow::setFilter);
+
+  sessionTable_ = new QTableWidget(0, 6, this);
+  sessionTable_->setObjectName("sessionTable");
+  sessionTable_->setHorizontalHeaderLabels(
+      {tr("Session"), tr("Trainee"), tr("Scenario"), tr("Started"), tr("Status"), tr("Score")});
+  sessionTable_->setSelectionBehavior(QAbstractItemView::SelectRows);
+  sessionTable_->setSelectionMode(QAbstractItemView::SingleSelection);
+  sessionTable_->setSortingEnabled(true);
+  sessionTable_->horizontalHeader()->setStretchLastSection(true);
+  connect(sessionTable_, &QTableWidget::itemSelectionChanged, this, [this] {
+    const auto rows = sessionTable_->selectionModel()->selectedRows();
+    if (!rows.isEmpty())
+      openSession(sessionTable_->item(rows.front().row(), 0)->data(Qt::UserRole).toLongLong());
+  });
+
+  scoreLabel_ = new QLabel(tr("Open a session to see it against its rubric."), this);
+  scoreLabel_->setObjectName("sessionScore");
+  metricTable_ = new QTableWidget(0, 4, this);
+  metricTable_->setObjectName("metricTable");
+  metricTable_->setHorizontalHeaderLabels(
+      {tr("Metric"), tr("Value"), tr("Criterion (weight)"), tr("Passed")});
+  metricTable_->horizontalHeader()->setStretchLastSection(true);
+
+  forceSeries_ = new QLineSeries();
+  forceSeries_->setName(tr("Force on the device (N)"));
+  eventSeries_ = new QScatterSeries();
+  eventSeries_->setName(tr("Events"));
+  eventSeries_->setMarkerSize(8.0);
+  auto* chart = new QChart();
+  chart->addSeries(forceSeries_);
+  chart->addSeries(eventSeries_);
+  auto* time_axis = new QValueAxis();
+  time_axis->setTitleText(tr("Time (s)"));
+  auto* force_axis = new QValueAxis();
+  force_axis->setTitleText(tr("Force (N)"));
+  chart->addAxis(time_axis, Qt::AlignBottom);
+  chart->addAxis(force_axis, Qt::AlignLeft);
+  for (QAbstractSeries* series :
+       {static_cast<QAbstractSeries*>(forceSeries_), static_cast<QAbstractSeries*>(eventSeries_)}) {
+    series->attachAxis(time_axis);
+    series->attachAxis(force_axis);
+  }
+  forceChart_ = new QChartView(chart, this);
+  forceChart_->setObjectName("forceChart");
+  forceChart_->setRenderHint(QPainter::Antialiasing);
+  forceChart_->setMinimumHeight(220);
+  eventList_ = new QListWidget(this);
+  eventList_->setObjectName("eventList");
+
+  instructorEdit_ = new QLineEdit(this);
+  instructorEdit_->setObjectName("gradeInstructor");
+  gradeEdit_ = new QLineEdit(this);
+  gradeEdit_->setObjectName("gradeText");
+  gradeEdit_->setPlaceholderText(tr("e.g. pass, fail, B+"));
+  commentEdit_ = new QPlainTextEdit(this);
+  commentEdit_->setObjectName("gradeComment");
+  commentEdit_->setMaximumHeight(80);
+  saveButton_ = new QPushButton(tr("Save Grade"), this);
+  saveButton_->setObjectName("saveGrade");
+  connect(saveButton_, &QPushButton::clicked, this, &SessionReviewWindow::saveGrade);
+  gradesLabel_ = new QLabel(this);
+  gradesLabel_->setObjectName("savedGrades");
+  gradesLabel_->setWordWrap(true);
+  gradesLabel_->setTextFormat(Qt::PlainText);
+  auto* form = new QFormLayout();
+  form->addRow(tr("Instructor:"), instructorEdit_);
+  form->addRow(tr("Grade:"), gradeEdit_);
+  form->addRow(tr("Comment:"), commentEdit_);
+  form->addRow(QString(), saveButton_);
+  form->addRow(tr("Saved grades:"), gradesLabel_);
+
+  auto* top = new QWidget(this);
+  auto* top_layout = new QVBoxLayout(top);
+  top_layout->addWidget(problemLabel_);
+  top_layout->addWidget(filterEdit_);
+  top_layout->addWidget(sessionTable_);
+  auto* detail = new QWidget(this);
+  auto* detail_layout = new QHBoxLayout(detail);
+  auto* left = new QVBoxLayout();
+  left->addWidget(scoreLabel_);
+  left->addWidget(metricTable_);
+  left->addLayout(form);
+  auto* right = new QVBoxLayout();
+  right->addWidget(forceChart_, 3);
+  right->addWidget(eventList_, 1);
+  detail_layout->addLayout(left, 1);
+  detail_layout->addLayout(right, 2);
+  auto* splitter = new QSplitter(Qt::Vertical, this);
+  splitter->addWidget(top);
+  splitter->addWidget(detail);
+  auto* layout = new QVBoxLayout(this);
+  layout->addWidget(splitter);
+  resize(1100, 800);
+
+  try {
+    store_ =
+        std::make_unique<SqliteSessionStore>(std::filesystem::path(databaseFile.toStdString()));
+  } catch (const StorageError& e) {
+    problem_ = tr("The sessions cannot be read: %1").arg(QString::fromUtf8(e.what()));
+  }
+  refresh();
+}
+
+SessionReviewWindow::~SessionReviewWindow() = default;
+
+void SessionReviewWindow::refresh() {
+  sessions_.clear();
+  scores_.clear();
+  if (store_) {
+    try {
+      sessions_ = store_->sessions();
+      for (const SessionSummary& s : sessions_)
+        scores_.push_back(
+            grade_against_rubric(rubric_of(*store_, s.id), store_->metrics(s.id)).score_percent);
+    } catch (const StorageError& e) {
+      problem_ = tr("The sessions cannot be read: %1").arg(QString::fromUtf8(e.what()));
+      sessions_.clear();
+      scores_.clear();
+    }
+  }
+  problemLabel_->setText(problem_);
+  problemLabel_->setVisible(!problem_.isEmpty());
+  showSessions();
+}
+
+void SessionReviewWindow::setFilter(const QString& text) {
+  filter_ = text;
+  if (filterEdit_->text() != text) filterEdit_->setText(text);
+  showSessions();
+}
+
+void SessionReviewWindow::showSessions() {
+  sessionTable_->setSortingEnabled(false);
+  sessionTable_->setRowCount(0);
+  for (std::size_t i = 0; i < sessions_.size(); ++i) {
+    const SessionSummary& s = sessions_[i];
+    const QString trainee = QString::fromStdString(s.trainee);
+    const QString scenario = QString::fromStdString(s.scenario_title);
+    if (!filter_.isEmpty() && !trainee.contains(filter_, Qt::CaseInsensitive) &&
+        !scenario.contains(filter_, Qt::CaseInsensitive))
+      continue;
+    const int row = sessionTable_->rowCount();
+    sessionTable_->insertRow(row);
+    auto* id = cell(QString::number(s.id));
+    id->setData(Qt::UserRole, static_cast<qlonglong>(s.id));
+    sessionTable_->setItem(row, 0, id);
+    sessionTable_->setItem(row, 1, cell(trainee));
+    sessionTable_->setItem(row, 2, cell(scenario));
+    sessionTable_->setItem(
+        row, 3,
+        cell(QDateTime::fromMSecsSinceEpoch(s.started_unix_ms).toString("yyyy-MM-dd hh:mm")));
+    sessionTable_->setItem(
+        row, 4,
+        cell(QString::fromUtf8(session_status_name(s.status).data(),
+                               static_cast<int>(session_status_name(s.status).size()))));
+    sessionTable_->setItem(row, 5,
+                           cell(scores_[i] ? QString::number(*scores_[i], 'f', 0) + " %" : "–"));
+  }
+  sessionTable_->setSortingEnabled(true);
+}
+
+int SessionReviewWindow::listedSessionCount() const {
+  return sessionTable_->rowCount();
+}
+
+bool SessionReviewWindow::openSession(std::int64_t session) {
+  for (int row = 0; row < sessionTable_->rowCount(); ++row)
+    if (sessionTable_->item(row, 0)->data(Qt::UserRole).toLongLong() == session) {
+      if (opened_ == session) return true;
+      opened_ = session;
+      sessionTable_->selectRow(row);
+      showOpenedSession();
+      return true;
+    }
+  return false;
+}
+
+void SessionReviewWindow::showOpenedSession() {
+  forceSeries_->clear();
+  eventSeries_->clear();
+  eventList_->clear();
+  metricTable_->setRowCount(0);
+  rubric_ = {};
+  if (!opened_ || !store_) return;
+  try {
+    const std::vector<MetricValue> metrics = store_->metrics(*opened_);
+    openedRubric_ = rubric_of(*store_, *opened_);
+    rubric_ = grade_against_rubric(openedRubric_, metrics);
+    scoreLabel_->setText(scoreText());
+    // The rubric's criteria first (passed or not), then the other metrics measured.
+    for (const CriterionResult& r : rubric_.criteria) {
+      const int row = metricTable_->rowCount();
+      metricTable_->insertRow(row);
+      const MetricInfo* info = find_metric(r.criterion.metric);
+      const QString unit =
+          info ? QString::fromUtf8(info->unit.data(), static_cast<int>(info->unit.size()))
+               : QString();
+      metricTable_->setItem(row, 0, cell(QString::fromStdString(r.criterion.metric)));
+      metricTable_->setItem(row, 1,
+                            cell(r.value ? number(*r.value) + " " + unit : tr("not measured")));
+      metricTable_->setItem(row, 2,
+                            cell((r.criterion.rule == PassRule::at_most ? "≤ " : "≥ ") +
+                                 number(r.criterion.threshold) + " " + unit + " (" +
+                                 number(r.criterion.weight) + ")"));
+      metricTable_->setItem(row, 3, cell(r.passed ? tr("yes") : tr("no")));
+    }
+    for (const MetricValue& m : metrics) {
+      const bool graded = std::any_of(openedRubric_.begin(), openedRubric_.end(),
+                                      [&](const RubricCriterion& c) { return c.metric == m.name; });
+      if (graded) continue;
+      const int row = metricTable_->rowCount();
+      metricTable_->insertRow(row);
+      metricTable_->setItem(row, 0, cell(QString::fromStdString(m.name)));
+      metricTable_->setItem(row, 1, cell(number(m.value)));
+      metricTable_->setItem(row, 2, cell(tr("not graded")));
+      metricTable_->setItem(row, 3, cell(QString()));
+    }
+
+    // The force on the device, each bucket of frames as its largest force.
+    const std::vector<ServoFrame> frames = store_->frames(*opened_);
+    const std::size_t bucket =
+        std::max<std::size_t>(1, (frames.size() + kMaxForcePoints - 1) / kMaxForcePoints);
+    QList<QPointF> points;
+    double largest = 0.0;
+    const double t0 = frames.empty() ? 0.0 : frames.front().time_s;
+    for (std::size_t begin = 0; begin < frames.size(); begin += bucket) {
+      std::size_t peak = begin;
+      for (std::size_t i = begin; i < std::min(frames.size(), begin + bucket); ++i)
+        if (frames[i].force_n.norm() > frames[peak].force_n.norm()) peak = i;
+      const double force = frames[peak].force_n.norm();
+      largest = std::max(largest, force);
+      points.append(QPointF(frames[peak].time_s - t0, force));
+    }
+    forceSeries_->replace(points);
+    const std::vector<SessionEvent> events = store_->events(*opened_);
+    for (const SessionEvent& e : events) {
+      const std::string_view kind = session_event_name(e.kind);
+      eventList_->addItem(QString("%1 s  %2  %3")
+                              .arg(e.time_s - t0, 0, 'f', 3)
+                              .arg(QString::fromUtf8(kind.data(), static_cast<int>(kind.size())))
+                              .arg(QString::fromStdString(e.detail)));
+      eventSeries_->append(e.time_s - t0, 0.0);
+    }
+    const double end_s = frames.empty() ? 1.0 : std::max(frames.back().time_s - t0, 1e-3);
+    auto axes = forceChart_->chart()->axes();
+    for (QAbstractAxis* axis : axes) {
+      auto* value_axis = static_cast<QValueAxis*>(axis);
+      if (axis->alignment() == Qt::AlignBottom)
+        value_axis->setRange(0.0, end_s);
+      else
+        value_axis->setRange(0.0, std::max(largest * 1.1, 0.1));
+    }
+    std::vector<SessionGrade> grades = store_->grades(*opened_);
+    QStringList lines;
+    for (const SessionGrade& g : grades)
+      lines
+          << tr("%1, %2: %3%4 — %5")
+                 .arg(QString::fromStdString(g.instructor),
+                      QDateTime::fromMSecsSinceEpoch(g.graded_unix_ms).toString("yyyy-MM-dd hh:mm"),
+                      QString::fromStdString(g.grade),
+                      g.score_percent ? tr(" (score %1 %)").arg(*g.score_percent, 0, 'f', 0)
+                                      : QString(),
+                      QString::fromStdString(g.comment));
+    gradesLabel_->setText(lines.isEmpty() ? tr("none yet") : lines.join('\n'));
+  } catch (const StorageError& e) {
+    scoreLabel_->setText(
+        tr("Session %1 cannot be read: %2").arg(*opened_).arg(QString::fromUtf8(e.what())));
+  }
+}
+
+QString SessionReviewWindow::scoreText() const {
+  if (!opened_) return {};
+  if (!rubric_.score_percent) return tr("Session %1: its scenario has no rubric.").arg(*opened_);
+  int passed = 0;
+  for (const CriterionResult& r : rubric_.criteria) passed += r.passed ? 1 : 0;
+  return tr("Session %1: score %2 % (%3 of %4 criteria passed)")
+      .arg(*opened_)
+      .arg(*rubric_.score_percent, 0, 'f', 0)
+      .arg(passed)
+      .arg(rubric_.criteria.size());
+}
+
+int SessionReviewWindow::forcePointCount() const {
+  return static_cast<int>(forceSeries_->count());
+}
+
+int SessionReviewWindow::eventCount() const {
+  return eventList_->count();
+}
+
+QString SessionReviewWindow::gradesText() const {
+  return gradesLabel_->text();
+}
+
+void SessionReviewWindow::setGradeForm(const QString& instructor, const QString& grade,
+                                       const QString& comment) {
+  instructorEdit_->setText(instructor);
+  gradeEdit_->setText(grade);
+  commentEdit_->setPlainText(comment);
+}
+
+bool SessionReviewWindow::saveGrade() {
+  if (!opened_ || !store_) return false;
+  const QString instructor = instructorEdit_->text().trimmed();
+  const QString grade = gradeEdit_->text().trimmed();
+  if (instructor.isEmpty() || grade.isEmpty()) {
+    gradesLabel_->setText(tr("A grade needs the instructor's name and the grade."));
+    return false;
+  }
+  SessionGrade entry;
+  entry.instructor = instructor.toStdString();
+  entry.graded_unix_ms = QDateTime::currentMSecsSinceEpoch();
+  entry.score_percent = rubric_.score_percent;
+  entry.grade = grade.toStdString();
+  entry.comment = commentEdit_->toPlainText().toStdString();
+  try {
+    store_->store_grade(*opened_, entry);
+  } catch (const StorageError& e) {
+    gradesLabel_->setText(tr("The grade was not saved: %1").arg(QString::fromUtf8(e.what())));
+    return false;
+  }
+  gradeEdit_->clear();
+  commentEdit_->clear();
+  showOpenedSession();
+  return true;
+}
+
+}  // namespace liversim

@@ -1,0 +1,90 @@
+#pragma once
+// The instructor's review of recorded sessions: the sessions listed and filtered (trainee,
+// scenario, date, score), and one session opened: its metrics against the scenario's rubric with
+// the overall score, the force on the device over time with the session's events, and a grade
+// and comment saved to the database (docs/session-storage.md).
+
+#include "liversim/core/grading.h"
+#include "liversim/core/session_log.h"
+
+#include <QString>
+#include <QWidget>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+class QChartView;
+class QLabel;
+class QLineEdit;
+class QLineSeries;
+class QListWidget;
+class QPlainTextEdit;
+class QPushButton;
+class QScatterSeries;
+class QTableWidget;
+
+namespace liversim {
+
+class SessionReviewWindow : public QWidget {
+  Q_OBJECT
+
+ public:
+  // Opens its own connection to the database file (the recorder keeps writing through the
+  // workstation's); a file it cannot open is said in the window, which then lists nothing.
+  explicit SessionReviewWindow(const QString& databaseFile, QWidget* parent = nullptr);
+  ~SessionReviewWindow() override;
+
+  QString problem() const { return problem_; }
+  // Re-reads the sessions (and their scores) from the database.
+  void refresh();
+  // Shows only sessions whose trainee or scenario title contains the text (any case).
+  void setFilter(const QString& text);
+  int listedSessionCount() const;
+  // Opens a session in the lower half; false when it is not listed.
+  bool openSession(std::int64_t session);
+  std::optional<std::int64_t> openedSession() const { return opened_; }
+
+  // What the opened session shows.
+  const RubricResult& rubricResult() const { return rubric_; }
+  QString scoreText() const;
+  int forcePointCount() const;  // points of the force curve (downsampled: peaks kept)
+  int eventCount() const;
+  QString gradesText() const;  // the grades saved so far, oldest first
+
+  // The grade form; saveGrade stores it (with the rubric's score) and shows it under the earlier
+  // ones. False, saying why, without an instructor name or a grade, or when the database refuses.
+  void setGradeForm(const QString& instructor, const QString& grade, const QString& comment);
+  bool saveGrade();
+
+ private:
+  void showSessions();
+  void showOpenedSession();
+
+  std::unique_ptr<SessionStore> store_;
+  QString problem_;
+  std::vector<SessionSummary> sessions_;
+  std::vector<std::optional<double>> scores_;  // per session of sessions_
+  QString filter_;
+  std::optional<std::int64_t> opened_;
+  std::vector<RubricCriterion> openedRubric_;
+  RubricResult rubric_;
+
+  QLabel* problemLabel_ = nullptr;
+  QLineEdit* filterEdit_ = nullptr;
+  QTableWidget* sessionTable_ = nullptr;
+  QLabel* scoreLabel_ = nullptr;
+  QTableWidget* metricTable_ = nullptr;
+  QChartView* forceChart_ = nullptr;
+  QLineSeries* forceSeries_ = nullptr;
+  QScatterSeries* eventSeries_ = nullptr;
+  QListWidget* eventList_ = nullptr;
+  QLineEdit* instructorEdit_ = nullptr;
+  QLineEdit* gradeEdit_ = nullptr;
+  QPlainTextEdit* commentEdit_ = nullptr;
+  QPushButton* saveButton_ = nullptr;
+  QLabel* gradesLabel_ = nullptr;
+};
+
+}  // namespace liversim
