@@ -1,5 +1,7 @@
 #include "sessions_command.h"
 
+#include "liversim/core/scenario.h"
+#include "liversim/core/session_export.h"
 #include "liversim/storage/sqlite_session_store.h"
 
 #include <CLI/CLI.hpp>
@@ -17,7 +19,7 @@ namespace {
 struct SessionsOptions {
   std::filesystem::path database;
   std::int64_t session = 0;
-  std::filesystem::path frames_csv, events_csv;
+  std::filesystem::path frames_csv, events_csv, metrics_csv;
 };
 
 void print_list(SqliteSessionStore& store) {
@@ -25,9 +27,8 @@ void print_list(SqliteSessionStore& store) {
   std::cout << "id,trainee,scenario,scenario_sha256,device,started_unix_ms,ended_unix_ms,status,"
                "frames,servo_rate_hz,servo_period_p99_ms,missed_deadlines,dropped_frames\n";
   for (const SessionSummary& s : sessions) {
-    std::cout << s.id << ',' << std::quoted(s.trainee) << ',' << std::quoted(s.scenario_title)
-              << ',' << s.scenario_sha256 << ',' << std::quoted(s.device) << ','
-              << s.started_unix_ms << ',';
+    std::cout << s.id << ',' << csv_field(s.trainee) << ',' << csv_field(s.scenario_title) << ','
+              << s.scenario_sha256 << ',' << csv_field(s.device) << ',' << s.started_unix_ms << ',';
     if (s.ended_unix_ms) std::cout << *s.ended_unix_ms;
     std::cout << ',' << session_status_name(s.status) << ',' << s.frame_count << ',';
     if (s.servo)
@@ -37,25 +38,6 @@ void print_list(SqliteSessionStore& store) {
       std::cout << ",,,";
     std::cout << '\n';
   }
-}
-
-// Full precision: the CSV reads back to the stored doubles.
-void write_frames(const std::vector<ServoFrame>& frames, std::ostream& out) {
-  out << std::setprecision(17)
-      << "time_s,x_mm,y_mm,z_mm,vx_mm_per_s,vy_mm_per_s,vz_mm_per_s,fx_n,fy_n,fz_n,buttons\n";
-  for (const ServoFrame& f : frames) {
-    out << f.time_s;
-    for (int k = 0; k < 3; ++k) out << ',' << f.sample.position_mm[k];
-    for (int k = 0; k < 3; ++k) out << ',' << f.sample.velocity_mm_per_s[k];
-    for (int k = 0; k < 3; ++k) out << ',' << f.force_n[k];
-    out << ',' << f.sample.buttons << '\n';
-  }
-}
-
-void write_events(const std::vector<SessionEvent>& events, std::ostream& out) {
-  out << std::setprecision(17) << "time_s,kind,detail\n";
-  for (const SessionEvent& e : events)
-    out << e.time_s << ',' << session_event_name(e.kind) << ',' << std::quoted(e.detail) << '\n';
 }
 
 int export_session(SqliteSessionStore& store, const SessionsOptions& o) {
@@ -75,13 +57,26 @@ int export_session(SqliteSessionStore& store, const SessionsOptions& o) {
     }
     return true;
   };
-  if (!write(o.frames_csv, [&](std::ostream& out) { write_frames(store.frames(o.session), out); }))
+  if (!write(o.frames_csv,
+             [&](std::ostream& out) { write_frames_csv(store.frames(o.session), out); }))
     return 1;
-  if (!o.events_csv.empty() &&
-      !write(o.events_csv, [&](std::ostream& out) { write_events(store.events(o.session), out); }))
+  if (!o.events_csv.empty() && !write(o.events_csv, [&](std::ostream& out) {
+        write_events_csv(store.events(o.session), out);
+      }))
+    return 1;
+  if (!o.metrics_csv.empty() && !write(o.metrics_csv, [&](std::ostream& out) {
+        const ScenarioReading reading = read_scenario(store.scenario_text(o.session));
+        const std::vector<MetricValue> metrics = store.metrics(o.session);
+        write_metrics_csv(metrics,
+                          grade_against_rubric(reading.scenario ? reading.scenario->rubric
+                                                                : std::vector<RubricCriterion>{},
+                                               metrics),
+                          out);
+      }))
     return 1;
   std::cout << "wrote session " << o.session << " to " << o.frames_csv.string()
-            << (o.events_csv.empty() ? "" : " and " + o.events_csv.string()) << '\n';
+            << (o.events_csv.empty() ? "" : ", " + o.events_csv.string())
+            << (o.metrics_csv.empty() ? "" : ", " + o.metrics_csv.string()) << '\n';
   return 0;
 }
 
@@ -97,7 +92,8 @@ std::function<std::optional<int>()> add_sessions_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   auto* exported = sessions->add_subcommand(
-      "export", "Write a session's frames (and events) as CSV, every number at full precision");
+      "export",
+      "Write a session's frames (and events, metrics) as CSV, every number at full precision");
   exported->add_option("--database", options->database, "Sessions database (.sqlite)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -105,6 +101,8 @@ std::function<std::optional<int>()> add_sessions_command(CLI::App& app) {
       ->required();
   exported->add_option("--frames", options->frames_csv, "Output CSV of the frames")->required();
   exported->add_option("--events", options->events_csv, "Output CSV of the events");
+  exported->add_option("--metrics", options->metrics_csv,
+                       "Output CSV of the metrics against the scenario's rubric, and the score");
   return [=]() -> std::optional<int> {
     if (!sessions->parsed()) return std::nullopt;
     try {

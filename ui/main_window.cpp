@@ -317,6 +317,9 @@ void MainWindow::buildMenus() {
   QAction* review =
       session->addAction(tr("&Review Sessions…"), this, [this] { openSessionReview(); });
   review->setObjectName("reviewSessionsAction");
+  QAction* history =
+      session->addAction(tr("My &Sessions…"), this, [this] { openTraineeHistory(); });
+  history->setObjectName("traineeHistoryAction");
   mark->setToolTip(
       tr("Palpation: mark the point of the liver under the tool as where the lesion "
          "is (graded at the session's end)"));
@@ -792,10 +795,7 @@ void MainWindow::beginRecording() {
   // A replay is not a new session: its input is already recorded.
   if (!sessions_ || !servo_ || recorder_ || haptics_.device == DeviceChoice::replay) return;
   SessionStart start;
-  start.trainee = QSettings()
-                      .value("sessions/trainee", qEnvironmentVariable("USER", tr("Trainee")))
-                      .toString()
-                      .toStdString();
+  start.trainee = traineeName().toStdString();
   if (scenario_) {
     QFile file(scenario_->file);
     start.scenario_title = scenario_->scenario.title;
@@ -857,21 +857,59 @@ void MainWindow::recordSimulationEvents(const SimulationSnapshot& snapshot, bool
   for (const SessionEvent& event : events) recorder_->record_event(event);
 }
 
+QString MainWindow::traineeName() const {
+  return QSettings()
+      .value("sessions/trainee", qEnvironmentVariable("USER", tr("Trainee")))
+      .toString();
+}
+
 SessionReviewWindow* MainWindow::openSessionReview() {
+  return showSessionsWindow(review_, std::nullopt);
+}
+
+SessionReviewWindow* MainWindow::openTraineeHistory() {
+  return showSessionsWindow(history_, traineeName());
+}
+
+SessionReviewWindow* MainWindow::showSessionsWindow(QPointer<SessionReviewWindow>& window,
+                                                    const std::optional<QString>& trainee) {
   if (!sessions_) {
     statusBar()->showMessage(sessionsProblem_.isEmpty() ? tr("There is no sessions database.")
                                                         : sessionsProblem_);
     return nullptr;
   }
-  if (!review_) {
-    review_ = new SessionReviewWindow(sessionsFile_, this);
-    review_->setAttribute(Qt::WA_DeleteOnClose);
+  if (!window) {
+    window = new SessionReviewWindow(sessionsFile_, trainee, this);
+    window->setAttribute(Qt::WA_DeleteOnClose);
   } else {
-    review_->refresh();
+    window->refresh();
   }
-  review_->show();
-  review_->raise();
-  return review_;
+  window->show();
+  window->raise();
+  return window;
+}
+
+QString MainWindow::sessionResultText(const RubricResult& rubric,
+                                      const std::vector<MetricValue>& metrics) {
+  if (!rubric.score_percent) {
+    for (const MetricValue& m : metrics)
+      if (m.name == "peak_force_n")
+        return tr("Last session: peak force %1 N (free practice: no rubric).")
+            .arg(m.value, 0, 'f', 2);
+    return tr("Last session stored (no rubric).");
+  }
+  QStringList missed;
+  for (const CriterionResult& r : rubric.criteria)
+    if (!r.passed)
+      missed << QString("%1 %2 %3 (%4)")
+                    .arg(QString::fromStdString(r.criterion.metric),
+                         r.criterion.rule == PassRule::at_most ? "≤" : "≥",
+                         QString::number(r.criterion.threshold),
+                         r.value ? tr("was %1").arg(r.value.value(), 0, 'g', 3) : tr("not done"));
+  QString text = tr("Last session: score %1 %").arg(*rubric.score_percent, 0, 'f', 0);
+  text += missed.isEmpty() ? tr(", every criterion passed.")
+                           : tr(". Not passed: %1.").arg(missed.join("; "));
+  return text;
 }
 
 bool MainWindow::markLesionUnderTool() {
@@ -941,6 +979,9 @@ void MainWindow::endRecording() {
       values.insert(values.end(), simulated.begin(), simulated.end());
     }
     if (!values.empty()) sessions_->store_metrics(session, values);
+    scenarioPanel_->showResult(sessionResultText(
+        scenario_ ? grade_against_rubric(scenario_->scenario.rubric, values) : RubricResult{},
+        values));
   } catch (const std::exception& e) {
     sessionsProblem_ =
         tr("The session's metrics were not stored: %1").arg(QString::fromUtf8(e.what()));

@@ -8,6 +8,7 @@
 #include "liversim/core/default_scene.h"
 #include "liversim/core/emulated_devices.h"
 #include "liversim/core/grab.h"
+#include "liversim/core/grading.h"
 #include "liversim/core/haptic_device.h"
 #include "liversim/core/realtime_simulation.h"
 #include "liversim/core/scenario.h"
@@ -117,6 +118,10 @@ class MainWindow : public QMainWindow {
   // The instructor's review of the sessions database's sessions (Session menu), in its own
   // window; null without a database.
   SessionReviewWindow* openSessionReview();
+  // The trainee's own sessions (Session menu): the same window, only the trainee's sessions
+  // (the trainee name recorded with sessions), without grading.
+  SessionReviewWindow* openTraineeHistory();
+  QString traineeName() const;
   // Palpation: records the rest point of the liver under the tool as the trainee's mark of the
   // lesion (a lesion_marked event; Session menu, M). False, saying why in the status bar, when
   // no session is recorded or no tool is in the scene.
@@ -219,7 +224,13 @@ class MainWindow : public QMainWindow {
   std::optional<SessionEventDetector> eventDetector_;
   std::set<std::string> breachedLesions_;
   void recordSimulationEvents(const SimulationSnapshot& snapshot, bool cut);
+  SessionReviewWindow* showSessionsWindow(QPointer<SessionReviewWindow>& window,
+                                          const std::optional<QString>& trainee);
+  // The trainee's summary of a session just ended, for the Scenario panel.
+  static QString sessionResultText(const RubricResult& rubric,
+                                   const std::vector<MetricValue>& metrics);
   QPointer<SessionReviewWindow> review_;
+  QPointer<SessionReviewWindow> history_;
   QString sessionsProblem_;
   std::unique_ptr<SessionRecorder> recorder_;  // while servo_ runs and sessions_ is open
   std::vector<TrajectoryPoint> replayPoints_;  // of the session replaySession() loaded

@@ -81,6 +81,9 @@ ScenarioPanel::ScenarioPanel(QWidget* parent) : QWidget(parent) {
   problem_ = addLabel(layout, this, "scenarioProblem");
   problem_->setStyleSheet("color: #b00020;");
   problem_->hide();
+  result_ = addLabel(layout, this, "sessionResult");
+  result_->setStyleSheet("font-weight: bold;");
+  result_->hide();
   layout->addStretch(1);
   showScenario(nullptr, {});
 }
@@ -125,6 +128,15 @@ void ScenarioPanel::showProblem(const QString& text) {
 
 QString ScenarioPanel::taskText() const {
   return task_->text();
+}
+
+void ScenarioPanel::showResult(const QString& text) {
+  result_->setText(text);
+  result_->setVisible(!text.isEmpty());
+}
+
+QString ScenarioPanel::resultText() const {
+  return result_->text();
 }
 
 QString ScenarioPanel::problemText() const {

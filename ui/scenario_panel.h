@@ -24,8 +24,12 @@ class ScenarioPanel : public QWidget {
   // A scenario that could not be opened: why, in red, under what is still running.
   void showProblem(const QString& text);
 
+  // The trainee's result of the session just ended (its score and criteria); empty hides it.
+  void showResult(const QString& text);
+
   QString taskText() const;
   QString problemText() const;
+  QString resultText() const;
 
  private:
   QLabel* title_ = nullptr;
@@ -34,6 +38,7 @@ class ScenarioPanel : public QWidget {
   QLabel* setup_ = nullptr;
   QLabel* file_ = nullptr;
   QLabel* problem_ = nullptr;
+  QLabel* result_ = nullptr;
 };
 
 // What the task asks, for the trainee: its instructions, or a sentence made from its fields.

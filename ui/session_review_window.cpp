@@ -1,11 +1,15 @@
 #include "session_review_window.h"
 
 #include "liversim/core/scenario.h"
+#include "liversim/core/session_export.h"
 #include "liversim/storage/sqlite_session_store.h"
 
+#include <QBuffer>
 #include <QChart>
 #include <QChartView>
 #include <QDateTime>
+#include <QDir>
+#include <QFileDialog>
 #include <QFormLayout>
 #include <QHBoxLayout>
 #include <QHeaderView>
@@ -13,16 +17,20 @@
 #include <QLineEdit>
 #include <QLineSeries>
 #include <QListWidget>
+#include <QPdfWriter>
 #include <QPlainTextEdit>
 #include <QPushButton>
+#include <QSaveFile>
 #include <QScatterSeries>
 #include <QSplitter>
 #include <QTableWidget>
+#include <QTextDocument>
 #include <QVBoxLayout>
 #include <QValueAxis>
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace liversim {
 
@@ -49,10 +57,12 @@ QTableWidgetItem* cell(const QString& text) {
 
 }  // namespace
 
-SessionReviewWindow::SessionReviewWindow(const QString& databaseFile, QWidget* parent)
-    : QWidget(parent, Qt::Window) {
-  setObjectName("sessionReviewWindow");
-  setWindowTitle(tr("Sessions — %1").arg(databaseFile));
+SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
+                                         const std::optional<QString>& trainee, QWidget* parent)
+    : QWidget(parent, Qt::Window), trainee_(trainee) {
+  setObjectName(trainee ? "traineeHistoryWindow" : "sessionReviewWindow");
+  setWindowTitle(trainee ? tr("Sessions of %1").arg(*trainee)
+                         : tr("Sessions — %1").arg(databaseFile));
   problemLabel_ = new QLabel(this);
   problemLabel_->setObjectName("reviewProblem");
   problemLabel_->setWordWrap(true);
@@ -82,7 +92,8 @@ SessionReviewWindow::SessionReviewWindow(const QString& databaseFile, QWidget* p
   metricTable_->setObjectName("metricTable");
   metricTable_->setHorizontalHeaderLabels(
       {tr("Metric"), tr("Value"), tr("Criterion (weight)"), tr("Passed")});
-  metricTable_->horizontalHeader()->setStretchLastSection(true);
+  metricTable_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  metricTable_->verticalHeader()->hide();
 
   forceSeries_ = new QLineSeries();
   forceSeries_->setName(tr("Force on the device (N)"));
@@ -125,12 +136,35 @@ SessionReviewWindow::SessionReviewWindow(const QString& databaseFile, QWidget* p
   gradesLabel_->setObjectName("savedGrades");
   gradesLabel_->setWordWrap(true);
   gradesLabel_->setTextFormat(Qt::PlainText);
+  csvButton_ = new QPushButton(tr("Export CSV…"), this);
+  csvButton_->setObjectName("exportCsv");
+  connect(csvButton_, &QPushButton::clicked, this, [this] {
+    const QString folder = QFileDialog::getExistingDirectory(this, tr("Export the session to"));
+    if (!folder.isEmpty()) exportCsv(folder);
+  });
+  pdfButton_ = new QPushButton(tr("Save Report as PDF…"), this);
+  pdfButton_->setObjectName("exportPdf");
+  connect(pdfButton_, &QPushButton::clicked, this, [this] {
+    const QString file = QFileDialog::getSaveFileName(this, tr("Save the report"), QString(),
+                                                      tr("PDF documents (*.pdf)"));
+    if (!file.isEmpty()) exportPdf(file);
+  });
   auto* form = new QFormLayout();
   form->addRow(tr("Instructor:"), instructorEdit_);
   form->addRow(tr("Grade:"), gradeEdit_);
   form->addRow(tr("Comment:"), commentEdit_);
   form->addRow(QString(), saveButton_);
   form->addRow(tr("Saved grades:"), gradesLabel_);
+  auto* exports = new QHBoxLayout();
+  exports->addWidget(csvButton_);
+  exports->addWidget(pdfButton_);
+  form->addRow(tr("Export:"), exports);
+  if (trainee) {  // a trainee sees the grades, and gives none
+    for (QWidget* field :
+         {static_cast<QWidget*>(instructorEdit_), static_cast<QWidget*>(gradeEdit_),
+          static_cast<QWidget*>(commentEdit_), static_cast<QWidget*>(saveButton_)})
+      form->setRowVisible(field, false);
+  }
 
   auto* top = new QWidget(this);
   auto* top_layout = new QVBoxLayout(top);
@@ -181,9 +215,14 @@ void SessionReviewWindow::refresh() {
       scores_.clear();
     }
   }
+  setProblem(problem_);
+  showSessions();
+}
+
+void SessionReviewWindow::setProblem(const QString& problem) {
+  problem_ = problem;
   problemLabel_->setText(problem_);
   problemLabel_->setVisible(!problem_.isEmpty());
-  showSessions();
 }
 
 void SessionReviewWindow::setFilter(const QString& text) {
@@ -199,6 +238,7 @@ void SessionReviewWindow::showSessions() {
     const SessionSummary& s = sessions_[i];
     const QString trainee = QString::fromStdString(s.trainee);
     const QString scenario = QString::fromStdString(s.scenario_title);
+    if (trainee_ && trainee != *trainee_) continue;
     if (!filter_.isEmpty() && !trainee.contains(filter_, Qt::CaseInsensitive) &&
         !scenario.contains(filter_, Qt::CaseInsensitive))
       continue;
@@ -364,6 +404,10 @@ void SessionReviewWindow::setGradeForm(const QString& instructor, const QString&
 
 bool SessionReviewWindow::saveGrade() {
   if (!opened_ || !store_) return false;
+  if (trainee_) {
+    gradesLabel_->setText(tr("Trainees cannot grade sessions."));
+    return false;
+  }
   const QString instructor = instructorEdit_->text().trimmed();
   const QString grade = gradeEdit_->text().trimmed();
   if (instructor.isEmpty() || grade.isEmpty()) {
@@ -386,6 +430,98 @@ bool SessionReviewWindow::saveGrade() {
   commentEdit_->clear();
   showOpenedSession();
   return true;
+}
+
+namespace {
+
+// Writes through a temporary file committed over `file` only when everything was written.
+bool write_whole(const QString& file, const std::string& bytes, QString& problem) {
+  QSaveFile out(file);
+  if (!out.open(QIODevice::WriteOnly) ||
+      out.write(bytes.data(), static_cast<qint64>(bytes.size())) !=
+          static_cast<qint64>(bytes.size()) ||
+      !out.commit()) {
+    problem = QObject::tr("%1 could not be written: %2").arg(file, out.errorString());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool SessionReviewWindow::exportCsv(const QString& folder) {
+  if (!opened_ || !store_) return false;
+  const QString base = QDir(folder).filePath(QString("session-%1-").arg(*opened_));
+  QString problem;
+  try {
+    std::ostringstream frames, events, metrics;
+    write_frames_csv(store_->frames(*opened_), frames);
+    write_events_csv(store_->events(*opened_), events);
+    write_metrics_csv(store_->metrics(*opened_), rubric_, metrics);
+    const bool written = write_whole(base + "frames.csv", frames.str(), problem) &&
+                         write_whole(base + "events.csv", events.str(), problem) &&
+                         write_whole(base + "metrics.csv", metrics.str(), problem);
+    setProblem(written ? QString() : problem);
+    return written;
+  } catch (const StorageError& e) {
+    setProblem(tr("Session %1 cannot be read: %2").arg(*opened_).arg(QString::fromUtf8(e.what())));
+    return false;
+  }
+}
+
+bool SessionReviewWindow::exportPdf(const QString& file) {
+  if (!opened_) return false;
+  const SessionSummary* summary = nullptr;
+  for (const SessionSummary& s : sessions_)
+    if (s.id == *opened_) summary = &s;
+  if (summary == nullptr) return false;
+  auto escaped = [](const QString& text) { return text.toHtmlEscaped(); };
+  QString html;
+  html += "<h1>" + escaped(tr("LiverSim session %1").arg(*opened_)) + "</h1>";
+  html +=
+      "<p>" + escaped(tr("Trainee: %1").arg(QString::fromStdString(summary->trainee))) + "<br>" +
+      escaped(tr("Scenario: %1").arg(QString::fromStdString(summary->scenario_title))) + "<br>" +
+      escaped(tr("Started: %1")
+                  .arg(QDateTime::fromMSecsSinceEpoch(summary->started_unix_ms)
+                           .toString("yyyy-MM-dd hh:mm"))) +
+      "<br><b>" + escaped(scoreText()) + "</b></p>";
+  html += "<table border=1 cellpadding=3 cellspacing=0><tr>";
+  for (int c = 0; c < metricTable_->columnCount(); ++c)
+    html += "<th>" + escaped(metricTable_->horizontalHeaderItem(c)->text()) + "</th>";
+  html += "</tr>";
+  for (int r = 0; r < metricTable_->rowCount(); ++r) {
+    html += "<tr>";
+    for (int c = 0; c < metricTable_->columnCount(); ++c)
+      html += "<td>" + escaped(metricTable_->item(r, c) ? metricTable_->item(r, c)->text() : "") +
+              "</td>";
+    html += "</tr>";
+  }
+  html += "</table>";
+  html += "<h2>" + escaped(tr("Force on the device")) + "</h2><img src=\"chart:force\" width=640>";
+  html += "<h2>" + escaped(tr("Events")) + "</h2><p>";
+  for (int i = 0; i < eventList_->count(); ++i)
+    html += escaped(eventList_->item(i)->text()) + "<br>";
+  html += "</p><h2>" + escaped(tr("Grades")) + "</h2><p>" +
+          escaped(gradesLabel_->text()).replace('\n', "<br>") + "</p>";
+
+  QTextDocument document;
+  const QImage chart = forceChart_->grab().toImage();
+  document.addResource(QTextDocument::ImageResource, QUrl("chart:force"), chart);
+  document.setHtml(html);
+  QByteArray bytes;
+  {
+    QBuffer buffer(&bytes);
+    buffer.open(QIODevice::WriteOnly);
+    QPdfWriter pdf(&buffer);
+    pdf.setPageSize(QPageSize(QPageSize::A4));
+    pdf.setTitle(tr("LiverSim session %1").arg(*opened_));
+    pdf.setCreator("LiverSim");
+    document.print(&pdf);
+  }
+  QString problem;
+  const bool written = write_whole(file, bytes.toStdString(), problem);
+  setProblem(written ? QString() : problem);
+  return written;
 }
 
 }  // namespace liversim

@@ -33,7 +33,10 @@ class SessionReviewWindow : public QWidget {
  public:
   // Opens its own connection to the database file (the recorder keeps writing through the
   // workstation's); a file it cannot open is said in the window, which then lists nothing.
-  explicit SessionReviewWindow(const QString& databaseFile, QWidget* parent = nullptr);
+  // With `trainee`, the trainee's own history: only that trainee's sessions, and no grading.
+  explicit SessionReviewWindow(const QString& databaseFile,
+                               const std::optional<QString>& trainee = std::nullopt,
+                               QWidget* parent = nullptr);
   ~SessionReviewWindow() override;
 
   QString problem() const { return problem_; }
@@ -58,8 +61,16 @@ class SessionReviewWindow : public QWidget {
   void setGradeForm(const QString& instructor, const QString& grade, const QString& comment);
   bool saveGrade();
 
+  // The opened session as CSV files in `folder` (session-N-frames.csv, -events.csv,
+  // -metrics.csv: docs/session-storage.md), and as a printable PDF report (its summary, metrics
+  // against the rubric, force plot, events and grades). False, saying why in problem(), when a
+  // file cannot be written; nothing is left half-written under the final name.
+  bool exportCsv(const QString& folder);
+  bool exportPdf(const QString& file);
+
  private:
   void showSessions();
+  void setProblem(const QString& problem);
   void showOpenedSession();
 
   std::unique_ptr<SessionStore> store_;
@@ -67,6 +78,7 @@ class SessionReviewWindow : public QWidget {
   std::vector<SessionSummary> sessions_;
   std::vector<std::optional<double>> scores_;  // per session of sessions_
   QString filter_;
+  std::optional<QString> trainee_;
   std::optional<std::int64_t> opened_;
   std::vector<RubricCriterion> openedRubric_;
   RubricResult rubric_;
@@ -84,6 +96,8 @@ class SessionReviewWindow : public QWidget {
   QLineEdit* gradeEdit_ = nullptr;
   QPlainTextEdit* commentEdit_ = nullptr;
   QPushButton* saveButton_ = nullptr;
+  QPushButton* csvButton_ = nullptr;
+  QPushButton* pdfButton_ = nullptr;
   QLabel* gradesLabel_ = nullptr;
 };
 

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <memory>
@@ -28,6 +29,7 @@
 #include "liversim/core/surface.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
+#include "scenario_panel.h"
 #include "session_review_window.h"
 #include "tool_panel.h"
 
@@ -316,6 +318,29 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   EXPECT_EQ(metrics.at("tissue_damage_mm3"), 0.0);
   EXPECT_EQ(metrics.count("lesion_margin_mm"), 0u) << "nothing was cut";
 
+  // The trainee's summary, in the Scenario panel.
+  EXPECT_TRUE(window_->scenarioPanel()->resultText().contains("score 100 %"))
+      << window_->scenarioPanel()->resultText().toStdString();
+  // The trainee's own history: this session only (another trainee's is not listed), no grading.
+  QAction* historyAction = window_->findChild<QAction*>("traineeHistoryAction");
+  ASSERT_NE(historyAction, nullptr);
+  historyAction->trigger();
+  auto* history = window_->findChild<SessionReviewWindow*>("traineeHistoryWindow");
+  ASSERT_NE(history, nullptr);
+  EXPECT_EQ(history->listedSessionCount(), 1);
+  ASSERT_TRUE(history->openSession(session));
+  history->setGradeForm("Me", "A+", "");
+  EXPECT_FALSE(history->saveGrade()) << "a trainee cannot grade";
+  QSettings().setValue("sessions/trainee", "Someone Else");
+  EXPECT_EQ(window_->traineeName(), "Someone Else");
+  history->close();
+  QCoreApplication::sendPostedEvents(nullptr, QEvent::DeferredDelete);
+  historyAction->trigger();
+  history = window_->findChild<SessionReviewWindow*>("traineeHistoryWindow");
+  ASSERT_NE(history, nullptr);
+  EXPECT_EQ(history->listedSessionCount(), 0);
+  history->close();
+
   // The instructor's review: the session against the scenario's rubric (success, no force, task
   // time 0: every criterion passes), its force curve and events; a grade saved is there when the
   // window is opened again.
@@ -354,6 +379,32 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   EXPECT_TRUE(review->gradesText().contains("score 100 %")) << review->gradesText().toStdString();
   ASSERT_EQ(store.grades(session).size(), 1u);
   EXPECT_EQ(store.grades(session)[0].grade, "pass");
+
+  // Exports: the three CSV files, and a PDF report with the plot.
+  const QString exported = folder_.filePath("export");
+  ASSERT_TRUE(QDir().mkpath(exported));
+  ASSERT_TRUE(review->exportCsv(exported)) << review->problem().toStdString();
+  auto read = [](const QString& file) {
+    std::ifstream in(file.toStdString());
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string metrics_csv = read(exported + QString("/session-%1-metrics.csv").arg(session));
+  EXPECT_NE(metrics_csv.find("\ntask_success,1,,at_least,1,3,1\n"), std::string::npos)
+      << metrics_csv;
+  EXPECT_NE(metrics_csv.find("\nscore_percent,100,%"), std::string::npos) << metrics_csv;
+  EXPECT_NE(read(exported + QString("/session-%1-events.csv").arg(session)).find("lesion_marked"),
+            std::string::npos);
+  const std::string frames_csv = read(exported + QString("/session-%1-frames.csv").arg(session));
+  EXPECT_EQ(std::count(frames_csv.begin(), frames_csv.end(), '\n'),
+            static_cast<long>(store.frames(session).size()) + 1);
+  const QString report = folder_.filePath("report.pdf");
+  ASSERT_TRUE(review->exportPdf(report)) << review->problem().toStdString();
+  const std::string pdf = read(report);
+  EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u);
+  EXPECT_GT(pdf.size(), 10'000u) << "the report has no plot";
+  EXPECT_FALSE(review->exportPdf("/nonexistent/folder/report.pdf"));
+  EXPECT_TRUE(review->problem().contains("/nonexistent/folder/report.pdf"))
+      << review->problem().toStdString();
 }
 
 // A recorded session's device input plays back through the servo, at its original rate, along
