@@ -2,8 +2,9 @@
 #include "bench_command.h"
 #include "cli_commands.h"
 #include "cut_bench_command.h"
-#include "sessions_command.h"
 #include "experiment_commands.h"
+#include "servo_bench_command.h"
+#include "sessions_command.h"
 #include "study_command.h"
 
 #include <CLI/CLI.hpp>
@@ -148,6 +149,7 @@ int main(int argc, char** argv) {
   const auto run_study = add_study_command(app);
   const auto run_bench = add_bench_command(app);
   const auto run_cut_bench = add_cut_bench_command(app);
+  const auto run_servo_bench = add_servo_bench_command(app);
   const auto run_sessions = add_sessions_command(app);
 
   try {
@@ -161,6 +163,7 @@ int main(int argc, char** argv) {
   if (auto exit_code = run_study()) return *exit_code;
   if (auto exit_code = run_bench()) return *exit_code;
   if (auto exit_code = run_cut_bench()) return *exit_code;
+  if (auto exit_code = run_servo_bench()) return *exit_code;
   if (auto exit_code = run_sessions()) return *exit_code;
   if (report->parsed()) return mesh_report(report_mesh);
   if (simulate_cmd->parsed()) return simulate(sim);

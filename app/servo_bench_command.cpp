@@ -1,0 +1,173 @@
+#include "servo_bench_command.h"
+
+#include "cli_commands.h"
+#include "liversim/core/cutting.h"
+#include "liversim/core/default_scene.h"
+#include "liversim/core/emulated_devices.h"
+#include "liversim/core/realtime_simulation.h"
+#include "liversim/core/servo_loop.h"
+#include "liversim/core/worker_pool.h"
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <numbers>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+namespace liversim::cli {
+namespace {
+
+struct ServoBenchOptions {
+  double seconds = 5.0;
+  int runs = 3;
+  int tets = 10583;
+  std::filesystem::path output_dir = "docs";
+};
+
+// The probe's ball pressing 3 mm into the top of the liver and circling there (radius 10 mm, one
+// turn every 2 s): device millimetres are scene millimetres (the default mapping).
+std::vector<TrajectoryPoint> circle_on_top(const TetMesh& mesh, double seconds) {
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < mesh.node_count(); ++n) box.extend(mesh.rest_position_m.at(n));
+  double top_m = -INFINITY;
+  for (std::size_t n = 0; n < mesh.node_count(); ++n) {
+    const Eigen::Vector3d p = mesh.rest_position_m.at(n);
+    if ((p.head<2>() - box.center().head<2>()).norm() < 0.015) top_m = std::max(top_m, p.z());
+  }
+  const double ball_mm = Tool{}.geometry.probe_tip_radius_m * 1e3;
+  const Eigen::Vector3d centre_mm(box.center().x() * 1e3, box.center().y() * 1e3,
+                                  top_m * 1e3 + ball_mm - 3.0);
+  std::vector<TrajectoryPoint> points;
+  for (double t = 0.0; t <= seconds + 0.01; t += 0.01) {
+    const double angle = std::numbers::pi * t;  // one turn every 2 s
+    points.push_back(
+        {t, centre_mm + 10.0 * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0), 0});
+  }
+  return points;
+}
+
+struct ServoRun {
+  bool simulation = false;
+  ServoStats stats;
+};
+
+ServoRun run_once(const SceneSetup& scene, bool with_simulation, double seconds) {
+  const std::vector<TrajectoryPoint> circle = circle_on_top(scene.mesh, seconds);
+  const Eigen::Vector3d circle_centre_m =
+      (circle.front().position_mm - Eigen::Vector3d(10.0, 0.0, 0.0)) * 1e-3;
+  TrajectoryDevice device("bench circle", circle);
+  ServoLoop servo(device, ServoLoop::Options{});
+  std::unique_ptr<RealtimeSimulation> simulation;
+  std::atomic<bool> stop_publisher{false};
+  std::thread publisher;
+  if (with_simulation) {
+    auto model = std::make_shared<const SimModel>(build_model(scene.mesh, scene.model_options));
+    simulation =
+        std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
+    simulation->enable_tools(boundary_surface(*model));
+    simulation->set_haptic_servo(&servo);
+    simulation->set_device_tool(DeviceToolSettings{});
+    simulation->start();
+  } else {
+    // A force model every 5 ms, as the simulation publishes one per cycle: a 100 N/m spring to
+    // the circle's centre (1 N on the circle).
+    publisher = std::thread([&] {
+      while (!stop_publisher.load()) {
+        LocalForceModel wall;
+        wall.stiffness_n_per_m = Eigen::Matrix3d::Identity() * 100.0;
+        wall.position_m = circle_centre_m;
+        wall.radius_m = 0.02;
+        servo.publish(wall);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    });
+  }
+  servo.start();
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  servo.stop();
+  if (simulation) simulation->stop();
+  stop_publisher = true;
+  if (publisher.joinable()) publisher.join();
+  return {with_simulation, servo.stats()};
+}
+
+int run(const ServoBenchOptions& o) {
+  std::filesystem::create_directories(o.output_dir);
+  const SceneSetup scene = default_scene(o.tets);
+  std::vector<ServoRun> runs;
+  for (bool with_simulation : {false, true})
+    for (int r = 0; r < o.runs; ++r) {
+      runs.push_back(run_once(scene, with_simulation, o.seconds));
+      const ServoStats& s = runs.back().stats;
+      std::cout << (with_simulation ? "with the simulation" : "alone") << ", run " << r + 1 << ": "
+                << number(s.rate_hz()) << " Hz, p99 " << number(s.period_percentile_s(0.99) * 1e3)
+                << " ms, max " << number(s.max_period_s * 1e3) << " ms, " << s.missed_deadlines
+                << " missed deadlines" << std::endl;
+    }
+  std::ostringstream md;
+  md << "# Haptic servo timing\n\nWritten by `liversim-cli bench-servo --seconds "
+     << number(o.seconds) << " --runs " << o.runs << " --tets " << o.tets << "` on " << today_utc()
+     << " (" << std::thread::hardware_concurrency()
+     << " hardware threads). Wall-clock timing of the servo thread on this machine: it is shared "
+        "with other work, so the tails vary from run to run; the tests assert only loose sanity "
+        "bounds (docs/haptics.md).\n\n"
+     << "The device is a scripted trajectory: the probe's ball pressing 3 mm into the top of the "
+        "liver and circling there (radius 10 mm, a turn every 2 s). **Alone**, the servo is the "
+        "only busy thread: a model of a 100 N/m spring to the circle's centre (1 N on the circle) "
+        "is published every 5 ms, as the simulation would. **With the simulation**, the real-time "
+        "simulation of the "
+     << scene.description
+     << " runs on all cores with the probe as the device's tool, publishing the local force model "
+        "each cycle: the workstation's load without its window.\n\n"
+     << "A tick is late (a missed deadline) when its period exceeds 1.5 ms. Periods come from "
+        "the servo's histogram (10 µs bins), so the percentiles are bin upper edges.\n\n"
+     << "| condition | run | ticks | rate (Hz) | period p50 (ms) | p99 (ms) | p99.9 (ms) | max "
+        "(ms) | missed deadlines | watchdog trips | largest force (N) |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  int index = 0;
+  for (const ServoRun& run : runs) {
+    const ServoStats& s = run.stats;
+    md << "| " << (run.simulation ? "with the simulation" : "alone") << " | "
+       << (index++ % o.runs) + 1 << " | " << s.ticks << " | " << number(s.rate_hz()) << " | "
+       << number(s.period_percentile_s(0.5) * 1e3) << " | "
+       << number(s.period_percentile_s(0.99) * 1e3) << " | "
+       << number(s.period_percentile_s(0.999) * 1e3) << " | " << number(s.max_period_s * 1e3)
+       << " | " << s.missed_deadlines << " | " << s.watchdog_trips << " | " << number(s.max_force_n)
+       << " |\n";
+  }
+  return write_report(o.output_dir / "haptics-servo.md", md.str());
+}
+
+}  // namespace
+
+std::function<std::optional<int>()> add_servo_bench_command(CLI::App& app) {
+  auto options = std::make_shared<ServoBenchOptions>();
+  auto* command = app.add_subcommand(
+      "bench-servo",
+      "Measure the haptic servo's rate and tick jitter alone and with the simulation running; "
+      "write docs/haptics-servo.md");
+  command->add_option("--seconds", options->seconds, "Length of each run (s)")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
+  command->add_option("--runs", options->runs, "Runs of each condition")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  command->add_option("--tets", options->tets, "Liver size of the simulation's load")
+      ->check(CLI::Range(100, 2'000'000))
+      ->capture_default_str();
+  command->add_option("--output-dir", options->output_dir, "Where haptics-servo.md goes")
+      ->capture_default_str();
+  return [options, command]() -> std::optional<int> {
+    if (!command->parsed()) return std::nullopt;
+    return guarded([&] { return run(*options); });
+  };
+}
+
+}  // namespace liversim::cli
