@@ -810,6 +810,7 @@ void MainWindow::beginRecording() {
                  : scripted_                                           ? scripted_->name()
                                                                        : "haptic device";
   start.started_unix_ms = QDateTime::currentMSecsSinceEpoch();
+  start.mapping = haptics_.mapping;
   ServoLoop* servo = servo_.get();
   try {
     recorder_ = std::make_unique<SessionRecorder>(

@@ -319,7 +319,13 @@ void SessionReviewWindow::showOpenedSession() {
       metricTable_->setItem(row, 3, cell(QString()));
     }
 
-    // The force on the device, each bucket of frames as its largest force.
+    // The force on the tissue (the device's over the mapping's scale; the device's own for
+    // sessions recorded without their mapping), each bucket of frames as its largest force.
+    std::optional<double> scale;
+    for (const SessionSummary& summary : sessions_)
+      if (summary.id == *opened_ && summary.mapping) scale = summary.mapping->scale;
+    forceSeries_->setName(scale ? tr("Force on the tissue (N)") : tr("Force on the device (N)"));
+    const double force_factor = scale ? 1.0 / *scale : 1.0;
     const std::vector<ServoFrame> frames = store_->frames(*opened_);
     const std::size_t bucket =
         std::max<std::size_t>(1, (frames.size() + kMaxForcePoints - 1) / kMaxForcePoints);
@@ -330,7 +336,7 @@ void SessionReviewWindow::showOpenedSession() {
       std::size_t peak = begin;
       for (std::size_t i = begin; i < std::min(frames.size(), begin + bucket); ++i)
         if (frames[i].force_n.norm() > frames[peak].force_n.norm()) peak = i;
-      const double force = frames[peak].force_n.norm();
+      const double force = frames[peak].force_n.norm() * force_factor;
       largest = std::max(largest, force);
       points.append(QPointF(frames[peak].time_s - t0, force));
     }

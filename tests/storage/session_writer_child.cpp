@@ -52,8 +52,8 @@ int main(int argc, char** argv) {
     const auto epoch = std::chrono::steady_clock::now() -
                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                            std::chrono::duration<double>(servo.now_s()));
-    SessionStart start{"Trainee A", "Scripted circle", "{\"title\": \"Scripted circle\"}",
-                       device.name(), 1'795'000'000'000};
+    SessionStart start{"Trainee A",   "Scripted circle", "{\"title\": \"Scripted circle\"}",
+                       device.name(), 1'795'000'000'000, std::nullopt};
     SessionRecorder recorder(store, start,
                              [&](ServoFrame& frame) { return servo.next_logged_frame(frame); });
     servo.start();

@@ -63,7 +63,7 @@ void expect_same_frames(const std::vector<ServoFrame>& read,
 }
 
 SessionStart start_of(const std::string& trainee, const std::string& scenario_text) {
-  return {trainee, "Palpation", scenario_text, "Scripted", 1'795'000'000'000};
+  return {trainee, "Palpation", scenario_text, "Scripted", 1'795'000'000'000, std::nullopt};
 }
 
 // Runs SQL on a file directly, outside the store (to make files the store must refuse).
@@ -203,6 +203,58 @@ TEST(SessionStore, GradesAndCommentsAreKeptPerSessionAndReadBackAfterReopening) 
   EXPECT_EQ(reopened.sessions().size(), 2u);
   EXPECT_EQ(reopened.sessions()[0].trainee, "Dr. O'Neil");
   EXPECT_EQ(reopened.integrity_check(), "ok");
+}
+
+// Migrations: a file written by every earlier schema version (tests/data/storage/sessions-vN,
+// made by that version's code) opens for writing, migrated, with everything it held; for
+// reading only it is refused until migrated. Sessions of earlier versions have no mapping; new
+// ones keep theirs exactly.
+TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
+  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 2) << "add a file of the version before";
+  const fs::path file = fresh_database("migrated-from-v1");
+  fs::copy_file(fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "sessions-v1.sqlite", file);
+  const std::string message = open_error(file, SqliteSessionStore::Access::read_only);
+  EXPECT_NE(message.find("schema version 1 needs migrating"), std::string::npos) << message;
+  WorkspaceMapping mapping;
+  mapping.scale = 1.5;
+  mapping.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()));
+  mapping.offset_m = {0.01, -0.02, 0.03};
+  std::int64_t added = 0;
+  {
+    SqliteSessionStore store(file);
+    SessionStart start = start_of("Trainee C", "{}");
+    start.mapping = mapping;
+    added = store.begin_session(start);
+  }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* version = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &version, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_step(version), SQLITE_ROW);
+  EXPECT_EQ(sqlite3_column_int(version, 0), 2);
+  sqlite3_finalize(version);
+  sqlite3_close(db);
+
+  SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
+  EXPECT_EQ(store.integrity_check(), "ok");
+  const std::vector<SessionSummary> sessions = store.sessions();
+  ASSERT_EQ(sessions.size(), 2u);
+  // The version-1 session: complete, its 202 frames, metric, event and grade, no mapping.
+  EXPECT_EQ(sessions[0].status, SessionStatus::complete);
+  EXPECT_EQ(sessions[0].frame_count, 202);
+  EXPECT_EQ(store.frames(sessions[0].id).size(), 202u);
+  EXPECT_FALSE(sessions[0].mapping);
+  EXPECT_EQ(store.metrics(sessions[0].id), (std::vector<MetricValue>{{"peak_force_n", 0.75}}));
+  ASSERT_EQ(store.events(sessions[0].id).size(), 1u);
+  EXPECT_EQ(store.events(sessions[0].id)[0].detail, "probe");
+  ASSERT_EQ(store.grades(sessions[0].id).size(), 1u);
+  EXPECT_EQ(store.grades(sessions[0].id)[0].comment, "v1 grade");
+  // The new session keeps its mapping exactly.
+  EXPECT_EQ(sessions[1].id, added);
+  ASSERT_TRUE(sessions[1].mapping);
+  EXPECT_EQ(sessions[1].mapping->scale, 1.5);
+  EXPECT_EQ(sessions[1].mapping->rotation.coeffs(), mapping.rotation.coeffs());
+  EXPECT_EQ(sessions[1].mapping->offset_m, mapping.offset_m);
 }
 
 TEST(SessionRecorder, WritesFramesAndEventsAndEndsTheSessionComplete) {

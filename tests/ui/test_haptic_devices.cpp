@@ -209,6 +209,8 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   EXPECT_EQ(sessions[0].status, SessionStatus::complete);
   EXPECT_EQ(sessions[0].scenario_title, "Free practice");
   EXPECT_NE(sessions[0].device.find("trajectory.txt"), std::string::npos) << sessions[0].device;
+  ASSERT_TRUE(sessions[0].mapping) << "the session keeps its workspace mapping";
+  EXPECT_EQ(sessions[0].mapping->scale, window_->hapticPreferences().mapping.scale);
   ASSERT_TRUE(sessions[0].servo.has_value());
   const std::vector<ServoFrame> frames = store.frames(session);
   // Every tick of the servo is a frame of the session; the figures are those the servo published

@@ -11,7 +11,7 @@ namespace liversim {
 namespace {
 
 // Version 1. Each later version adds its step to kMigrations (and a test that opens a file of
-// every earlier version).
+// every earlier version: tests/data/storage/sessions-vN.sqlite, written by that version).
 constexpr const char* kSchemaV1 = R"sql(
 CREATE TABLE people (
   id INTEGER PRIMARY KEY,
@@ -83,7 +83,20 @@ CREATE TABLE grades (
 )sql";
 
 // kMigrations[v] takes a file from version v to v + 1 (version 0: a new, empty file).
-constexpr std::array<const char*, 1> kMigrations = {kSchemaV1};
+// Version 2: the session's workspace mapping (device → scene), so that its tissue forces and a
+// replay can be recovered; null for sessions recorded before.
+constexpr const char* kSchemaV2 = R"sql(
+ALTER TABLE sessions ADD COLUMN mapping_scale REAL;
+ALTER TABLE sessions ADD COLUMN mapping_rotation_w REAL;
+ALTER TABLE sessions ADD COLUMN mapping_rotation_x REAL;
+ALTER TABLE sessions ADD COLUMN mapping_rotation_y REAL;
+ALTER TABLE sessions ADD COLUMN mapping_rotation_z REAL;
+ALTER TABLE sessions ADD COLUMN mapping_offset_x_m REAL;
+ALTER TABLE sessions ADD COLUMN mapping_offset_y_m REAL;
+ALTER TABLE sessions ADD COLUMN mapping_offset_z_m REAL;
+)sql";
+
+constexpr std::array<const char*, 2> kMigrations = {kSchemaV1, kSchemaV2};
 static_assert(kMigrations.size() == SqliteSessionStore::kSchemaVersion);
 
 enum StatementId {
@@ -347,14 +360,24 @@ std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
       prepared(kFindScenario, "SELECT id FROM scenarios WHERE sha256 = ?1")
           .bind(1, std::string_view(hash))
           .single_integer("looking up the scenario");
-  prepared(kAddSession,
-           "INSERT INTO sessions (trainee_id, scenario_id, device, started_unix_ms, status) "
-           "VALUES (?1, ?2, ?3, ?4, 'recording')")
-      .bind(1, trainee)
+  Statement& add =
+      prepared(kAddSession,
+               "INSERT INTO sessions (trainee_id, scenario_id, device, started_unix_ms, status, "
+               "mapping_scale, mapping_rotation_w, mapping_rotation_x, mapping_rotation_y, "
+               "mapping_rotation_z, mapping_offset_x_m, mapping_offset_y_m, mapping_offset_z_m) "
+               "VALUES (?1, ?2, ?3, ?4, 'recording', ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)");
+  add.bind(1, trainee)
       .bind(2, scenario)
       .bind(3, std::string_view(start.device))
-      .bind(4, start.started_unix_ms)
-      .run("adding the session");
+      .bind(4, start.started_unix_ms);
+  if (const auto& m = start.mapping) {
+    const double values[] = {m->scale,        m->rotation.w(), m->rotation.x(), m->rotation.y(),
+                             m->rotation.z(), m->offset_m.x(), m->offset_m.y(), m->offset_m.z()};
+    for (int k = 0; k < 8; ++k) add.bind(5 + k, values[k]);
+  } else {
+    for (int k = 0; k < 8; ++k) add.bind_null(5 + k);
+  }
+  add.run("adding the session");
   const std::int64_t session = sqlite3_last_insert_rowid(db_);
   commit();
   return session;
@@ -493,7 +516,9 @@ std::vector<SessionSummary> SqliteSessionStore::sessions() {
       "SELECT s.id, p.name, c.title, c.sha256, s.device, s.started_unix_ms, s.ended_unix_ms, "
       "s.status, s.frame_count, s.servo_ticks, s.servo_rate_hz, s.servo_period_p50_ms, "
       "s.servo_period_p99_ms, s.servo_period_max_ms, s.missed_deadlines, s.force_clamps, "
-      "s.stiffness_clamps, s.rate_limited, s.watchdog_trips, s.device_faults, s.dropped_frames "
+      "s.stiffness_clamps, s.rate_limited, s.watchdog_trips, s.device_faults, s.dropped_frames, "
+      "s.mapping_scale, s.mapping_rotation_w, s.mapping_rotation_x, s.mapping_rotation_y, "
+      "s.mapping_rotation_z, s.mapping_offset_x_m, s.mapping_offset_y_m, s.mapping_offset_z_m "
       "FROM sessions s JOIN people p ON p.id = s.trainee_id "
       "JOIN scenarios c ON c.id = s.scenario_id ORDER BY s.id");
   std::vector<SessionSummary> result;
@@ -527,6 +552,13 @@ std::vector<SessionSummary> SqliteSessionStore::sessions() {
       f.device_faults = count(19);
       f.dropped_frames = count(20);
       s.servo = f;
+    }
+    if (!rows.is_null(21)) {
+      WorkspaceMapping m;
+      m.scale = rows.real(21);
+      m.rotation = Eigen::Quaterniond(rows.real(22), rows.real(23), rows.real(24), rows.real(25));
+      m.offset_m = Eigen::Vector3d(rows.real(26), rows.real(27), rows.real(28));
+      s.mapping = m;
     }
     result.push_back(std::move(s));
   }

@@ -57,6 +57,8 @@ struct SessionStart {
   std::string scenario_text;  // the exact scenario file content the session runs
   std::string device;         // the haptic device's name
   std::int64_t started_unix_ms = 0;
+  // Device → scene for the session (schema 2 on): tissue forces are device forces / its scale.
+  std::optional<WorkspaceMapping> mapping;
 };
 
 // The servo's figures of a session (ServoStats reduced to what is kept).
@@ -81,6 +83,7 @@ struct SessionSummary {
   SessionStatus status = SessionStatus::recording;
   std::int64_t frame_count = 0;
   std::optional<SessionServoFigures> servo;  // set when the session ended normally
+  std::optional<WorkspaceMapping> mapping;   // none for sessions recorded before schema 2
 };
 
 // A gradable metric's value (gradable_metrics() in scenario.h names them and their units).
