@@ -344,6 +344,7 @@ void MainWindow::updateRecentMenu() {
 
 MainWindow::~MainWindow() {
   if (modelBuilder_.joinable()) modelBuilder_.join();
+  if (metricsWorker_.joinable()) metricsWorker_.join();
   simulation_->stop();
   detachDevice();  // the servo's last command is a zero force
 }
@@ -962,32 +963,63 @@ void MainWindow::endRecording() {
     return;
   }
   recorder_.reset();
+  computeSessionMetrics(session, std::move(outcome));
+}
+
+void MainWindow::computeSessionMetrics(std::int64_t session,
+                                       std::optional<OutcomeTracking> outcome) {
   // The metrics of its trace, from what was stored, and of its simulation
-  // (docs/session-metrics.md).
-  try {
+  // (docs/session-metrics.md): a long session is hundreds of megabytes of frames, so they are
+  // read and computed on a worker with its own connection, off the UI thread.
+  if (metricsWorker_.joinable()) metricsWorker_.join();  // one at a time
+  ++pendingMetrics_;
+  std::optional<Scenario> scenario;
+  if (scenario_) scenario = scenario_->scenario;
+  metricsWorker_ = std::thread([this, file = sessionsFile_.toStdString(), session,
+                                outcome = std::move(outcome), scenario = std::move(scenario),
+                                mapping = haptics_.mapping] {
     std::vector<MetricValue> values;
-    const std::vector<SessionEvent> events = sessions_->events(session);
-    const std::vector<ServoFrame> frames = sessions_->frames(session);
-    if (!frames.empty())
-      values = trace_metric_values(
-          compute_trace_metrics(frames, tool_intervals(events), haptics_.mapping, {}));
-    if (outcome) {
-      const Scenario* scenario = scenario_ ? &scenario_->scenario : nullptr;
-      const std::vector<MetricValue> simulated = outcome_metric_values(
-          compute_outcome_metrics(*outcome->initial_model, *outcome->model, outcome->tracker,
-                                  scenario, lesion_marks(events)),
-          scenario);
-      values.insert(values.end(), simulated.begin(), simulated.end());
+    QString problem;
+    try {
+      SqliteSessionStore store{std::filesystem::path(file)};
+      const std::vector<SessionEvent> events = store.events(session);
+      const std::vector<ServoFrame> frames = store.frames(session);
+      if (!frames.empty())
+        values =
+            trace_metric_values(compute_trace_metrics(frames, tool_intervals(events), mapping, {}));
+      if (outcome) {
+        const Scenario* run = scenario ? &*scenario : nullptr;
+        const std::vector<MetricValue> simulated = outcome_metric_values(
+            compute_outcome_metrics(*outcome->initial_model, *outcome->model, outcome->tracker, run,
+                                    lesion_marks(events)),
+            run);
+        values.insert(values.end(), simulated.begin(), simulated.end());
+      }
+      if (!values.empty()) store.store_metrics(session, values);
+    } catch (const std::exception& e) {
+      problem = tr("The session's metrics were not stored: %1").arg(QString::fromUtf8(e.what()));
     }
-    if (!values.empty()) sessions_->store_metrics(session, values);
-    scenarioPanel_->showResult(sessionResultText(
-        scenario_ ? grade_against_rubric(scenario_->scenario.rubric, values) : RubricResult{},
-        values));
-  } catch (const std::exception& e) {
-    sessionsProblem_ =
-        tr("The session's metrics were not stored: %1").arg(QString::fromUtf8(e.what()));
-    statusBar()->showMessage(sessionsProblem_);
-  }
+    const QString result =
+        problem.isEmpty()
+            ? sessionResultText(
+                  scenario ? grade_against_rubric(scenario->rubric, values) : RubricResult{},
+                  values)
+            : QString();
+    // Dropped if the window is gone (it joins this thread first).
+    QMetaObject::invokeMethod(
+        this,
+        [this, session, problem, result] {
+          --pendingMetrics_;
+          if (!problem.isEmpty()) {
+            sessionsProblem_ = problem;
+            statusBar()->showMessage(problem);
+          } else {
+            scenarioPanel_->showResult(result);
+          }
+          emit sessionMetricsStored(session, problem.isEmpty());
+        },
+        Qt::QueuedConnection);
+  });
 }
 
 void MainWindow::openOmni() {

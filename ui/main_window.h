@@ -132,6 +132,9 @@ class MainWindow : public QMainWindow {
   static constexpr double kGrabRadiusM = 0.02;
 
  signals:
+  // A recorded session's metrics were computed and stored (or not: stored false, the reason in
+  // sessionsProblem()), after its end, on a worker.
+  void sessionMetricsStored(qint64 session, bool stored);
   void integratorChangeFinished(bool applied);
   void scenarioOpenFinished(bool opened);
 
@@ -222,6 +225,9 @@ class MainWindow : public QMainWindow {
   QString sessionsFile_;
   // While recording: the events the display frames show, and the lesions a cut has breached.
   std::optional<SessionEventDetector> eventDetector_;
+  std::thread metricsWorker_;
+  int pendingMetrics_ = 0;
+  void computeSessionMetrics(std::int64_t session, std::optional<OutcomeTracking> outcome);
   std::set<std::string> breachedLesions_;
   void recordSimulationEvents(const SimulationSnapshot& snapshot, bool cut);
   SessionReviewWindow* showSessionsWindow(QPointer<SessionReviewWindow>& window,

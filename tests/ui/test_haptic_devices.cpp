@@ -198,8 +198,13 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   ASSERT_TRUE(window_->recordingSession().has_value()) << window_->sessionsProblem().toStdString();
   const std::int64_t session = *window_->recordingSession();
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 600; }, kTimeoutMs));
+  QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
   ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
   EXPECT_FALSE(window_->recordingSession().has_value());
+  // The metrics are computed off the UI thread, then reported.
+  ASSERT_TRUE(metricsStored.wait(kTimeoutMs));
+  EXPECT_EQ(metricsStored.first().at(0).toLongLong(), session);
+  EXPECT_TRUE(metricsStored.first().at(1).toBool());
   EXPECT_TRUE(window_->sessionsProblem().isEmpty()) << window_->sessionsProblem().toStdString();
 
   SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
@@ -305,7 +310,9 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   QAction* mark = window_->findChild<QAction*>("markLesionAction");
   ASSERT_NE(mark, nullptr);
   mark->trigger();
+  QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
   ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  ASSERT_TRUE(metricsStored.wait(kTimeoutMs));
 
   SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
   const std::vector<Eigen::Vector3d> marks = lesion_marks(store.events(session));
