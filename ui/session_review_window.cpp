@@ -344,10 +344,18 @@ void SessionReviewWindow::showOpenedSession() {
     const std::vector<SessionEvent> events = store_->events(*opened_);
     for (const SessionEvent& e : events) {
       const std::string_view kind = session_event_name(e.kind);
+      // A mark's detail is kept at full precision; shown to the tenth of a millimetre.
+      QString detail = QString::fromStdString(e.detail);
+      const std::vector<Eigen::Vector3d> mark = lesion_marks(std::span(&e, 1));
+      if (!mark.empty())
+        detail = tr("at (%1, %2, %3) mm")
+                     .arg(mark[0].x() * 1e3, 0, 'f', 1)
+                     .arg(mark[0].y() * 1e3, 0, 'f', 1)
+                     .arg(mark[0].z() * 1e3, 0, 'f', 1);
       eventList_->addItem(QString("%1 s  %2  %3")
                               .arg(e.time_s - t0, 0, 'f', 3)
                               .arg(QString::fromUtf8(kind.data(), static_cast<int>(kind.size())))
-                              .arg(QString::fromStdString(e.detail)));
+                              .arg(detail));
       eventSeries_->append(e.time_s - t0, 0.0);
     }
     const double end_s = frames.empty() ? 1.0 : std::max(frames.back().time_s - t0, 1e-3);
@@ -395,6 +403,12 @@ int SessionReviewWindow::forcePointCount() const {
 
 int SessionReviewWindow::eventCount() const {
   return eventList_->count();
+}
+
+QStringList SessionReviewWindow::eventLines() const {
+  QStringList lines;
+  for (int i = 0; i < eventList_->count(); ++i) lines << eventList_->item(i)->text();
+  return lines;
 }
 
 QString SessionReviewWindow::gradesText() const {

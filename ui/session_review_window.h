@@ -8,6 +8,7 @@
 #include "liversim/core/session_log.h"
 
 #include <QString>
+#include <QStringList>
 #include <QWidget>
 
 #include <cstdint>
@@ -54,7 +55,8 @@ class SessionReviewWindow : public QWidget {
   QString scoreText() const;
   int forcePointCount() const;  // points of the force curve (downsampled: peaks kept)
   int eventCount() const;
-  QString gradesText() const;  // the grades saved so far, oldest first
+  QStringList eventLines() const;  // as listed: time, kind, detail
+  QString gradesText() const;      // the grades saved so far, oldest first
 
   // The grade form; saveGrade stores it (with the rubric's score) and shows it under the earlier
   // ones. False, saying why, without an instructor name or a grade, or when the database refuses.

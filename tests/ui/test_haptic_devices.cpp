@@ -372,6 +372,9 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   EXPECT_TRUE(review->scoreText().contains("100 %")) << review->scoreText().toStdString();
   EXPECT_GT(review->forcePointCount(), 0);
   EXPECT_EQ(review->eventCount(), static_cast<int>(store.events(session).size()));
+  const QString markLine = review->eventLines().filter("lesion_marked").value(0);
+  EXPECT_TRUE(markLine.contains(QString(" at (%1, ").arg(marks[0].x() * 1e3, 0, 'f', 1)))
+      << markLine.toStdString();
   review->setGradeForm("", "pass", "");
   EXPECT_FALSE(review->saveGrade()) << "a grade needs the instructor";
   review->setGradeForm("Dr. Grey", "pass", "Found it at the first attempt.");
