@@ -8,6 +8,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace liversim {
 namespace {
@@ -241,6 +242,7 @@ void RealtimeSimulation::set_device_tool(const std::optional<DeviceToolSettings>
 }
 
 void RealtimeSimulation::change_tool(const std::optional<Tool>& tool) {
+  if (running()) log_input({SimulationInput::Kind::tool, tool, {}, 0, false});
   const bool kind_changed = !tool || !active_tool_ || tool->kind != active_tool_->kind;
   active_tool_ = tool;
   if (!active_tool_ && tools_) tools_->release();
@@ -253,6 +255,7 @@ void RealtimeSimulation::take_inputs() {
     if (springs_changed_) {
       active_springs_.assign(pending_springs_.begin(), pending_springs_.end());  // no realloc
       springs_changed_ = false;
+      log_input({SimulationInput::Kind::springs, std::nullopt, active_springs_, 0, false});
     }
     if (device_tool_changed_) {
       // The tool held so far goes: the device's appears with its first frame, or without a
@@ -331,6 +334,89 @@ void merge_guarded(GuardedReport& total, const GuardedReport& one) {
 
 }  // namespace
 
+GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
+  const SimModel& model = *model_;  // a cut may replace it between cycles
+  const bool tool_acts = tools_ && active_tool_;
+  // Guarded: a bad step goes back to the last good state and is retried with shorter steps; a
+  // bad input (a NaN from a device) is refused.
+  GuardOptions guard;
+  guard.check_energy = check_energy;
+  // A tool's springs follow the surface: recomputed before every step of the cycle.
+  auto tool_inputs = [&] {
+    step_springs_.assign(active_springs_.begin(), active_springs_.end());
+    const auto tool_springs = tools_->update(*active_tool_, state_.position_m, blade_in_tissue_);
+    step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
+    return StepInputs{{}, step_springs_};
+  };
+  GuardedReport guarded;
+  if (tool_acts) {
+    for (int s = 0; s < steps; ++s) {
+      GuardOptions step_guard = guard;
+      step_guard.check_energy = guard.check_energy && s == 0;
+      const GuardedReport one =
+          guarded_advance(model, state_, tool_inputs(), step_s_, checkpoint_, step_guard);
+      merge_guarded(guarded, one);
+      if (one.gave_up) break;
+    }
+  } else {
+    const StepInputs inputs{{}, active_springs_};
+    guarded = guarded_advance(model, state_, inputs, steps * step_s_, checkpoint_, guard);
+  }
+  if (guarded.energy) {
+    energy_created_ = guarded.energy_created;
+    const double supplied = guarded.energy->supplied_j();
+    dissipated_fraction_ = supplied > 0.0 ? guarded.energy->dissipated_j() / supplied : 0.0;
+  }
+  if (guarded.problem != HealthProblem::none) last_problem_ = guarded.problem;
+  rollbacks_ += guarded.rollbacks;
+  if (guarded.inputs_rejected) ++rejected_inputs_;
+  if (guarded.gave_up) halted_ = true;
+  if (cutting_ && tool_acts && active_tool_->kind == ToolKind::scalpel && !guarded.gave_up)
+    cut_with_scalpel(*active_tool_);
+  return guarded;
+}
+
+void RealtimeSimulation::log_inputs(bool on) {
+  std::lock_guard lock(input_log_mutex_);
+  logging_inputs_ = on;
+}
+
+std::vector<SimulationInput> RealtimeSimulation::take_input_log() {
+  std::lock_guard lock(input_log_mutex_);
+  return std::exchange(input_log_, {});
+}
+
+void RealtimeSimulation::log_input(SimulationInput input) {
+  std::lock_guard lock(input_log_mutex_);
+  if (!logging_inputs_) return;
+  // A device moves the tool at every loop, many times between cycles: a tool of the same kind
+  // replacing one that no cycle used has the same effect as both (change_tool), so it replaces it.
+  if (input.kind == SimulationInput::Kind::tool && input.tool && !input_log_.empty()) {
+    SimulationInput& last = input_log_.back();
+    if (last.kind == SimulationInput::Kind::tool && last.tool &&
+        last.tool->kind == input.tool->kind) {
+      last.tool = input.tool;
+      return;
+    }
+  }
+  input_log_.push_back(std::move(input));
+}
+
+void RealtimeSimulation::replay(std::span<const SimulationInput> inputs) {
+  if (running()) throw std::logic_error("replay needs the simulation stopped");
+  for (const SimulationInput& input : inputs) switch (input.kind) {
+      case SimulationInput::Kind::tool:
+        change_tool(input.tool);
+        break;
+      case SimulationInput::Kind::springs:
+        active_springs_.assign(input.springs.begin(), input.springs.end());
+        break;
+      case SimulationInput::Kind::cycle:
+        if (!halted_.load()) advance_cycle(input.steps, input.check_energy);
+        break;
+    }
+}
+
 void RealtimeSimulation::run() {
   using Clock = std::chrono::steady_clock;
   using Seconds = std::chrono::duration<double>;
@@ -356,9 +442,6 @@ void RealtimeSimulation::run() {
 
   while (!stop_requested_.load(std::memory_order_relaxed)) {
     take_inputs();
-    const SimModel& model = *model_;  // a cut may replace it between cycles
-    const bool tool_acts = tools_ && active_tool_;
-    const StepInputs inputs{{}, active_springs_};
     const auto cycle_start = Clock::now();
     const StepAccumulator::Due due = clock.add(Seconds(cycle_start - last_cycle).count());
     last_cycle = cycle_start;
@@ -367,43 +450,11 @@ void RealtimeSimulation::run() {
       dropped_s += due.dropped_s;
     }
     if (due.steps > 0 && !halted_.load(std::memory_order_relaxed)) {
-      // Guarded: a bad step goes back to the last good state and is retried with shorter steps;
-      // a bad input (a NaN from a device) is refused.
-      GuardOptions guard;
-      guard.check_energy = close_books;  // one pass over the elements, once per window
+      const bool check_energy = close_books;  // one pass over the elements, once per window
       close_books = false;
-      // A tool's springs follow the surface: recomputed before every step of the cycle.
-      auto tool_inputs = [&] {
-        step_springs_.assign(active_springs_.begin(), active_springs_.end());
-        const auto tool_springs =
-            tools_->update(*active_tool_, state_.position_m, blade_in_tissue_);
-        step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
-        return StepInputs{{}, step_springs_};
-      };
-      GuardedReport guarded;
-      if (tool_acts) {
-        for (int s = 0; s < due.steps; ++s) {
-          GuardOptions step_guard = guard;
-          step_guard.check_energy = guard.check_energy && s == 0;
-          const GuardedReport one =
-              guarded_advance(model, state_, tool_inputs(), step_s_, checkpoint_, step_guard);
-          merge_guarded(guarded, one);
-          if (one.gave_up) break;
-        }
-      } else {
-        guarded = guarded_advance(model, state_, inputs, due.steps * step_s_, checkpoint_, guard);
-      }
-      if (guarded.energy) {
-        energy_created_ = guarded.energy_created;
-        const double supplied = guarded.energy->supplied_j();
-        dissipated_fraction_ = supplied > 0.0 ? guarded.energy->dissipated_j() / supplied : 0.0;
-      }
-      if (guarded.problem != HealthProblem::none) last_problem_ = guarded.problem;
-      rollbacks_ += guarded.rollbacks;
-      if (guarded.inputs_rejected) ++rejected_inputs_;
-      if (guarded.gave_up) halted_ = true;
-      if (cutting_ && tool_acts && active_tool_->kind == ToolKind::scalpel && !guarded.gave_up)
-        cut_with_scalpel(*active_tool_);
+      log_input({SimulationInput::Kind::cycle, std::nullopt, {}, due.steps, check_energy});
+      const GuardedReport guarded = advance_cycle(due.steps, check_energy);
+      const bool tool_acts = tools_ && active_tool_;
       const StepReport& report = guarded.steps;
       window_integrating_s += Seconds(Clock::now() - cycle_start).count();
       accumulate(window_report, report);

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <thread>
 
@@ -342,6 +343,88 @@ TEST_F(RealtimeSteppingFixture, AScalpelDrawnThroughTheLiverCutsItWhileItRuns) {
   EXPECT_EQ(seen.position_m.size(), seen.model->node_count);
   EXPECT_FALSE(simulation.stats().halted);
   EXPECT_EQ(check_health(*seen.model, simulation.state()), HealthProblem::none);
+}
+
+// Determinism (issue 10): what the running loop took (tools set from another thread at whatever
+// moments, as many steps per cycle as the wall clock gave, the springs of a grab, the cuts the
+// scalpel made) replayed in order on the same model from the same state gives the same liver to
+// the last bit; a log missing one cycle does not.
+TEST_F(RealtimeSteppingFixture, ReplayingTheLoggedInputsReproducesTheRunToTheLastBit) {
+  const auto model = model_with({});
+  auto make = [&] {
+    auto simulation = std::make_unique<RealtimeSimulation>(model, make_rest_state(*model));
+    simulation->enable_tools(extract_surface(*mesh_));
+    CuttingSettings anything;
+    anything.cutting_stress_pa = 0.0;
+    simulation->enable_cutting(anything);
+    return simulation;
+  };
+  const auto live = make();
+  live->log_inputs(true);
+  live->start();
+  // A grab of the marked node pulled 5 mm out and let go, then a probe pressing the top, then
+  // the scalpel drawn 6 cm through the liver.
+  const NodeIndex node = anterior_marked_node(*mesh_);
+  const Eigen::Vector3d marked = model->rest_position_m.at(node);
+  const NodeSpring grab{node, marked + Eigen::Vector3d(0.0, 0.0, 0.005), 50.0};
+  live->set_springs(std::span(&grab, 1));
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  live->clear_springs();
+  const Eigen::AlignedBox3d box = rest_box(*model);
+  Tool probe;
+  probe.pose.origin_m = Eigen::Vector3d(box.center().x(), box.center().y(), box.max().z());
+  for (int k = 0; k < 10; ++k) {
+    probe.pose.origin_m.z() -= 0.0005;
+    live->set_tool(probe);
+    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+  }
+  Tool scalpel;
+  scalpel.kind = ToolKind::scalpel;
+  scalpel.geometry.blade_length_m = 0.06;
+  const Eigen::Vector3d start(box.center().x() - 0.04, box.center().y(), box.max().z() + 0.005);
+  for (int k = 0; k <= 60; ++k) {
+    scalpel.pose.origin_m = start + Eigen::Vector3d(0.001 * k, 0.0, 0.0);
+    live->set_tool(scalpel);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  live->set_tool(std::nullopt);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  live->stop();
+  const std::vector<SimulationInput> log = live->take_input_log();
+  int cycles = 0, tools = 0, springs = 0;
+  for (const SimulationInput& input : log) {
+    cycles += input.kind == SimulationInput::Kind::cycle;
+    tools += input.kind == SimulationInput::Kind::tool;
+    springs += input.kind == SimulationInput::Kind::springs;
+  }
+  EXPECT_GT(cycles, 50);
+  EXPECT_GT(tools, 10);
+  EXPECT_EQ(springs, 2);  // the grab and its release
+  ASSERT_GT(live->model().node_count, model->node_count) << "the scalpel cut nothing";
+  ASSERT_FALSE(live->stats().halted);
+
+  const auto replayed = make();
+  replayed->replay(log);
+  EXPECT_EQ(replayed->state().step_count, live->state().step_count);
+  EXPECT_EQ(replayed->state().time_s, live->state().time_s);
+  ASSERT_EQ(replayed->model().node_count, live->model().node_count);
+  EXPECT_TRUE(replayed->state().position_m.x == live->state().position_m.x &&
+              replayed->state().position_m.y == live->state().position_m.y &&
+              replayed->state().position_m.z == live->state().position_m.z)
+      << "the replay's positions differ from the run's";
+  EXPECT_TRUE(replayed->state().velocity_m_per_s.x == live->state().velocity_m_per_s.x);
+
+  // One cycle fewer (the one before the last tool change): not the same liver.
+  std::vector<SimulationInput> shorter = log;
+  for (std::size_t i = shorter.size(); i-- > 0;)
+    if (shorter[i].kind == SimulationInput::Kind::cycle && shorter[i].steps > 0) {
+      shorter.erase(shorter.begin() + static_cast<std::ptrdiff_t>(i));
+      break;
+    }
+  const auto other = make();
+  other->replay(shorter);
+  EXPECT_NE(other->state().step_count, live->state().step_count);
+  EXPECT_FALSE(other->state().position_m.x == live->state().position_m.x);
 }
 
 // Waits (at most a minute of wall time) until the running simulation has simulated `duration_s`

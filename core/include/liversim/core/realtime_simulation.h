@@ -52,6 +52,18 @@ struct SimulationSnapshot {
   double resected_volume_m3 = 0.0;  // taken out by cuts since the start
 };
 
+// One input the simulation took, in the order it took them: all that changes its state besides
+// its own stepping. Replayed in order on the same model from the same state, they give the same
+// states to the last bit (the engine's loops are deterministic whatever the thread count).
+struct SimulationInput {
+  enum class Kind : std::uint8_t { tool, springs, cycle };
+  Kind kind = Kind::cycle;
+  std::optional<Tool> tool;         // tool: the tool from then on (none: taken away)
+  std::vector<NodeSpring> springs;  // springs: the set springs from then on
+  int steps = 0;                    // cycle: whole steps taken
+  bool check_energy = false;        // cycle: the energy books were closed at its first step
+};
+
 // A session's outcome tracking (outcome_metrics.h) as it stands: the tracker, the model its
 // elements belong to (the newest it observed), and the model when tracking began.
 struct OutcomeTracking {
@@ -194,6 +206,14 @@ class RealtimeSimulation {
   // track_outcome begins it).
   std::optional<OutcomeTracking> outcome() const;
 
+  // From any thread: keep (or stop keeping) every input the simulation takes from its next loop
+  // on, and take those kept so far.
+  void log_inputs(bool on);
+  std::vector<SimulationInput> take_input_log();
+  // While stopped: takes `inputs` (an input log of a simulation built from the same model and
+  // state, with the same tools and cutting enabled) exactly as the loop took them.
+  void replay(std::span<const SimulationInput> inputs);
+
   // Consumer side (one thread, e.g. the UI): the newest snapshot, if one was published since.
   bool update_snapshot() { return snapshots_.update(); }
   const SimulationSnapshot& snapshot() const { return snapshots_.front(); }
@@ -247,6 +267,12 @@ class RealtimeSimulation {
   // Takes the inputs set from other threads (springs, tool, device tool) for the next cycle.
   void take_inputs();
   void change_tool(const std::optional<Tool>& tool);
+  // A cycle's steps, guarded, and the cut of a scalpel in the tissue after them.
+  GuardedReport advance_cycle(int steps, bool check_energy);
+  void log_input(SimulationInput input);    // when logging; simulation thread
+  std::mutex input_log_mutex_;              // UI ↔ simulation only
+  bool logging_inputs_ = false;             // under input_log_mutex_
+  std::vector<SimulationInput> input_log_;  // under input_log_mutex_
   double haptic_servo_period_s() const;
 
   // Outcome tracking: asked for from any thread, begun and updated by the simulation thread.
