@@ -267,6 +267,47 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   EXPECT_NE(window_->servo(), nullptr) << "the device runs without recording";
 }
 
+// The simulation's events reach the session: scripted forceps closing on the top of the liver
+// (the device's button), holding, and opening again record a grasp, then a release.
+TEST_F(DeviceTest, AGraspAndReleaseByTheDeviceAreSessionEvents) {
+  useSceneMillimetres();
+  openWindow();
+  const QString database = folder_.filePath("sessions.sqlite");
+  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
+  window_->toolPanel()->setTool(ToolKind::forceps);
+  // First where the view holds the forceps: the grasp point's offset from the device's point.
+  const Eigen::Vector3d above_mm = topOfTheMiddle_mm() + Eigen::Vector3d(0, 0, 40);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted,
+                                 writeTrajectory({{0.0, above_mm, 0}, {600.0, above_mm, 0}})));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().tool.has_value(); }, kTimeoutMs));
+  Tool closed = *snapshot().tool;
+  closed.jaw_opening = 0.0;
+  const Eigen::Vector3d grasp_offset_m = forceps_grasp_point_m(closed) - closed.pose.origin_m;
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  // Then the grasp point on the top, jaws closed from 0.3 s to 1.5 s.
+  const Eigen::Vector3d at_mm = topOfTheMiddle_mm() - grasp_offset_m * 1e3;
+  ASSERT_TRUE(window_->useDevice(
+      DeviceChoice::scripted,
+      writeTrajectory({{0.0, at_mm, 0}, {0.3, at_mm, 1}, {1.5, at_mm, 0}, {600.0, at_mm, 0}})));
+  ASSERT_TRUE(window_->recordingSession().has_value());
+  const std::int64_t session = *window_->recordingSession();
+  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().tool_grasping; }, kTimeoutMs))
+      << "the forceps took no hold";
+  ASSERT_TRUE(QTest::qWaitFor([&] { return !snapshot().tool_grasping; }, kTimeoutMs))
+      << "the forceps did not let go";
+  QTest::qWait(100);  // a display frame or two after the release
+  QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  ASSERT_TRUE(metricsStored.wait(kTimeoutMs));
+  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
+  std::vector<SessionEventKind> kinds;
+  for (const SessionEvent& e : store.events(session))
+    if (e.kind == SessionEventKind::grasp || e.kind == SessionEventKind::release)
+      kinds.push_back(e.kind);
+  const std::vector<SessionEventKind> expected{SessionEventKind::grasp, SessionEventKind::release};
+  EXPECT_EQ(kinds, expected);
+}
+
 // Palpation, the shipped scenario: the scripted probe held just off the liver's surface where it is
 // nearest the hidden lesion; the trainee marks it (Session menu, M); the session's end grades the
 // mark: the task succeeded, and the probe, never pressing, damaged nothing. Then the instructor
