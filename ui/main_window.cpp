@@ -828,8 +828,13 @@ void MainWindow::beginRecording() {
     const Millimetres3& mm = scenario_->scenario.task.grasp_point_mm;
     lift_point_m = Eigen::Vector3d(mm[0], mm[1], mm[2]) * 1e-3;
   }
-  simulation_->track_outcome(lift_point_m);
-  eventDetector_.emplace(TraceMetricSettings{}.safe_force_n);
+  // The scenario's grading thresholds (free practice: the defaults).
+  const TaskSpec task = scenario_ ? scenario_->scenario.task : TaskSpec{};
+  OutcomeSettings outcome;
+  outcome.damage_tension_strain = task.damage_tension_strain;
+  outcome.damage_compression_strain = task.damage_compression_strain;
+  simulation_->track_outcome(lift_point_m, outcome);
+  eventDetector_.emplace(task.safe_force_n);
   breachedLesions_.clear();
 }
 
@@ -984,9 +989,11 @@ void MainWindow::computeSessionMetrics(std::int64_t session,
       SqliteSessionStore store{std::filesystem::path(file)};
       const std::vector<SessionEvent> events = store.events(session);
       const std::vector<ServoFrame> frames = store.frames(session);
+      TraceMetricSettings trace;
+      trace.safe_force_n = scenario ? scenario->task.safe_force_n : TaskSpec{}.safe_force_n;
       if (!frames.empty())
-        values =
-            trace_metric_values(compute_trace_metrics(frames, tool_intervals(events), mapping, {}));
+        values = trace_metric_values(
+            compute_trace_metrics(frames, tool_intervals(events), mapping, trace));
       if (outcome) {
         const Scenario* run = scenario ? &*scenario : nullptr;
         const std::vector<MetricValue> simulated = outcome_metric_values(

@@ -462,11 +462,17 @@ TaskSpec read_task(const Json& value, std::vector<ScenarioError>& errors) {
   TaskSpec task;
   Fields f(value, "task", errors,
            {"kind", "instructions", "time_limit_s", "lesion", "margin_mm", "planned_plane",
-            "grasp_point_mm", "lift_mm"});
+            "grasp_point_mm", "lift_mm", "safe_force_n", "damage_tension_strain",
+            "damage_compression_strain"});
   if (!f.is_object()) return task;
   task.kind = f.choice("kind", kTaskNames, true).value_or(task.kind);
   task.instructions = f.text("instructions", false).value_or("");
   task.time_limit_s = f.number("time_limit_s", 10.0, 7200.0, "s", true).value_or(task.time_limit_s);
+  task.safe_force_n = f.number("safe_force_n", 0.1, 10.0, "N", false).value_or(task.safe_force_n);
+  task.damage_tension_strain =
+      f.number("damage_tension_strain", 0.05, 2.0, "", false).value_or(task.damage_tension_strain);
+  task.damage_compression_strain = f.number("damage_compression_strain", 0.05, 0.95, "", false)
+                                       .value_or(task.damage_compression_strain);
   const bool about_lesion = task.kind != TaskKind::retract_lobe;
   auto only_for = [&](std::string_view key, std::string_view kinds) {
     if (f.has(key)) f.fail(key, "is for task kind " + std::string(kinds) + " only");
@@ -862,6 +868,9 @@ std::string write_scenario(const Scenario& s) {
   task["kind"] = task_name(k.kind);
   if (!k.instructions.empty()) task["instructions"] = k.instructions;
   task["time_limit_s"] = k.time_limit_s;
+  task["safe_force_n"] = k.safe_force_n;
+  task["damage_tension_strain"] = k.damage_tension_strain;
+  task["damage_compression_strain"] = k.damage_compression_strain;
   if (k.kind == TaskKind::retract_lobe) {
     task["grasp_point_mm"] = triple(k.grasp_point_mm);
     task["lift_mm"] = k.lift_mm;

@@ -50,6 +50,9 @@ Scenario every_field_set() {
   s.task.lesion = "tumour";
   s.task.margin_mm = 12.0;
   s.task.planned_plane = PlaneSpec{{-45.0, 5.0, 5.0}, {0.0, 0.0, 1.0}};
+  s.task.safe_force_n = 2.0;
+  s.task.damage_tension_strain = 0.4;
+  s.task.damage_compression_strain = 0.6;
   s.rubric = {{"lesion_breached", 3.0, PassRule::at_most, 0.0},
               {"lesion_margin_mm", 2.0, PassRule::at_least, 10.0}};
   return s;
@@ -111,6 +114,10 @@ TEST(ScenarioFile, EveryFieldSurvivesASaveAndALoad) {
       {"tools", [](Scenario& s) { s.tools.push_back(ToolKind::probe); }},
       {"task.instructions", [](Scenario& s) { s.task.instructions.clear(); }},
       {"task.time_limit_s", [](Scenario& s) { s.task.time_limit_s = 60.0; }},
+      {"task.safe_force_n", [](Scenario& s) { s.task.safe_force_n = 0.8; }},
+      {"task.damage_tension_strain", [](Scenario& s) { s.task.damage_tension_strain = 0.25; }},
+      {"task.damage_compression_strain",
+       [](Scenario& s) { s.task.damage_compression_strain = 0.45; }},
       {"task.margin_mm", [](Scenario& s) { s.task.margin_mm = 0.0; }},
       {"task.planned_plane", [](Scenario& s) { s.task.planned_plane.reset(); }},
       {"rubric[1].threshold", [](Scenario& s) { s.rubric[1].threshold = 5.5; }},
@@ -258,11 +265,13 @@ TEST(ScenarioFile, SeveralFaultsAreAllReported) {
   };
   replace("\"poisson_ratio\": 0.48", "\"poisson_ratio\": 0.7");
   replace("\"time_limit_s\": 450.0", "\"time_limit_s\": -1");
+  replace("\"safe_force_n\": 2.0", "\"safe_force_n\": 0");
   const ScenarioReading reading = read_scenario(text);
   EXPECT_FALSE(reading.scenario.has_value());
   std::set<std::string> paths;
   for (const ScenarioError& e : reading.errors) paths.insert(e.path);
-  EXPECT_EQ(paths, (std::set<std::string>{"parenchyma.poisson_ratio", "task.time_limit_s"}));
+  EXPECT_EQ(paths, (std::set<std::string>{"parenchyma.poisson_ratio", "task.time_limit_s",
+                                          "task.safe_force_n"}));
 }
 
 // The shipped scenarios read cleanly and build a model with the effects and lesions they ask for.

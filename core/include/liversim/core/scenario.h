@@ -104,6 +104,12 @@ struct TaskSpec {
   std::optional<PlaneSpec> planned_plane;  // resect_lesion
   Millimetres3 grasp_point_mm{};           // retract_lobe: where the lobe is to be grasped
   double lift_mm = 30.0;                   // retract_lobe: how far it is to be lifted
+  // Grading thresholds (docs/session-metrics.md): a force on the tissue above safe_force_n is
+  // excessive; tissue stretched past 1 + tension strain or squeezed below 1 − compression strain
+  // is damaged.
+  double safe_force_n = 1.5;
+  double damage_tension_strain = 0.3;
+  double damage_compression_strain = 0.5;
   bool operator==(const TaskSpec&) const = default;
 };
 
