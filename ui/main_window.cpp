@@ -36,6 +36,7 @@
 #include <QSettings>
 #include <QStatusBar>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <numbers>
@@ -853,9 +854,10 @@ void MainWindow::recordSimulationEvents(const SimulationSnapshot& snapshot, bool
     const auto surface = cut_surface_at_rest_m(*snapshot.model);
     for (const LesionSpec& lesion : scenario_->scenario.lesions) {
       if (breachedLesions_.count(lesion.name)) continue;
-      const auto margin = lesion_margin(surface, lesion_ellipsoid(lesion),
-                                        OutcomeSettings{}.margin_sample_spacing_mm * 1e-3);
-      if (margin && margin->breached) {
+      const Ellipsoid ellipsoid = lesion_ellipsoid(lesion);
+      if (std::any_of(surface.begin(), surface.end(), [&](const auto& triangle) {
+            return triangle_meets_ellipsoid(triangle, ellipsoid);
+          })) {
         breachedLesions_.insert(lesion.name);
         events.push_back({now_s, SessionEventKind::lesion_breach, lesion.name});
       }

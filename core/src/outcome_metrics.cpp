@@ -20,11 +20,6 @@ double triangle_area(const Triangle& t) {
   return 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).norm();
 }
 
-// Rest volume of element e of the model.
-double rest_volume(const SimModel& model, std::size_t e) {
-  return model.rest_volume_m3[e];
-}
-
 std::optional<std::size_t> lesion_index(const Scenario& scenario, const std::string& name) {
   for (std::size_t i = 0; i < scenario.lesions.size(); ++i)
     if (scenario.lesions[i].name == name) return i;
@@ -254,7 +249,7 @@ void OutcomeTracker::carry_over(const CutResult& cut) {
 double OutcomeTracker::damaged_volume_m3(const SimModel& model) const {
   double volume = 0.0;
   for (std::size_t e = 0; e < model.tet_count && e < damaged_.size(); ++e)
-    if (damaged_[e]) volume += rest_volume(model, e);
+    if (damaged_[e]) volume += model.rest_volume_m3[e];
   return volume;
 }
 

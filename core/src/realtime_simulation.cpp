@@ -241,8 +241,13 @@ void RealtimeSimulation::set_device_tool(const std::optional<DeviceToolSettings>
   tool_changed_ = false;
 }
 
+void RealtimeSimulation::take_tool(const std::optional<Tool>& tool) {
+  if (logging_inputs_.load(std::memory_order_relaxed))
+    log_input({SimulationInput::Kind::tool, tool, {}, 0, false});
+  change_tool(tool);
+}
+
 void RealtimeSimulation::change_tool(const std::optional<Tool>& tool) {
-  if (running()) log_input({SimulationInput::Kind::tool, tool, {}, 0, false});
   const bool kind_changed = !tool || !active_tool_ || tool->kind != active_tool_->kind;
   active_tool_ = tool;
   if (!active_tool_ && tools_) tools_->release();
@@ -255,27 +260,28 @@ void RealtimeSimulation::take_inputs() {
     if (springs_changed_) {
       active_springs_.assign(pending_springs_.begin(), pending_springs_.end());  // no realloc
       springs_changed_ = false;
-      log_input({SimulationInput::Kind::springs, std::nullopt, active_springs_, 0, false});
+      if (logging_inputs_.load(std::memory_order_relaxed))  // a copy: only when logging
+        log_input({SimulationInput::Kind::springs, std::nullopt, active_springs_, 0, false});
     }
     if (device_tool_changed_) {
       // The tool held so far goes: the device's appears with its first frame, or without a
       // device, set_tool's next one.
       device_tool_changed_ = false;
       device_tool_ = pending_device_tool_;
-      change_tool(std::nullopt);
+      take_tool(std::nullopt);
     }
     if (tool_changed_) {
       tool_changed_ = false;
-      if (!device_tool_) change_tool(pending_tool_);
+      if (!device_tool_) take_tool(pending_tool_);
     }
   }
   ServoFrame frame;
   if (haptic_servo_ && haptic_servo_->newest_frame(frame)) {
     device_sample_ = frame.sample;
     if (device_tool_)
-      change_tool(device_tool(*device_tool_,
-                              haptic_servo_->mapping().scene_position_m(frame.sample.position_mm),
-                              frame.sample.buttons));
+      take_tool(device_tool(*device_tool_,
+                            haptic_servo_->mapping().scene_position_m(frame.sample.position_mm),
+                            frame.sample.buttons));
   }
 }
 
@@ -377,8 +383,7 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
 }
 
 void RealtimeSimulation::log_inputs(bool on) {
-  std::lock_guard lock(input_log_mutex_);
-  logging_inputs_ = on;
+  logging_inputs_.store(on);
 }
 
 std::vector<SimulationInput> RealtimeSimulation::take_input_log() {
@@ -388,7 +393,6 @@ std::vector<SimulationInput> RealtimeSimulation::take_input_log() {
 
 void RealtimeSimulation::log_input(SimulationInput input) {
   std::lock_guard lock(input_log_mutex_);
-  if (!logging_inputs_) return;
   // A device moves the tool at every loop, many times between cycles: a tool of the same kind
   // replacing one that no cycle used has the same effect as both (change_tool), so it replaces it.
   if (input.kind == SimulationInput::Kind::tool && input.tool && !input_log_.empty()) {
@@ -452,7 +456,8 @@ void RealtimeSimulation::run() {
     if (due.steps > 0 && !halted_.load(std::memory_order_relaxed)) {
       const bool check_energy = close_books;  // one pass over the elements, once per window
       close_books = false;
-      log_input({SimulationInput::Kind::cycle, std::nullopt, {}, due.steps, check_energy});
+      if (logging_inputs_.load(std::memory_order_relaxed))
+        log_input({SimulationInput::Kind::cycle, std::nullopt, {}, due.steps, check_energy});
       const GuardedReport guarded = advance_cycle(due.steps, check_energy);
       const bool tool_acts = tools_ && active_tool_;
       const StepReport& report = guarded.steps;

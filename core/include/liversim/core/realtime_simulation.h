@@ -267,11 +267,12 @@ class RealtimeSimulation {
   // Takes the inputs set from other threads (springs, tool, device tool) for the next cycle.
   void take_inputs();
   void change_tool(const std::optional<Tool>& tool);
+  void take_tool(const std::optional<Tool>& tool);  // the loop's: logged, then change_tool
   // A cycle's steps, guarded, and the cut of a scalpel in the tissue after them.
   GuardedReport advance_cycle(int steps, bool check_energy);
-  void log_input(SimulationInput input);    // when logging; simulation thread
+  void log_input(SimulationInput input);  // simulation thread, when logging_inputs_
+  std::atomic<bool> logging_inputs_{false};
   std::mutex input_log_mutex_;              // UI ↔ simulation only
-  bool logging_inputs_ = false;             // under input_log_mutex_
   std::vector<SimulationInput> input_log_;  // under input_log_mutex_
   double haptic_servo_period_s() const;
 
