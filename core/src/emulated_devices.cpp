@@ -11,7 +11,12 @@
 namespace liversim {
 
 void ManualDevice::set(const Eigen::Vector3d& position_mm, std::uint32_t buttons) {
-  input_.back() = Input{position_mm, buttons};
+  input_.back() = Input{position_mm, buttons, placements_};
+  input_.publish();
+}
+
+void ManualDevice::place(const Eigen::Vector3d& position_mm, std::uint32_t buttons) {
+  input_.back() = Input{position_mm, buttons, ++placements_};
   input_.publish();
 }
 
@@ -19,9 +24,11 @@ DeviceStatus ManualDevice::read(double time_s, DeviceSample& sample) {
   input_.update();
   const Input& input = input_.front();
   sample.position_mm = input.position_mm;
-  sample.buttons = input.buttons;
+  const bool placed = input.placement != read_placement_;
+  sample.buttons = input.buttons | (placed ? kRepositioned : 0u);
+  read_placement_ = input.placement;
   const double dt_s = time_s - previous_s_;
-  sample.velocity_mm_per_s = previous_s_ >= 0.0 && dt_s > 0.0
+  sample.velocity_mm_per_s = !placed && previous_s_ >= 0.0 && dt_s > 0.0
                                  ? Eigen::Vector3d((input.position_mm - previous_mm_) / dt_s)
                                  : Eigen::Vector3d::Zero();
   previous_mm_ = input.position_mm;

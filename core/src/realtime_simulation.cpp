@@ -232,9 +232,11 @@ void RealtimeSimulation::set_haptic_servo(ServoLoop* servo) {
   device_sample_.reset();
 }
 
-void RealtimeSimulation::set_device_tool(const std::optional<DeviceToolSettings>& settings) {
+void RealtimeSimulation::set_device_tool(const std::optional<DeviceToolSettings>& settings,
+                                         double from_servo_s) {
   std::lock_guard lock(springs_mutex_);
   pending_device_tool_ = settings;
+  pending_device_tool_from_s_ = from_servo_s;
   device_tool_changed_ = true;
   // The tool held so far goes with the change; a set_tool after this call counts.
   pending_tool_.reset();
@@ -268,6 +270,7 @@ void RealtimeSimulation::take_inputs() {
       // device, set_tool's next one.
       device_tool_changed_ = false;
       device_tool_ = pending_device_tool_;
+      device_tool_from_s_ = pending_device_tool_from_s_;
       take_tool(std::nullopt);
     }
     if (tool_changed_) {
@@ -278,7 +281,7 @@ void RealtimeSimulation::take_inputs() {
   ServoFrame frame;
   if (haptic_servo_ && haptic_servo_->newest_frame(frame)) {
     device_sample_ = frame.sample;
-    if (device_tool_)
+    if (device_tool_ && frame.time_s >= device_tool_from_s_)
       take_tool(device_tool(*device_tool_,
                             haptic_servo_->mapping().scene_position_m(frame.sample.position_mm),
                             frame.sample.buttons));

@@ -146,8 +146,12 @@ TraceMetrics compute_trace_metrics(std::span<const ServoFrame> frames,
       if (!first_contact_s) first_contact_s = end_s - contact.duration_s;
     }
 
+    // A jump (the mouse putting the tool down elsewhere) is no path.
     const double length_mm =
-        mapping.scale * (frames[i + 1].sample.position_mm - frames[i].sample.position_mm).norm();
+        (frames[i + 1].sample.buttons & kRepositioned)
+            ? 0.0
+            : mapping.scale *
+                  (frames[i + 1].sample.position_mm - frames[i].sample.position_mm).norm();
     metrics.path_length_mm += length_mm;
     advance_tool_to(start_s);
     const std::ptrdiff_t tool_at_start = tool_index;

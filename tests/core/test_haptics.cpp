@@ -427,6 +427,32 @@ TEST(TrajectoryDevice, ReplaysLoggedFramesAtTheirOriginalTimes) {
   EXPECT_TRUE(trajectory_of_frames({}).empty());
 }
 
+// The mouse: a drag moves the device (velocity from the change over the servo's ticks); a press
+// puts it where the mouse is, which is no motion at all.
+TEST(ManualDevice, AMoveHasTheVelocityOfTheChangeAndAPlacementNone) {
+  ManualDevice device;
+  DeviceSample sample;
+  device.set({0.0, 0.0, 0.0}, 0);
+  ASSERT_TRUE(device.read(1.000, sample).ok());
+  EXPECT_EQ(sample.velocity_mm_per_s.norm(), 0.0) << "the first read has nothing to differ from";
+  device.set({2.0, 0.0, -1.0}, 1);
+  device.read(1.002, sample);
+  EXPECT_TRUE(sample.position_mm.isApprox(Eigen::Vector3d(2.0, 0.0, -1.0)));
+  EXPECT_TRUE(sample.velocity_mm_per_s.isApprox(Eigen::Vector3d(1000.0, 0.0, -500.0)));
+  EXPECT_EQ(sample.buttons, 1u);
+  device.read(1.003, sample);  // no new input: still
+  EXPECT_EQ(sample.velocity_mm_per_s.norm(), 0.0);
+  device.place({120.0, 40.0, 7.0}, 1);  // 12 cm away within a millisecond: a jump
+  device.read(1.004, sample);
+  EXPECT_TRUE(sample.position_mm.isApprox(Eigen::Vector3d(120.0, 40.0, 7.0)));
+  EXPECT_EQ(sample.velocity_mm_per_s.norm(), 0.0);
+  EXPECT_EQ(sample.buttons, 1u | kRepositioned) << "the jump's sample is not marked";
+  device.set({121.0, 40.0, 7.0}, 1);  // and moves on from there
+  device.read(1.005, sample);
+  EXPECT_TRUE(sample.velocity_mm_per_s.isApprox(Eigen::Vector3d(1000.0, 0.0, 0.0)));
+  EXPECT_EQ(sample.buttons, 1u);
+}
+
 TEST(TrajectoryDevice, PlaysTheTrajectoryOnTheServoClock) {
   TrajectoryDevice device("scripted",
                           {{0.0, {0, 0, 0}, 0}, {1.0, {10, 0, 0}, 1}, {2.0, {10, 20, 0}, 0}});

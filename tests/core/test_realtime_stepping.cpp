@@ -627,6 +627,35 @@ TEST_F(RealtimeSteppingFixture, AScriptedDeviceHoldsTheForcepsPullsTheLiverAndFe
   EXPECT_FALSE(after.tool_grasping) << "the forceps let go when the device put them down";
 }
 
+// The mouse puts the device's tool down where it presses: a frame stamped before the press, with
+// the device still where the last press left it, never shows the tool there.
+TEST_F(RealtimeSteppingFixture, FramesFromBeforeTheDeviceToolWasSetAreNotTaken) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(*mesh_));
+  ManualDevice device;
+  ServoLoop::Options options;  // device mm = scene mm
+  options.mapping.scale = 1.0;
+  ServoLoop servo(device, options);  // not started: the test ticks it
+  const Eigen::Vector3d old_mm(0.0, 0.0, 500.0), new_mm(0.0, 0.0, 400.0);
+  device.place(old_mm, 0);
+  servo.tick(1.0);
+  simulation.set_haptic_servo(&servo);
+  simulation.set_device_tool(DeviceToolSettings{}, 2.0);
+  simulation.start();
+  const SimulationSnapshot before = run_until(
+      simulation, 0.05, [](const SimulationSnapshot& seen) { return seen.tool.has_value(); });
+  EXPECT_FALSE(before.tool) << "the frame of t = 1 s, before the press at 2 s, was taken";
+  ASSERT_TRUE(before.device_sample) << "the frame itself was read";
+  device.place(new_mm, 0);
+  servo.tick(2.0);
+  const SimulationSnapshot after = run_until(
+      simulation, 1.0, [](const SimulationSnapshot& seen) { return seen.tool.has_value(); });
+  simulation.stop();
+  ASSERT_TRUE(after.tool) << "the frame stamped at the press was not taken";
+  EXPECT_LT((after.tool->pose.origin_m - new_mm * 1e-3).norm(), 1e-12);
+}
+
 // A disarmed blade (the cut button up) only pushes: pressed far past the point where an armed one
 // breaks in, it never does; armed, it breaks in.
 TEST_F(RealtimeSteppingFixture, ADisarmedScalpelPressesButNeverBreaksIn) {

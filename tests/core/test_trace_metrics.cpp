@@ -192,6 +192,36 @@ TEST(TraceMetrics, AToolChangeSplitsThePerToolFigures) {
 // Scale 2 (scene m per device m), turned 90° about z and moved: 4 mm of device travel at 4 mm/s
 // is 8 mm at 8 mm/s in the scene (moving, where 4 mm/s would not be), and a device force of 2.4 N
 // is 1.2 N on the tissue (below the 1.5 N safe force, where 2.4 N would not be).
+// The mouse: pressed at x = 0, dragged 10 mm at 20 mm/s, released (the tool lifted 30 mm: a
+// jump), pressed again 50 mm away (a jump) and dragged 4 mm. The path is the two drags, 14 mm, and
+// the jumps are neither path nor movement: two movements, one per drag.
+TEST(TraceMetrics, JumpsOfARepositionedDeviceAreNoPath) {
+  std::vector<ServoFrame> frames;
+  double t_s = 0.0;
+  Eigen::Vector3d at_mm = Eigen::Vector3d::Zero();
+  auto add = [&](const Eigen::Vector3d& position_mm, bool jump) {
+    frames.push_back(frame_at(t_s, position_mm));
+    if (jump) frames.back().sample.buttons = kRepositioned;
+    t_s += kFrameS;
+    at_mm = position_mm;
+  };
+  add(at_mm, false);
+  for (int i = 1; i <= 500; ++i) add(Eigen::Vector3d(0.02 * i, 0.0, 0.0), false);  // 10 mm
+  add(at_mm + Eigen::Vector3d(0.0, 0.0, 30.0), true);                              // lifted
+  for (int i = 0; i < 300; ++i) add(at_mm, false);                                 // 0.3 s away
+  add(Eigen::Vector3d(60.0, 0.0, 0.0), true);                                      // put down
+  for (int i = 1; i <= 200; ++i) add(Eigen::Vector3d(60.0 + 0.02 * i, 0.0, 0.0), false);  // 4 mm
+
+  const TraceMetrics metrics =
+      compute_trace_metrics(frames, kProbeThroughout, WorkspaceMapping{}, {});
+
+  // Each step of 0.02 mm at positions up to 64 mm is good to about 2ε·64 mm.
+  const double tolerance_mm = 700 * 2.0 * kEps * 64.0 + relative_tolerance(700) * 14.0;
+  EXPECT_NEAR(metrics.path_length_mm, 14.0, tolerance_mm);
+  EXPECT_NEAR(metrics.per_tool.at(ToolKind::probe).path_length_mm, 14.0, tolerance_mm);
+  EXPECT_EQ(metrics.movements, 2);
+}
+
 TEST(TraceMetrics, TheMappingScaleAppliesToDistanceAndForce) {
   WorkspaceMapping mapping;
   mapping.scale = 2.0;

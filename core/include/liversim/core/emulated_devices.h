@@ -24,20 +24,26 @@ class ManualDevice final : public HapticDevice {
   DeviceStatus read(double time_s, DeviceSample& sample) override;
   DeviceStatus write_force(const Eigen::Vector3d& force_n) override;
 
-  // UI thread.
+  // UI thread. `set` moves the device there (its velocity is the change over the servo's ticks);
+  // `place` puts it there at once (a press where the mouse is, not a motion: zero velocity, and
+  // the first sample there marked kRepositioned).
   void set(const Eigen::Vector3d& position_mm, std::uint32_t buttons);
+  void place(const Eigen::Vector3d& position_mm, std::uint32_t buttons);
   Eigen::Vector3d last_force_n();
 
  private:
   struct Input {
     Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
     std::uint32_t buttons = 0;
+    std::uint64_t placement = 0;  // counts place() calls
   };
   DeviceLimits limits_;  // the Omni's: the mouse pushes nothing back
   TripleBuffer<Input> input_{Input{}};
   TripleBuffer<Eigen::Vector3d> force_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d previous_mm_ = Eigen::Vector3d::Zero();
   double previous_s_ = -1.0;
+  std::uint64_t placements_ = 0;      // UI thread
+  std::uint64_t read_placement_ = 0;  // servo thread
 };
 
 // One point of a trajectory: where the device is at a time, and which buttons are down.

@@ -24,8 +24,13 @@ struct DeviceLimits {
 struct DeviceSample {
   Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity_mm_per_s = Eigen::Vector3d::Zero();
-  std::uint32_t buttons = 0;  // bit 0: first button (grasp / cut), bit 1: second
+  // Bit 0: first button (grasp / cut), bit 1: second; kRepositioned is no button.
+  std::uint32_t buttons = 0;
 };
+
+// Set in a sample's buttons when the device got to its position by a jump, not a motion (the
+// mouse puts the tool down where it presses): path metrics count no distance to it.
+inline constexpr std::uint32_t kRepositioned = 1u << 31;
 
 enum class DeviceFault {
   none,

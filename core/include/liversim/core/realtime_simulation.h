@@ -192,7 +192,10 @@ class RealtimeSimulation {
   // From any thread: the haptic device holds this tool (nothing: it holds none). While one is set
   // and a servo is attached, each cycle takes the device's newest frame, maps it into the scene
   // (the servo's WorkspaceMapping) and uses device_tool() as the tool; set_tool is then ignored.
-  void set_device_tool(const std::optional<DeviceToolSettings>& settings);
+  // Frames stamped before `from_servo_s` (servo clock) are not taken: the mouse puts the tool
+  // down where it presses, and a frame from before the press must not show it where it was.
+  void set_device_tool(const std::optional<DeviceToolSettings>& settings,
+                       double from_servo_s = -std::numeric_limits<double>::infinity());
 
   // From any thread: from the next cycle on, each published cycle is observed by an outcome
   // tracker, and cuts carry it over (a session's tissue damage, lift, resected volume). Off until
@@ -248,8 +251,10 @@ class RealtimeSimulation {
   std::optional<Tool> active_tool_;                        // simulation thread's copy
   std::optional<DeviceToolSettings> pending_device_tool_;  // under springs_mutex_
   bool device_tool_changed_ = false;
+  double pending_device_tool_from_s_ = 0.0;        // under springs_mutex_
   std::optional<DeviceToolSettings> device_tool_;  // simulation thread's copy
-  std::optional<DeviceSample> device_sample_;      // the servo's newest frame
+  double device_tool_from_s_ = 0.0;
+  std::optional<DeviceSample> device_sample_;  // the servo's newest frame
   ServoLoop* haptic_servo_ = nullptr;
   std::optional<ToolInteraction> tools_;  // simulation thread only once started
   std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tool's
