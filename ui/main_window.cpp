@@ -95,6 +95,10 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   toolPanel_->setObjectName("toolPanel");
   addPanelDock(tr("Tool"), "toolDock", toolPanel_);
   connect(toolPanel_, &ToolPanel::toolChanged, this, [this] {
+    if (mouse_) {
+      if (tool_) endTool();  // the mouse puts the new one down with its next press
+      return;
+    }
     if (servo_) simulation_->set_device_tool(deviceToolSettings());
     recordToolChoice();
   });
@@ -140,12 +144,16 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   frameWindow_.start();
   simulation_->start();
   // The device of the last session: the Omni if it is there again (a script is played on
-  // request only).
+  // request only); otherwise the mouse.
   const DeviceChoice last = haptics_.device;
   haptics_.device = DeviceChoice::mouse;
-  devicePanel_->showDevice(DeviceChoice::mouse);
-  devicePanel_->showStatus(tr("The mouse moves the tool."));
-  if (last == DeviceChoice::openhaptics) useDevice(DeviceChoice::openhaptics);
+  useDevice(DeviceChoice::mouse);
+  if (last == DeviceChoice::openhaptics && !useDevice(DeviceChoice::openhaptics)) {
+    HapticPreferences remembered = haptics_;  // tried again at the next start
+    remembered.device = last;
+    QSettings settings;
+    save_haptic_preferences(settings, remembered);
+  }
 }
 
 void MainWindow::addPanelDock(const QString& title, const char* name, QWidget* panel) {
@@ -433,7 +441,6 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   if (grab_) simulation_->set_springs(springs_);
   simulation_->enable_tools(scene_->surface());
   simulation_->enable_cutting();
-  if (tool_) simulation_->set_tool(tool_);
   attachDevice();
   simulation_->start();
   setup_.model_options.integrator = settings;
@@ -446,7 +453,7 @@ bool MainWindow::beginGrab(QPoint pos, Qt::MouseButton button, Qt::KeyboardModif
   if (grab_ || tool_) return true;
   if (button != Qt::LeftButton || modifiers != Qt::NoModifier) return false;
   if (const auto kind = toolPanel_->tool()) {
-    if (servo_) return false;  // the device holds the tool: the mouse turns the view
+    if (!mouse_) return false;  // a device holds the tool: the mouse turns the view
     return beginTool(*kind, pos);
   }
   const auto hit = scene_->pick(pos.x(), pos.y());
@@ -484,9 +491,11 @@ Eigen::Quaterniond MainWindow::toolOrientationFromView() const {
   return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), shaft_direction);
 }
 
-// The tool is put on the liver where the mouse presses, its shaft toward the viewer and tilted up
-// by 35° (as a laparoscopic instrument comes in through a port, and so that it shows): the probe's
-// ball on the surface, the forceps' jaws closed on it, the blade's tip touching it.
+// The mouse is a device like the others (ManualDevice, through the servo, recorded): a press puts
+// the tool on the liver where the mouse is, its shaft toward the viewer and tilted up by 35° (as a
+// laparoscopic instrument comes in through a port, and so that it shows), with the action button
+// down: the probe's ball on the surface, the forceps' jaws closed on it, the blade's tip touching
+// it and armed. Device millimetres are scene millimetres (kMouseMapping).
 bool MainWindow::beginTool(ToolKind kind, QPoint pos) {
   const auto hit = scene_->pick(pos.x(), pos.y());
   if (!hit) return false;  // background: the camera takes the drag
@@ -510,8 +519,14 @@ bool MainWindow::beginTool(ToolKind kind, QPoint pos) {
   }
   tool_ = tool;
   toolPoint_m_ = hit->point_m;
-  simulation_->set_tool(tool_);
-  showTool(tool_);
+  mouse_->place(tool.pose.origin_m * 1e3, kMouseActionButton);
+  simulation_->set_device_tool(deviceToolSettings(), servo_->now_s());
+  // After the placement, so that the frames of the tool's interval are all where it is put. A
+  // session of the mouse begins when it first takes a tool to the liver.
+  if (!recorder_)
+    beginRecording();
+  else
+    recordToolChoice();
   return true;
 }
 
@@ -528,14 +543,19 @@ void MainWindow::moveTool(QPoint pos) {
   }
   tool_->pose.origin_m += move;
   toolPoint_m_ += move;
-  simulation_->set_tool(tool_);
-  showTool(tool_);
+  mouse_->set(tool_->pose.origin_m * 1e3, kMouseActionButton);
 }
 
+// The release lets go (the action button up) and takes the tool out of the scene; the device's
+// point is lifted along the shaft, so that a replay of the session's device input, which keeps
+// the tool in the scene, does not leave it resting on the liver.
 void MainWindow::endTool() {
+  const Eigen::Vector3d shaft = tool_->pose.orientation * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d lifted_m = tool_->pose.origin_m + kMouseLiftM * shaft;
   tool_.reset();
-  simulation_->set_tool(std::nullopt);  // the forceps let go as they leave
-  showTool(tool_);
+  recordToolChoice();  // before the lift, which is no motion of the tool in use
+  mouse_->place(lifted_m * 1e3, 0);
+  simulation_->set_device_tool(std::nullopt);  // the forceps let go as they leave
 }
 
 void MainWindow::showTool(const std::optional<Tool>& tool) {
@@ -568,7 +588,7 @@ void MainWindow::showNewestSnapshot() {
       shownTopology_ = snapshot.topology_version;
     }
     scene_->update_positions(snapshot.position_m);
-    if (servo_) showTool(snapshot.tool);  // the device moves it
+    showTool(snapshot.tool);  // where the simulation has it
     if (tool_ || (servo_ && snapshot.tool))
       toolPanel_->showForce(snapshot.time_s, snapshot.tool_force_n, snapshot.tool_grasping);
     else if (grab_)
@@ -695,9 +715,16 @@ Eigen::Vector3d MainWindow::deviceHome_m() const {
 }
 
 std::optional<DeviceToolSettings> MainWindow::deviceToolSettings() const {
+  DeviceToolSettings settings;
+  if (mouse_) {
+    if (!tool_) return std::nullopt;  // the mouse holds a tool only while pressed
+    settings.kind = tool_->kind;
+    settings.orientation = tool_->pose.orientation;
+    settings.action_buttons = kMouseActionButton;
+    return settings;
+  }
   const auto kind = toolPanel_->tool();
   if (!kind) return std::nullopt;  // the hand: the device holds nothing
-  DeviceToolSettings settings;
   settings.kind = *kind;
   settings.orientation = toolOrientationFromView();
   settings.action_buttons = haptics_.action_buttons;
@@ -718,7 +745,8 @@ void MainWindow::detachDevice() {
   if (servo_) servo_->stop();  // the last command is a zero force; its last frames are logged
   endRecording();
   servo_.reset();
-  scripted_.reset();
+  mouse_ = nullptr;
+  ownDevice_.reset();
 }
 
 bool MainWindow::setSessionsDatabase(const QString& file) {
@@ -754,6 +782,10 @@ bool MainWindow::replaySession(std::int64_t session) {
   std::vector<ServoFrame> frames;
   try {
     frames = sessions_->frames(session);
+    // Mapped as it was recorded (sessions before schema 2 kept no mapping: today's).
+    replayMapping_ = haptics_.mapping;
+    for (const SessionSummary& summary : sessions_->sessions())
+      if (summary.id == session && summary.mapping) replayMapping_ = *summary.mapping;
   } catch (const StorageError& e) {
     return refuse(tr("Cannot replay session %1: %2").arg(session).arg(QString::fromUtf8(e.what())));
   }
@@ -794,8 +826,10 @@ void MainWindow::chooseSessionToReplay() {
 }
 
 void MainWindow::beginRecording() {
-  // A replay is not a new session: its input is already recorded.
+  // A replay is not a new session: its input is already recorded. The mouse's session begins
+  // with its first press.
   if (!sessions_ || !servo_ || recorder_ || haptics_.device == DeviceChoice::replay) return;
+  if (mouse_ && !tool_) return;
   SessionStart start;
   start.trainee = traineeName().toStdString();
   if (scenario_) {
@@ -808,12 +842,16 @@ void MainWindow::beginRecording() {
     start.scenario_text = "free practice on the built-in liver, " +
                           std::to_string(setup_.mesh.tet_count()) + " tetrahedra";
   }
-  start.device = haptics_.device == DeviceChoice::openhaptics && omni_ ? omni_->name()
-                 : scripted_                                           ? scripted_->name()
-                                                                       : "haptic device";
+  start.device = ownDevice_ ? ownDevice_->name() : omni_ ? omni_->name() : "haptic device";
   start.started_unix_ms = QDateTime::currentMSecsSinceEpoch();
-  start.mapping = haptics_.mapping;
+  start.mapping = servo_->mapping();
   ServoLoop* servo = servo_.get();
+  // The servo has queued frames since it started (the mouse's, until its first press): the
+  // session's are those from now on.
+  ServoFrame earlier;
+  while (servo->next_logged_frame(earlier)) {
+  }
+  droppedBeforeRecording_ = servo->dropped_log_frames();
   try {
     recorder_ = std::make_unique<SessionRecorder>(
         *sessions_, start, [servo](ServoFrame& frame) { return servo->next_logged_frame(frame); });
@@ -924,8 +962,9 @@ QString MainWindow::sessionResultText(const RubricResult& rubric,
 bool MainWindow::markLesionUnderTool() {
   if (!recorder_ || !servo_) {
     statusBar()->showMessage(
-        tr("Marks are kept with a recorded session: drive the tool with a "
-           "haptic device to record one."));
+        sessions_ ? tr("Marks are kept with a recorded session: put a tool on the liver first.")
+                  : tr("Marks are kept with a recorded session, and there is no sessions "
+                       "database."));
     return false;
   }
   const SimulationSnapshot& snapshot = simulation_->snapshot();
@@ -945,7 +984,9 @@ bool MainWindow::markLesionUnderTool() {
 
 void MainWindow::recordToolChoice() {
   if (!recorder_ || !servo_) return;
-  const auto tool = toolPanel_->tool();
+  // The mouse holds a tool while pressed; a device, the Tool panel's.
+  const auto tool =
+      mouse_ ? (tool_ ? std::optional(tool_->kind) : std::nullopt) : toolPanel_->tool();
   // The hand holds no tool (tool_intervals reads any other name as none).
   recorder_->record_event({servo_->now_s(), SessionEventKind::tool_selected,
                            tool ? std::string(tool_name(*tool)) : "hand"});
@@ -954,7 +995,7 @@ void MainWindow::recordToolChoice() {
 void MainWindow::endRecording() {
   if (!recorder_) return;
   const ServoStats stats = servo_ ? servo_->stats() : ServoStats{};
-  const std::uint64_t dropped = servo_ ? servo_->dropped_log_frames() : 0;
+  const std::uint64_t dropped = servo_ ? servo_->dropped_log_frames() - droppedBeforeRecording_ : 0;
   const std::int64_t session = recorder_->session();
   eventDetector_.reset();
   std::optional<OutcomeTracking> outcome;
@@ -970,11 +1011,11 @@ void MainWindow::endRecording() {
     return;
   }
   recorder_.reset();
-  computeSessionMetrics(session, std::move(outcome));
+  computeSessionMetrics(session, std::move(outcome), servo_->mapping());
 }
 
-void MainWindow::computeSessionMetrics(std::int64_t session,
-                                       std::optional<OutcomeTracking> outcome) {
+void MainWindow::computeSessionMetrics(std::int64_t session, std::optional<OutcomeTracking> outcome,
+                                       const WorkspaceMapping& mapping) {
   // The metrics of its trace, from what was stored, and of its simulation
   // (docs/session-metrics.md): a long session is hundreds of megabytes of frames, so they are
   // read and computed on a worker with its own connection, off the UI thread.
@@ -984,7 +1025,7 @@ void MainWindow::computeSessionMetrics(std::int64_t session,
   if (scenario_) scenario = scenario_->scenario;
   metricsWorker_ = std::thread([this, file = sessionsFile_.toStdString(), session,
                                 outcome = std::move(outcome), scenario = std::move(scenario),
-                                mapping = haptics_.mapping] {
+                                mapping] {
     std::vector<MetricValue> values;
     QString problem;
     try {
@@ -1052,10 +1093,12 @@ bool MainWindow::useDevice(DeviceChoice choice, const QString& trajectoryFile) {
     return false;
   };
   HapticDevice* device = nullptr;
-  std::unique_ptr<HapticDevice> scripted;
+  std::unique_ptr<HapticDevice> owned;  // the devices the window makes: all but the Omni
   QString file = trajectoryFile.isEmpty() ? haptics_.trajectory_file : trajectoryFile;
   switch (choice) {
     case DeviceChoice::mouse:
+      owned = std::make_unique<ManualDevice>();
+      device = owned.get();
       break;
     case DeviceChoice::openhaptics:
       if (!omni_) openOmni();
@@ -1064,22 +1107,23 @@ bool MainWindow::useDevice(DeviceChoice choice, const QString& trajectoryFile) {
       break;
     case DeviceChoice::replay:
       if (replayPoints_.empty()) return refuse(tr("Choose a recorded session to replay."));
-      scripted = std::make_unique<TrajectoryDevice>(replayName_.toStdString(), replayPoints_);
-      device = scripted.get();
+      owned = std::make_unique<TrajectoryDevice>(replayName_.toStdString(), replayPoints_);
+      device = owned.get();
       break;
     case DeviceChoice::scripted:
       if (file.isEmpty()) return refuse(tr("Choose a trajectory file to play."));
       try {
-        scripted = std::make_unique<TrajectoryDevice>(
+        owned = std::make_unique<TrajectoryDevice>(
             tr("Scripted: %1").arg(QFileInfo(file).fileName()).toStdString(),
             load_trajectory(file.toStdString()));
       } catch (const std::exception& e) {
         return refuse(tr("Cannot play the trajectory: %1").arg(QString::fromUtf8(e.what())));
       }
-      device = scripted.get();
+      device = owned.get();
       break;
   }
-  if (device && !haptics_.mapping_set) {
+  const bool mouse = choice == DeviceChoice::mouse;
+  if (!mouse && !haptics_.mapping_set) {
     // First use: the device's axes the screen's, its origin just in front of the liver, and
     // its workspace (about 16 cm across for an Omni) over the liver's 25 cm.
     haptics_.mapping.rotation = deviceAxesFromView();
@@ -1088,9 +1132,12 @@ bool MainWindow::useDevice(DeviceChoice choice, const QString& trajectoryFile) {
     haptics_.mapping_set = true;
   }
   std::unique_ptr<ServoLoop> servo;
-  if (device) {
+  {
     ServoLoop::Options options;
-    options.mapping = haptics_.mapping;
+    // A replay maps as its session did; the mouse's millimetres are the scene's.
+    options.mapping = mouse                            ? kMouseMapping
+                      : choice == DeviceChoice::replay ? replayMapping_
+                                                       : haptics_.mapping;
     try {
       servo = std::make_unique<ServoLoop>(*device, options);
     } catch (const std::exception& e) {
@@ -1102,21 +1149,22 @@ bool MainWindow::useDevice(DeviceChoice choice, const QString& trajectoryFile) {
   simulation_->stop();
   detachDevice();
   servo_ = std::move(servo);
-  scripted_ = std::move(scripted);
+  ownDevice_ = std::move(owned);
+  mouse_ = mouse ? static_cast<ManualDevice*>(ownDevice_.get()) : nullptr;
   haptics_.device = choice;
   if (choice == DeviceChoice::scripted) haptics_.trajectory_file = file;
   attachDevice();
   simulation_->start();
-  if (servo_) servo_->start();
-  beginRecording();
-  if (!servo_) showTool(std::nullopt);
+  servo_->start();
+  if (!mouse) beginRecording();  // the mouse's begins with its first press
   saveHapticPreferences();
   devicePanel_->showDevice(choice);
-  devicePanel_->setCalibrationAvailable(servo_ != nullptr);
+  devicePanel_->setCalibrationAvailable(!mouse);
   devicePanel_->showServoStats(nullptr);
-  devicePanel_->showStatus(device ? tr("%1 moves the tool chosen in the Tool panel.")
-                                        .arg(QString::fromStdString(device->name()))
-                                  : tr("The mouse moves the tool."));
+  devicePanel_->showStatus(mouse ? tr("The mouse moves the tool: press on the liver to put the "
+                                      "tool chosen in the Tool panel there.")
+                                 : tr("%1 moves the tool chosen in the Tool panel.")
+                                       .arg(QString::fromStdString(device->name())));
   return true;
 }
 

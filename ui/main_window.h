@@ -90,8 +90,10 @@ class MainWindow : public QMainWindow {
   static QStringList recentScenarios();
   static constexpr int kRecentScenarioCount = 8;
 
-  // Haptic devices (Device panel). The mouse moves the tool directly; any other device drives it
-  // through the 1 kHz servo, holding the tool chosen in the Tool panel (the hand: none). The
+  // Haptic devices (Device panel). Each drives the tool through the 1 kHz servo: the mouse puts
+  // the Tool panel's tool on the liver where it presses and moves it while held (its session is
+  // recorded from its first press); the others hold the tool chosen in the Tool panel (the
+  // hand: none) all the time. The
   // Phantom Omni is looked for at start, in the OpenHaptics runtime libHD.so (or the library
   // named by LIVERSIM_OPENHAPTICS_LIBRARY). Returns false, saying why in the panel, when the
   // device cannot be used; the device in use then stays.
@@ -105,7 +107,8 @@ class MainWindow : public QMainWindow {
   CalibrationDialog* openCalibration();
 
   // Sessions (docs/session-storage.md): while a device drives the tool through the servo, its
-  // frames and events are recorded to the sessions database, one session per device and scene.
+  // frames and events are recorded to the sessions database, one session per device and scene
+  // (the mouse's from its first press on the liver).
   // Opens (or creates) the database; false, with the reason in sessionsProblem() and the status
   // bar, when it cannot: the workstation then runs without recording.
   bool setSessionsDatabase(const QString& file);
@@ -216,8 +219,15 @@ class MainWindow : public QMainWindow {
   HapticPreferences haptics_;
   std::unique_ptr<HapticDevice> omni_;  // opened at start when its runtime and device are there
   QString omniProblem_;                 // why not, otherwise
-  std::unique_ptr<HapticDevice> scripted_;
-  std::unique_ptr<ServoLoop> servo_;  // runs while a device other than the mouse is in use
+  std::unique_ptr<HapticDevice> ownDevice_;  // the mouse, a script or a replay (not the Omni)
+  ManualDevice* mouse_ = nullptr;            // ownDevice_, while the mouse is the device
+  std::unique_ptr<ServoLoop> servo_;         // runs for the device in use, the mouse too
+  // The mouse: its millimetres are the scene's; its action button is held while pressed; its
+  // release lifts the tool this far up its shaft.
+  static inline const WorkspaceMapping kMouseMapping{};
+  static constexpr std::uint32_t kMouseActionButton = 1;
+  static constexpr double kMouseLiftM = 0.03;
+  std::uint64_t droppedBeforeRecording_ = 0;  // servo log frames dropped before the session
 
   std::optional<OpenedScenario> scenario_;
 
@@ -227,7 +237,8 @@ class MainWindow : public QMainWindow {
   std::optional<SessionEventDetector> eventDetector_;
   std::thread metricsWorker_;
   int pendingMetrics_ = 0;
-  void computeSessionMetrics(std::int64_t session, std::optional<OutcomeTracking> outcome);
+  void computeSessionMetrics(std::int64_t session, std::optional<OutcomeTracking> outcome,
+                             const WorkspaceMapping& mapping);
   std::set<std::string> breachedLesions_;
   void recordSimulationEvents(const SimulationSnapshot& snapshot, bool cut);
   SessionReviewWindow* showSessionsWindow(QPointer<SessionReviewWindow>& window,
@@ -240,6 +251,7 @@ class MainWindow : public QMainWindow {
   QString sessionsProblem_;
   std::unique_ptr<SessionRecorder> recorder_;  // while servo_ runs and sessions_ is open
   std::vector<TrajectoryPoint> replayPoints_;  // of the session replaySession() loaded
+  WorkspaceMapping replayMapping_;             // and the mapping it was recorded with
   QString replayName_;
 
   // Builds the model of an integrator change (reading setup_.mesh, which changes only when no

@@ -144,7 +144,8 @@ TEST_F(DeviceTest, WithoutTheOpenHapticsRuntimeTheOmniIsNotFoundSaysWhyAndTheMou
   EXPECT_TRUE(panel->statusText().contains("not available")) << panel->statusText().toStdString();
   EXPECT_EQ(window_->device(), DeviceChoice::mouse);
   EXPECT_EQ(panel->shownDevice(), DeviceChoice::mouse);
-  EXPECT_EQ(window_->servo(), nullptr);
+  ASSERT_NE(window_->servo(), nullptr) << "the mouse drives the tool through the servo";
+  EXPECT_EQ(window_->servo()->mapping().scale, 1.0) << "the mouse's millimetres are the scene's";
 }
 
 TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
@@ -175,10 +176,10 @@ TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->devicePanel()->servoText().contains(" Hz"); },
                               kTimeoutMs))
       << window_->devicePanel()->servoText().toStdString();
-  // The mouse again: the servo stops, the probe goes.
+  // The mouse again: the script's servo stops, the probe goes until the mouse puts it down.
   ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
-  EXPECT_EQ(window_->servo(), nullptr);
-  EXPECT_TRUE(window_->devicePanel()->servoText().contains("not running"));
+  EXPECT_EQ(window_->device(), DeviceChoice::mouse);
+  EXPECT_TRUE(window_->devicePanel()->statusText().contains("mouse"));
   ASSERT_TRUE(QTest::qWaitFor([&] { return !snapshot().tool.has_value(); }, kTimeoutMs));
 }
 
@@ -190,7 +191,8 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   openWindow();
   const QString database = folder_.filePath("sessions.sqlite");
   ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
-  EXPECT_FALSE(window_->recordingSession().has_value()) << "the mouse is not recorded";
+  EXPECT_FALSE(window_->recordingSession().has_value())
+      << "the mouse's session begins with its first press on the liver";
   const Eigen::Vector3d start_mm(5.0, 6.0, 40.0), end_mm(15.0, 6.0, 40.0);
   const QString file = writeTrajectory({{0.0, start_mm, 0}, {0.4, end_mm, 1}, {600.0, end_mm, 1}});
   window_->toolPanel()->setTool(ToolKind::forceps);
@@ -512,7 +514,7 @@ TEST_F(DeviceTest, ABadTrajectoryFileIsNamedWithItsLineAndTheDeviceInUseStays) {
   EXPECT_TRUE(status.contains("broken.txt:2")) << status.toStdString();
   EXPECT_TRUE(status.contains("'x' is not a number")) << status.toStdString();
   EXPECT_EQ(window_->device(), DeviceChoice::mouse);
-  EXPECT_EQ(window_->servo(), nullptr);
+  EXPECT_EQ(window_->devicePanel()->shownDevice(), DeviceChoice::mouse);
   EXPECT_FALSE(window_->useDevice(DeviceChoice::scripted, folder_.filePath("missing.txt")));
   EXPECT_TRUE(window_->devicePanel()->statusText().contains("missing.txt"));
 }
@@ -522,7 +524,12 @@ TEST_F(DeviceTest, CalibrationPutsTheStylusJustInFrontOfTheLiverAndIsRemembered)
   const Eigen::Vector3d stylus_mm(10.0, 20.0, 30.0);
   const QString file = writeTrajectory({{0.0, stylus_mm, 0}, {600.0, stylus_mm, 0}});
   ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
-  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().device_sample.has_value(); }, kTimeoutMs));
+  // The script's frames, not the mouse's before it.
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        return snapshot().device_sample && snapshot().device_sample->position_mm == stylus_mm;
+      },
+      kTimeoutMs));
   CalibrationDialog* dialog = window_->openCalibration();
   ASSERT_NE(dialog, nullptr);
   dialog->alignWithView();
@@ -582,7 +589,7 @@ TEST_F(DeviceTest, TheOmniIsOfferedWhenItOpensAndAFatalFaultHandsTheToolBackToTh
   EXPECT_TRUE(panel->statusText().contains("stopped")) << panel->statusText().toStdString();
   EXPECT_TRUE(panel->statusText().contains("mouse")) << panel->statusText().toStdString();
   EXPECT_FALSE(panel->openHapticsOffered());
-  EXPECT_EQ(window_->servo(), nullptr);
+  EXPECT_EQ(panel->shownDevice(), DeviceChoice::mouse);
   double force_n[3];
   last_force(force_n);
   EXPECT_EQ(Eigen::Vector3d(force_n[0], force_n[1], force_n[2]), Eigen::Vector3d::Zero());

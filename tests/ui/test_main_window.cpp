@@ -19,6 +19,7 @@
 #include <QRadioButton>
 #include <QSettings>
 #include <QSignalSpy>
+#include <QTemporaryDir>
 #include <QTest>
 #include <algorithm>
 #include <array>
@@ -33,6 +34,7 @@
 #include "accuracy_panel.h"
 #include "liversim/core/default_scene.h"
 #include "liversim/core/integrator.h"
+#include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
 #include "render/liver_scene.h"
 #include "tool_panel.h"
@@ -356,6 +358,78 @@ TEST_F(MainWindowTest, ForcepsFromTheToolPanelHoldPullAndLetGo) {
                               kSimulatedTimeTimeoutMs));
   ASSERT_TRUE(waitSimulated(0.05));
   EXPECT_EQ(window_->simulation().snapshot().tool_force_n.norm(), 0.0);
+}
+
+// The mouse is a device like the others (issue 8): its tool goes through the 1 kHz servo at the
+// point the press put it, device millimetres being scene millimetres; its session is recorded from
+// its first press, with the probe held from the press to the release, and the stored path is the
+// drag's length in the scene.
+TEST_F(MainWindowTest, TheMouseDrivesTheToolThroughTheServoAndItsSessionIsRecorded) {
+  QTemporaryDir folder;
+  ASSERT_TRUE(folder.isValid());
+  const QString database = folder.filePath("sessions.sqlite");
+  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
+  ASSERT_NE(window_->servo(), nullptr);
+  EXPECT_FALSE(window_->recordingSession()) << "recorded before the mouse took a tool";
+  const std::optional<QPoint> start = pointOnTheLiver();
+  ASSERT_TRUE(start);
+  window_->toolPanel()->setTool(ToolKind::probe);
+
+  // Where the drag takes the probe: along the view plane through the picked point.
+  const auto picked = pickAt(*start);
+  ASSERT_TRUE(picked);
+  const QPoint endDisplay = toDisplay(*start + kDrag);
+  const Eigen::Vector3d dragged_m =
+      window_->scene().display_to_world(endDisplay.x(), endDisplay.y(), picked->point_m) -
+      picked->point_m;
+  bool toolThroughTheServo = true;
+  pressAndMove(*start, *start + kDrag, [&] {
+    const SimulationSnapshot& seen = window_->simulation().snapshot();
+    if (seen.tool && seen.device_sample)
+      toolThroughTheServo &=
+          (seen.tool->pose.origin_m - seen.device_sample->position_mm * 1e-3).norm() < 1e-12;
+  });
+  ASSERT_TRUE(window_->recordingSession()) << window_->sessionsProblem().toStdString();
+  const std::int64_t session = *window_->recordingSession();
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        const auto& tool = window_->simulation().snapshot().tool;
+        return tool && (tool->pose.origin_m - window_->heldTool()->pose.origin_m).norm() < 1e-12;
+      },
+      kSimulatedTimeTimeoutMs))
+      << "the probe never reached the point the drag put it";
+  EXPECT_TRUE(toolThroughTheServo) << "the tool was not at the device's point";
+  release(*start + kDrag);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return !window_->simulation().snapshot().tool; },
+                              kSimulatedTimeTimeoutMs))
+      << "the released probe stayed";
+  // A scene change would end it too; choosing the mouse again does.
+  QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  ASSERT_TRUE(metricsStored.wait(kSimulatedTimeTimeoutMs));
+  EXPECT_TRUE(metricsStored.first().at(1).toBool()) << window_->sessionsProblem().toStdString();
+
+  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
+  const std::vector<SessionSummary> sessions = store.sessions();
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_EQ(sessions[0].id, session);
+  EXPECT_EQ(sessions[0].device, "Mouse and keyboard");
+  EXPECT_EQ(sessions[0].status, SessionStatus::complete);
+  ASSERT_TRUE(sessions[0].mapping);
+  EXPECT_EQ(sessions[0].mapping->scale, 1.0);
+  EXPECT_GT(sessions[0].frame_count, 0);
+  std::vector<std::string> held;
+  for (const SessionEvent& event : store.events(session))
+    if (event.kind == SessionEventKind::tool_selected) held.push_back(event.detail);
+  EXPECT_EQ(held, (std::vector<std::string>{"probe", "hand"}));
+  // The drag moved the probe in straight steps: its path is the drag's length (to the
+  // millimetre's thousandth the frames' doubles carry, and the steps' rounding to pixels).
+  std::optional<double> path_mm;
+  for (const MetricValue& metric : store.metrics(session))
+    if (metric.name == "path_length_mm") path_mm = metric.value;
+  ASSERT_TRUE(path_mm);
+  EXPECT_NEAR(*path_mm, dragged_m.norm() * 1e3, 0.02 * dragged_m.norm() * 1e3)
+      << "the drag was " << dragged_m.norm() * 1e3 << " mm";
 }
 
 // The scalpel drawn across the liver cuts it (issue 7): the simulation's mesh gains node copies
