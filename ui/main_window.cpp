@@ -215,8 +215,28 @@ bool MainWindow::openScenario(const QString& file) {
     std::shared_ptr<const SimModel> model;
     QString error;
     try {
-      setup = std::make_shared<SceneSetup>(build_scene(
-          opened.scenario, std::filesystem::path(opened.file.toStdString()).parent_path()));
+      // A surface model is meshed first: each attempt at its element count is shown.
+      const auto progress = [this,
+                             name = QFileInfo(opened.file).fileName()](const MeshingProgress& p) {
+        const QString text =
+            p.tet_count == 0
+                ? tr("Building the scene of %1: meshing the organ, attempt %2 of at most %3 "
+                     "(elements of %4 mm)…")
+                      .arg(name)
+                      .arg(p.attempt)
+                      .arg(p.max_attempts)
+                      .arg(p.element_size_mm, 0, 'f', 1)
+                : tr("Building the scene of %1: attempt %2 made %3 elements…")
+                      .arg(name)
+                      .arg(p.attempt)
+                      .arg(p.tet_count);
+        QMetaObject::invokeMethod(
+            this, [this, text] { statusBar()->showMessage(text); }, Qt::QueuedConnection);
+        return true;
+      };
+      setup = std::make_shared<SceneSetup>(
+          build_scene(opened.scenario,
+                      std::filesystem::path(opened.file.toStdString()).parent_path(), progress));
       model = std::make_shared<const SimModel>(build_model(setup->mesh, setup->model_options));
     } catch (const std::exception& e) {
       error = QString::fromUtf8(e.what());

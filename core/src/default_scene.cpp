@@ -46,6 +46,27 @@ SceneSetup scene_from_file(const std::filesystem::path& file,
   return setup;
 }
 
+SceneSetup scene_from_surface(const std::filesystem::path& file, double metres_per_unit,
+                              int target_tet_count, const MeshingProgressCallback& progress) {
+  TriangleSurface surface = read_surface_file(file, metres_per_unit);
+  orient_outward(surface);
+  SurfaceMeshingOptions options;
+  options.target_tet_count = target_tet_count;
+  options.progress = progress;
+  SceneSetup setup;
+  try {
+    setup.mesh = tetrahedralise_surface(surface, options);
+  } catch (const SurfaceMeshingCancelled&) {
+    throw;
+  } catch (const SurfaceImportError& e) {
+    throw SurfaceImportError(file.string() + ": " + e.what());
+  }
+  setup.visual = visual_surface_on_nodes(setup.mesh);
+  setup.description =
+      file.filename().string() + ", " + std::to_string(setup.mesh.tet_count()) + " tetrahedra";
+  return setup;
+}
+
 NodeIndex anterior_marked_node(const TetMesh& mesh) {
   Eigen::AlignedBox3d box;
   for (std::size_t n = 0; n < mesh.node_count(); ++n) box.extend(mesh.rest_position_m.at(n));

@@ -5,6 +5,7 @@
 #include "liversim/core/mesh_io.h"
 #include "liversim/core/parameter_ranges.h"
 #include "liversim/core/surface.h"
+#include "liversim/core/surface_import.h"
 
 #include <nlohmann/json.hpp>
 
@@ -28,7 +29,11 @@ namespace p = parameter;
 constexpr std::pair<OrganGeometry, std::string_view> kGeometryNameList[] = {
     {OrganGeometry::built_in_liver, "built-in-liver"},
     {OrganGeometry::tet_mesh_file, "tet-mesh-file"},
+    {OrganGeometry::surface_file, "surface-file"},
 };
+// A surface model's length unit, as written, and its metres.
+constexpr std::pair<double, std::string_view> kLengthUnitList[] = {
+    {1e-3, "mm"}, {1e-2, "cm"}, {1.0, "m"}};
 constexpr std::pair<TaskKind, std::string_view> kTaskNameList[] = {
     {TaskKind::palpate_lesion, "palpate-lesion"},
     {TaskKind::retract_lobe, "retract-lobe"},
@@ -296,23 +301,40 @@ constexpr double kPositionLimitMm = 1000.0;
 
 OrganSpec read_organ(const Json& value, std::vector<ScenarioError>& errors) {
   OrganSpec organ;
-  Fields f(
-      value, "organ", errors,
-      {"geometry", "file", "target_tet_count", "fix_ligament", "fixed_node_set", "fixed_balls"});
+  Fields f(value, "organ", errors,
+           {"geometry", "file", "length_unit", "target_tet_count", "fix_ligament", "fixed_node_set",
+            "fixed_balls"});
   if (!f.is_object()) return organ;
   organ.geometry = f.choice("geometry", kGeometryNames, true).value_or(organ.geometry);
-  if (organ.geometry == OrganGeometry::tet_mesh_file) {
-    organ.file = f.text("file", true, true).value_or("");
-    organ.fixed_node_set = f.text("fixed_node_set", false).value_or("");
-    for (std::string_view key : {"target_tet_count", "fix_ligament"})
-      if (f.has(key)) f.fail(key, "is for geometry built-in-liver only");
-  } else {
+  const bool built_in = organ.geometry == OrganGeometry::built_in_liver;
+  const bool mesh_file = organ.geometry == OrganGeometry::tet_mesh_file;
+  const bool surface_file = organ.geometry == OrganGeometry::surface_file;
+  if (!built_in) organ.file = f.text("file", true, true).value_or("");
+  if (mesh_file) organ.fixed_node_set = f.text("fixed_node_set", false).value_or("");
+  if (!mesh_file)
     organ.target_tet_count =
         f.integer("target_tet_count", 1000, 50000, false).value_or(organ.target_tet_count);
-    organ.fix_ligament = f.boolean("fix_ligament", false).value_or(true);
-    for (std::string_view key : {"file", "fixed_node_set"})
-      if (f.has(key)) f.fail(key, "is for geometry tet-mesh-file only");
+  if (built_in) organ.fix_ligament = f.boolean("fix_ligament", false).value_or(true);
+  if (surface_file) {
+    const std::optional<std::string> unit = f.text("length_unit", true);
+    bool known = false;
+    for (const auto& [metres, name] : kLengthUnitList)
+      if (unit && *unit == name) {
+        organ.metres_per_unit = metres;
+        known = true;
+      }
+    if (unit && !known) f.fail("length_unit", "is \"" + *unit + "\"; expected mm, cm or m");
   }
+  // A field of another geometry is an error.
+  const std::pair<std::string_view, std::string_view> only_for[] = {
+      {"file", built_in ? "tet-mesh-file and surface-file" : ""},
+      {"fixed_node_set", mesh_file ? "" : "tet-mesh-file"},
+      {"target_tet_count", mesh_file ? "built-in-liver and surface-file" : ""},
+      {"fix_ligament", built_in ? "" : "built-in-liver"},
+      {"length_unit", surface_file ? "" : "surface-file"}};
+  for (const auto& [key, geometries] : only_for)
+    if (!geometries.empty() && f.has(key))
+      f.fail(key, "is for geometry " + std::string(geometries) + " only");
   if (const Json* balls = f.array("fixed_balls", false, "balls {centre_mm, radius_mm}")) {
     for (std::size_t i = 0; i < balls->size(); ++i) {
       Fields b((*balls)[i], f.at("fixed_balls") + "[" + std::to_string(i) + "]", errors,
@@ -649,6 +671,19 @@ std::vector<ScenarioError> validate(const Scenario& s) {
 
   const bool built_in = s.organ.geometry == OrganGeometry::built_in_liver;
   if (!built_in && s.organ.file.empty()) fail("organ.file", "missing: expected a mesh file");
+  if (s.organ.geometry == OrganGeometry::surface_file) {
+    if (!s.organ.file.empty() && !is_surface_file(s.organ.file)) {
+      std::string formats;
+      for (const std::string& extension : surface_file_extensions())
+        formats += (formats.empty() ? "" : ", ") + extension;
+      fail("organ.file",
+           "\"" + s.organ.file + "\" is invalid: expected a surface model (" + formats + ")");
+    }
+    if (std::none_of(std::begin(kLengthUnitList), std::end(kLengthUnitList),
+                     [&](const auto& unit) { return unit.first == s.organ.metres_per_unit; }))
+      fail("organ.length_unit",
+           format_number(s.organ.metres_per_unit) + " m is invalid: expected mm, cm or m");
+  }
   const LiverShape liver;
   std::set<std::string> names;
   for (std::size_t i = 0; i < s.lesions.size(); ++i) {
@@ -805,9 +840,14 @@ std::string write_scenario(const Scenario& s) {
   if (s.organ.geometry == OrganGeometry::built_in_liver) {
     organ["target_tet_count"] = s.organ.target_tet_count;
     organ["fix_ligament"] = s.organ.fix_ligament;
-  } else {
+  } else if (s.organ.geometry == OrganGeometry::tet_mesh_file) {
     organ["file"] = s.organ.file;
     if (!s.organ.fixed_node_set.empty()) organ["fixed_node_set"] = s.organ.fixed_node_set;
+  } else {
+    organ["file"] = s.organ.file;
+    for (const auto& [metres, name] : kLengthUnitList)
+      if (metres == s.organ.metres_per_unit) organ["length_unit"] = name;
+    organ["target_tet_count"] = s.organ.target_tet_count;
   }
   if (!s.organ.fixed_balls.empty()) {
     OrderedJson balls = OrderedJson::array();
@@ -926,7 +966,8 @@ void write_scenario_file(const Scenario& scenario, const std::filesystem::path& 
   }
 }
 
-SceneSetup build_scene(const Scenario& s, const std::filesystem::path& scenario_folder) {
+SceneSetup build_scene(const Scenario& s, const std::filesystem::path& scenario_folder,
+                       const MeshingProgressCallback& meshing_progress) {
   if (const auto errors = validate(s); !errors.empty())
     throw std::invalid_argument(errors.front().text());
   SceneSetup scene;
@@ -936,9 +977,13 @@ SceneSetup build_scene(const Scenario& s, const std::filesystem::path& scenario_
   } else {
     std::filesystem::path file = s.organ.file;
     if (file.is_relative()) file = scenario_folder / file;
-    scene = scene_from_file(file, s.organ.fixed_node_set.empty()
-                                      ? std::nullopt
-                                      : std::optional<std::string>(s.organ.fixed_node_set));
+    if (s.organ.geometry == OrganGeometry::surface_file)
+      scene = scene_from_surface(file, s.organ.metres_per_unit, s.organ.target_tet_count,
+                                 meshing_progress);
+    else
+      scene = scene_from_file(file, s.organ.fixed_node_set.empty()
+                                        ? std::nullopt
+                                        : std::optional<std::string>(s.organ.fixed_node_set));
   }
   TetMesh& mesh = scene.mesh;
   ModelOptions& options = scene.model_options;

@@ -211,6 +211,9 @@ TEST(ScenarioFile, EachMalformedFileGetsItsOwnErrorAndNothingIsHalfLoaded) {
       {"schema-modulus-as-text.json",
        {"parenchyma.youngs_modulus_pa", "\"3500\" is invalid: expected a number"}},
       {"schema-unknown-tool.json", {"tools[1]", "\"laser\" is invalid"}},
+      {"schema-surface-file-without-unit.json", {"organ.length_unit", "missing"}},
+      {"schema-surface-file-with-node-set.json",
+       {"organ.fixed_node_set", "is for geometry tet-mesh-file only"}},
       {"schema-rubric-both-rules.json", {"rubric[0]", "exactly one of at_most and at_least"}},
       {"schema-unknown-metric.json", {"rubric[0].metric", "\"speed\" is invalid"}},
       {"schema-unknown-integrator.json", {"integrator.kind", "\"euler\" is invalid"}},
@@ -235,6 +238,8 @@ TEST(ScenarioFile, EachMalformedFileGetsItsOwnErrorAndNothingIsHalfLoaded) {
         "2000 Pa is invalid: expected 1 to 100 times the parenchyma's 3500 Pa"}},
       {"semantic-duplicate-lesion-names.json", {"lesions[1].name", "another lesion has this name"}},
       {"semantic-zero-fibre-direction.json", {"parenchyma.fibres.direction", "not all 0"}},
+      {"semantic-surface-file-not-a-model.json",
+       {"organ.file", "expected a surface model (.obj, .stl, .ply, .gltf, .glb, .fbx, .3ds)"}},
       {"semantic-rubric-weights-zero.json", {"rubric", "the weights sum to 0"}},
   };
   std::set<std::string> seen;

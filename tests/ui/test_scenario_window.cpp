@@ -12,14 +12,19 @@
 #include <QPushButton>
 #include <QSettings>
 #include <QSignalSpy>
+#include <QStatusBar>
 #include <QTemporaryDir>
 #include <QTest>
 
+#include <filesystem>
+#include <fstream>
 #include <memory>
 
 #include "accuracy_panel.h"
 #include "liversim/core/default_scene.h"
+#include "liversim/core/mesh_io.h"
 #include "liversim/core/scenario.h"
+#include "liversim/core/surface.h"
 #include "main_window.h"
 #include "scenario_panel.h"
 #include "tool_panel.h"
@@ -121,6 +126,67 @@ TEST_F(ScenarioWindowTest, OpeningAScenarioRunsItsSceneInPlaceOfTheOldOne) {
   EXPECT_TRUE(finished.first().first().toBool());
   EXPECT_EQ(MainWindow::recentScenarios().size(), 1);  // not listed twice
   EXPECT_TRUE(waitSimulated(0.02));
+}
+
+// A scenario whose organ is a surface model (issue 9): the real liver's boundary written as an OBJ
+// in millimetres; the window meshes it at the scenario's count, saying so in the status bar, and
+// runs it. The same model with a hole is refused, naming the file and the hole.
+TEST_F(ScenarioWindowTest, AScenarioOfASurfaceModelIsMeshedShowingProgressAndRuns) {
+  const TetMesh liver = read_tet_mesh(std::filesystem::path(LIVERSIM_SHARED_DIR) /
+                                      "data/external/zhang-liver/Liver_Iso.inp");
+  const BoundarySurface boundary = extract_surface(liver);
+  QTemporaryDir folder;
+  ASSERT_TRUE(folder.isValid());
+  auto write_obj = [&](const QString& name, std::size_t triangles) {
+    std::ofstream obj(folder.filePath(name).toStdString());
+    obj.precision(17);
+    for (NodeIndex n : boundary.nodes) {
+      const Eigen::Vector3d p = liver.rest_position_m.at(n) * 1e3;
+      obj << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+    }
+    for (std::size_t t = 0; t < triangles; ++t)
+      obj << "f " << boundary.triangles[t][0] + 1 << ' ' << boundary.triangles[t][1] + 1 << ' '
+          << boundary.triangles[t][2] + 1 << '\n';
+  };
+  write_obj("liver.obj", boundary.triangles.size());
+  write_obj("holed.obj", boundary.triangles.size() - 1);
+  ScenarioReading reading = read_scenario_file(kSmallScenario.toStdString());
+  ASSERT_TRUE(reading.scenario);
+  Scenario scenario = *reading.scenario;
+  scenario.organ = OrganSpec{};
+  scenario.organ.geometry = OrganGeometry::surface_file;
+  scenario.organ.file = "liver.obj";
+  scenario.organ.metres_per_unit = 1e-3;
+  scenario.organ.target_tet_count = 2000;
+  scenario.lesions.clear();
+  scenario.task.kind = TaskKind::retract_lobe;  // needs no lesion
+  scenario.rubric.clear();
+  scenario.tools = {ToolKind::forceps};
+  const QString file = folder.filePath("imported.json");
+  write_scenario_file(scenario, file.toStdString());
+  ASSERT_TRUE(read_scenario_file(file.toStdString()).scenario)
+      << read_scenario_file(file.toStdString()).errors.front().text();
+
+  QStringList shown;
+  QObject::connect(window_->statusBar(), &QStatusBar::messageChanged,
+                   [&](const QString& message) { shown << message; });
+  ASSERT_EQ(open(file), true) << window_->scenarioPanel()->problemText().toStdString();
+  EXPECT_TRUE(shown.filter("meshing the organ, attempt 1").size() == 1)
+      << shown.join('\n').toStdString();
+  EXPECT_FALSE(shown.filter("elements…").isEmpty()) << shown.join('\n').toStdString();
+  ASSERT_TRUE(waitSimulated(0.05)) << "the imported organ does not simulate";
+  const std::size_t tets = window_->simulation().snapshot().model->tet_count;
+  EXPECT_NEAR(static_cast<double>(tets), 2000.0, 0.05 * 2000.0);
+
+  scenario.organ.file = "holed.obj";
+  const QString holed = folder.filePath("holed.json");
+  write_scenario_file(scenario, holed.toStdString());
+  EXPECT_EQ(open(holed), false);
+  EXPECT_TRUE(window_->scenarioPanel()->problemText().contains("holed.obj"))
+      << window_->scenarioPanel()->problemText().toStdString();
+  EXPECT_TRUE(window_->scenarioPanel()->problemText().contains("not closed"))
+      << window_->scenarioPanel()->problemText().toStdString();
+  EXPECT_EQ(window_->simulation().snapshot().model->tet_count, tets) << "the scene was replaced";
 }
 
 TEST_F(ScenarioWindowTest, ABadScenarioIsRefusedWithItsErrorsAndTheSceneGoesOn) {

@@ -6,8 +6,10 @@
 #include "liversim/core/liver_geometry.h"
 #include "liversim/core/model.h"
 #include "liversim/core/surface.h"
+#include "liversim/core/surface_import.h"
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -27,6 +29,15 @@ SceneSetup default_scene(int tet_count = kDefaultLiverTetCount);
 // file and std::invalid_argument when the set does not exist.
 SceneSetup scene_from_file(const std::filesystem::path& file,
                            const std::optional<std::string>& fixed_node_set);
+
+// Meshing's progress; returning false cancels (SurfaceMeshingCancelled).
+using MeshingProgressCallback = std::function<bool(const MeshingProgress&)>;
+
+// A surface model (surface_import.h) in `metres_per_unit`, checked and tetrahedralised at about
+// `target_tet_count` elements; nothing is fixed. The rendered surface is the mesh's boundary,
+// which is the model's own triangles. Throws SurfaceImportError naming the file and the problem.
+SceneSetup scene_from_surface(const std::filesystem::path& file, double metres_per_unit,
+                              int target_tet_count, const MeshingProgressCallback& progress = {});
 
 // The surface node nearest to the centre of the anterior (+z) face of the mesh's bounding box: a
 // reproducible "marked point" for loads when none is given.

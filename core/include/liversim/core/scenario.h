@@ -29,6 +29,7 @@ using Millimetres3 =
 enum class OrganGeometry {
   built_in_liver,  // the generated liver (liver_geometry.h) at target_tet_count
   tet_mesh_file,   // a tetrahedral mesh (.inp, .msh; mesh_io.h), in metres
+  surface_file,    // a surface model (surface_import.h), tetrahedralised at target_tet_count
 };
 
 // A ball of the organ's surface held fixed (e.g. painted in the editor): surface nodes within
@@ -41,8 +42,9 @@ struct FixedBall {
 
 struct OrganSpec {
   OrganGeometry geometry = OrganGeometry::built_in_liver;
-  std::string file;  // tet_mesh_file: relative to the scenario file's folder, or absolute
-  int target_tet_count = kDefaultLiverTetCount;  // built_in_liver
+  std::string file;  // the files': relative to the scenario file's folder, or absolute
+  int target_tet_count = kDefaultLiverTetCount;  // built_in_liver, surface_file
+  double metres_per_unit = 1e-3;                 // surface_file: its length unit (length_unit)
   bool fix_ligament = true;    // built_in_liver: the coronary ligament's bare area
   std::string fixed_node_set;  // tet_mesh_file: a node set of the file ("" none)
   std::vector<FixedBall> fixed_balls;
@@ -179,7 +181,8 @@ void write_scenario_file(const Scenario& scenario, const std::filesystem::path& 
 // integrator, the effects' laws, fixed nodes) and what is rendered. `scenario_folder` resolves a
 // relative mesh file. Throws std::invalid_argument naming the field at fault (e.g. a node set
 // missing from the mesh, a lesion outside the mesh) and MeshReadError for a bad mesh file.
-SceneSetup build_scene(const Scenario& scenario, const std::filesystem::path& scenario_folder);
+SceneSetup build_scene(const Scenario& scenario, const std::filesystem::path& scenario_folder,
+                       const MeshingProgressCallback& meshing_progress = {});
 
 std::string_view task_name(TaskKind kind);
 

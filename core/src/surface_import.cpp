@@ -1,0 +1,353 @@
+#include "liversim/core/surface_import.h"
+
+#include "liversim/core/surface.h"
+#include "liversim/core/surface_bvh.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <gmsh.h>
+#include <assimp/Importer.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <unordered_map>
+
+namespace liversim {
+namespace {
+
+std::string where_mm(const Eigen::Vector3d& point_m) {
+  std::ostringstream text;
+  text.setf(std::ios::fixed);
+  text.precision(1);
+  text << "(" << point_m.x() * 1e3 << ", " << point_m.y() * 1e3 << ", " << point_m.z() * 1e3
+       << ") mm";
+  return text.str();
+}
+
+// Whether segment [p, q] crosses triangle (a, b, c) at an interior point of both (Möller–Trumbore;
+// touching at an edge or a corner does not count).
+bool segment_crosses_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
+                              const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                              const Eigen::Vector3d& c) {
+  const Eigen::Vector3d d = q - p, e1 = b - a, e2 = c - a;
+  const Eigen::Vector3d h = d.cross(e2);
+  const double det = e1.dot(h);
+  const double scale = d.norm() * e1.norm() * e2.norm();
+  if (std::abs(det) <= 1e-12 * scale) return false;  // parallel or coplanar: not counted
+  const Eigen::Vector3d s = p - a;
+  const double u = s.dot(h) / det;
+  const Eigen::Vector3d k = s.cross(e1);
+  const double v = d.dot(k) / det;
+  const double t = e2.dot(k) / det;
+  constexpr double kInside = 1e-9;
+  return u > kInside && v > kInside && u + v < 1.0 - kInside && t > kInside && t < 1.0 - kInside;
+}
+
+bool triangles_cross(const std::array<Eigen::Vector3d, 3>& a,
+                     const std::array<Eigen::Vector3d, 3>& b) {
+  for (int i = 0; i < 3; ++i) {
+    if (segment_crosses_triangle(a[i], a[(i + 1) % 3], b[0], b[1], b[2])) return true;
+    if (segment_crosses_triangle(b[i], b[(i + 1) % 3], a[0], a[1], a[2])) return true;
+  }
+  return false;
+}
+
+// Gmsh has one global state: one user at a time, initialised and finalised around each use.
+std::mutex gmsh_mutex;
+
+struct GmshSession {
+  GmshSession() {
+    gmsh::initialize(0, nullptr, false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.NumThreads", 1);
+  }
+  ~GmshSession() {
+    try {
+      gmsh::finalize();
+    } catch (...) {  // Gmsh throws its last error again (a std::string) on any later call
+    }
+  }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+};
+
+int count_tets() {
+  std::vector<std::size_t> tags, nodes;
+  gmsh::model::mesh::getElementsByType(4, tags, nodes);
+  return static_cast<int>(tags.size());
+}
+
+TetMesh read_gmsh_model() {
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coord, parametric;
+  gmsh::model::mesh::getNodes(node_tags, coord, parametric, -1, -1, true, false);
+  std::vector<std::size_t> tet_tags, tet_nodes;
+  gmsh::model::mesh::getElementsByType(4, tet_tags, tet_nodes);
+  // Only the nodes of elements, numbered in the order the elements meet them.
+  std::unordered_map<std::size_t, std::size_t> position_of;
+  for (std::size_t i = 0; i < node_tags.size(); ++i) position_of[node_tags[i]] = i;
+  std::unordered_map<std::size_t, NodeIndex> index_of;
+  TetMesh mesh;
+  auto node = [&](std::size_t tag) {
+    const auto [it, added] = index_of.try_emplace(tag, static_cast<NodeIndex>(index_of.size()));
+    if (added) {
+      const std::size_t i = position_of.at(tag);
+      mesh.rest_position_m.push_back({coord[3 * i], coord[3 * i + 1], coord[3 * i + 2]});
+    }
+    return it->second;
+  };
+  for (std::size_t e = 0; e < tet_tags.size(); ++e) {
+    std::array<NodeIndex, 4> corners;
+    for (int c = 0; c < 4; ++c) corners[c] = node(tet_nodes[4 * e + c]);
+    const double volume =
+        signed_tet_volume(mesh.rest_position_m.at(corners[0]), mesh.rest_position_m.at(corners[1]),
+                          mesh.rest_position_m.at(corners[2]), mesh.rest_position_m.at(corners[3]));
+    if (volume < 0.0) std::swap(corners[2], corners[3]);
+    mesh.add_tet(corners);
+  }
+  return mesh;
+}
+
+}  // namespace
+
+double TriangleSurface::volume_m3() const {
+  double six_volume = 0.0;
+  for (const auto& t : triangles)
+    six_volume += vertices_m[t[0]].dot(vertices_m[t[1]].cross(vertices_m[t[2]]));
+  return six_volume / 6.0;
+}
+
+const std::vector<std::string>& surface_file_extensions() {
+  static const std::vector<std::string> extensions = {".obj", ".stl", ".ply", ".gltf",
+                                                      ".glb", ".fbx", ".3ds"};
+  return extensions;
+}
+
+bool is_surface_file(const std::filesystem::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const auto& known = surface_file_extensions();
+  return std::find(known.begin(), known.end(), extension) != known.end();
+}
+
+TriangleSurface read_surface_file(const std::filesystem::path& file, double metres_per_unit) {
+  const std::string name = file.string();
+  if (!(metres_per_unit > 0.0) || !std::isfinite(metres_per_unit))
+    throw SurfaceImportError(name + ": the length unit must be a positive number of metres");
+  if (!std::filesystem::exists(file)) throw SurfaceImportError(name + ": no such file");
+  Assimp::Importer importer;
+  // Points and lines are no surface: dropped.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* scene = importer.ReadFile(
+      name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                aiProcess_PreTransformVertices | aiProcess_SortByPType | aiProcess_FindDegenerates);
+  if (scene == nullptr)
+    throw SurfaceImportError(name +
+                             ": cannot read it as a surface model: " + importer.GetErrorString());
+  TriangleSurface surface;
+  // The same point in two meshes (or twice in one) is one vertex.
+  std::map<std::array<double, 3>, std::int32_t> vertex_at;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[m];
+    std::vector<std::int32_t> index(mesh->mNumVertices);
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D& p = mesh->mVertices[v];
+      const std::array<double, 3> key{p.x * metres_per_unit, p.y * metres_per_unit,
+                                      p.z * metres_per_unit};
+      const auto [it, added] =
+          vertex_at.try_emplace(key, static_cast<std::int32_t>(surface.vertices_m.size()));
+      if (added) surface.vertices_m.emplace_back(key[0], key[1], key[2]);
+      index[v] = it->second;
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      const std::array<std::int32_t, 3> t{index[face.mIndices[0]], index[face.mIndices[1]],
+                                          index[face.mIndices[2]]};
+      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;  // welded to nothing
+      surface.triangles.push_back(t);
+    }
+  }
+  if (surface.triangles.empty()) throw SurfaceImportError(name + ": the file holds no triangles");
+  for (const Eigen::Vector3d& v : surface.vertices_m)
+    if (!v.allFinite()) throw SurfaceImportError(name + ": a vertex is not a number");
+  return surface;
+}
+
+std::vector<std::string> surface_problems(const TriangleSurface& surface, int max_problems) {
+  std::vector<std::string> problems;
+  int more = 0;
+  auto report = [&](std::string text) {
+    if (static_cast<int>(problems.size()) < max_problems)
+      problems.push_back(std::move(text));
+    else
+      ++more;
+  };
+  const auto& v = surface.vertices_m;
+  auto centre = [&](std::size_t t) {
+    const auto& tri = surface.triangles[t];
+    return Eigen::Vector3d((v[tri[0]] + v[tri[1]] + v[tri[2]]) / 3.0);
+  };
+  // Edges: each must be used twice, once in each direction.
+  std::map<std::pair<std::int32_t, std::int32_t>, std::pair<int, int>> edge_uses;  // (fwd, back)
+  for (const auto& t : surface.triangles)
+    for (int i = 0; i < 3; ++i) {
+      const std::int32_t a = t[i], b = t[(i + 1) % 3];
+      auto& uses = edge_uses[{std::min(a, b), std::max(a, b)}];
+      (a < b ? uses.first : uses.second) += 1;
+    }
+  int open = 0, non_manifold = 0, flipped = 0;
+  for (const auto& [edge, uses] : edge_uses) {
+    const Eigen::Vector3d middle = (v[edge.first] + v[edge.second]) / 2.0;
+    const int total = uses.first + uses.second;
+    if (total == 1) {
+      if (open++ == 0) report("the surface is not closed: a hole's edge at " + where_mm(middle));
+    } else if (total > 2) {
+      if (non_manifold++ == 0)
+        report("an edge at " + where_mm(middle) + " belongs to " + std::to_string(total) +
+               " triangles (a surface can only meet itself along an edge once)");
+    } else if (uses.first != 1) {
+      if (flipped++ == 0)
+        report("triangles face against their neighbour at the edge at " + where_mm(middle) +
+               " (inconsistent orientation)");
+    }
+  }
+  if (open > 1) report(std::to_string(open) + " edges border holes in all");
+  if (non_manifold > 1) report(std::to_string(non_manifold) + " edges are shared by 3 or more");
+  if (flipped > 1) report(std::to_string(flipped) + " edges join triangles facing apart");
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    const auto& tri = surface.triangles[t];
+    const double area2 = (v[tri[1]] - v[tri[0]]).cross(v[tri[2]] - v[tri[0]]).norm();
+    const double longest = std::max({(v[tri[1]] - v[tri[0]]).norm(), (v[tri[2]] - v[tri[1]]).norm(),
+                                     (v[tri[0]] - v[tri[2]]).norm()});
+    if (area2 <= 1e-12 * longest * longest) {
+      report("a triangle at " + where_mm(centre(t)) + " has no area");
+      break;
+    }
+  }
+  // Crossings, between triangles that share no vertex.
+  BoundarySurface boundary;
+  boundary.nodes.resize(v.size());
+  NodeArray position;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    boundary.nodes[i] = static_cast<NodeIndex>(i);
+    position.push_back(v[i]);
+  }
+  boundary.triangles = surface.triangles;
+  const SurfaceBvh bvh(boundary, position);
+  int crossings = 0;
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    const auto& a = surface.triangles[t];
+    Aabb box;
+    for (int i = 0; i < 3; ++i) box.grow(v[a[i]]);
+    const std::array<Eigen::Vector3d, 3> ta{v[a[0]], v[a[1]], v[a[2]]};
+    bvh.for_each_triangle_overlapping(box, [&](std::int32_t u) {
+      if (static_cast<std::size_t>(u) <= t) return;  // each pair once
+      const auto& b = surface.triangles[u];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          if (a[i] == b[j]) return;
+      if (triangles_cross(ta, {v[b[0]], v[b[1]], v[b[2]]}))
+        if (crossings++ == 0)
+          report("the surface intersects itself: triangles at " + where_mm(centre(t)) + " and " +
+                 where_mm(centre(static_cast<std::size_t>(u))) + " cross");
+    });
+  }
+  if (crossings > 1) report(std::to_string(crossings) + " pairs of triangles cross in all");
+  if (more > 0) problems.push_back("and " + std::to_string(more) + " more problems");
+  return problems;
+}
+
+void orient_outward(TriangleSurface& surface) {
+  if (surface.volume_m3() >= 0.0) return;
+  for (auto& t : surface.triangles) std::swap(t[1], t[2]);
+}
+
+namespace {
+TetMesh mesh_with_gmsh(const TriangleSurface& surface, const SurfaceMeshingOptions& options);
+}  // namespace
+
+TetMesh tetrahedralise_surface(const TriangleSurface& surface,
+                               const SurfaceMeshingOptions& options) {
+  if (options.target_tet_count < 4 || options.max_attempts < 1 || !(options.count_tolerance > 0))
+    throw std::invalid_argument("tetrahedralise_surface: bad options");
+  if (const auto problems = surface_problems(surface); !problems.empty()) {
+    std::string text = "the surface bounds no solid:";
+    for (const std::string& problem : problems) text += "\n  " + problem;
+    throw SurfaceImportError(text);
+  }
+  std::lock_guard lock(gmsh_mutex);
+  GmshSession session;
+  try {
+    return mesh_with_gmsh(surface, options);
+  } catch (const std::string& error) {  // how Gmsh's API reports an error
+    throw SurfaceImportError("Gmsh could not mesh the solid: " + error);
+  }
+}
+
+namespace {
+
+TetMesh mesh_with_gmsh(const TriangleSurface& surface, const SurfaceMeshingOptions& options) {
+  const double volume_m3 = std::abs(surface.volume_m3());
+  gmsh::model::add("organ");
+  const int discrete = gmsh::model::addDiscreteEntity(2);
+  std::vector<std::size_t> node_tags(surface.vertices_m.size());
+  std::vector<double> coord;
+  coord.reserve(3 * surface.vertices_m.size());
+  for (std::size_t i = 0; i < surface.vertices_m.size(); ++i) {
+    node_tags[i] = i + 1;
+    for (int k = 0; k < 3; ++k) coord.push_back(surface.vertices_m[i][k]);
+  }
+  gmsh::model::mesh::addNodes(2, discrete, node_tags, coord);
+  std::vector<std::size_t> triangle_nodes;
+  triangle_nodes.reserve(3 * surface.triangles.size());
+  for (const auto& t : surface.triangles)
+    for (int k = 0; k < 3; ++k) triangle_nodes.push_back(static_cast<std::size_t>(t[k]) + 1);
+  gmsh::model::mesh::addElementsByType(discrete, 2, {}, triangle_nodes);
+  // The surface's own triangles bound the volume (Gmsh would remesh it only after splitting it
+  // into patches it can parametrise, which fails on coarse organ models); the interior is
+  // meshed at the element size.
+  const int loop = gmsh::model::geo::addSurfaceLoop({discrete});
+  const int volume = gmsh::model::geo::addVolume({loop});
+  gmsh::model::geo::synchronize();
+  gmsh::option::setNumber("Mesh.Optimize",
+                          1);  // Gmsh's own: fewer flat elements, a longer stable step
+
+  // First guess: V/h³ regular tetrahedra of edge h fill 6√2 ≈ 8.5 per h³; each next attempt
+  // scales h by the cube root of the miss.
+  double size_m = std::cbrt(8.5 * volume_m3 / options.target_tet_count);
+  int best_miss = -1;
+  double best_size_m = size_m;
+  for (int attempt = 1; attempt <= options.max_attempts; ++attempt) {
+    MeshingProgress progress{attempt, options.max_attempts, size_m * 1e3, 0};
+    if (options.progress && !options.progress(progress)) throw SurfaceMeshingCancelled();
+    gmsh::option::setNumber("Mesh.MeshSizeMin", size_m);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", size_m);
+    gmsh::model::mesh::clear({{3, volume}});  // the surface's triangles stay
+    gmsh::model::mesh::generate(3);
+    progress.tet_count = count_tets();
+    if (options.progress && !options.progress(progress)) throw SurfaceMeshingCancelled();
+    if (progress.tet_count == 0) throw SurfaceImportError("Gmsh made no elements of the solid");
+    const int miss = std::abs(progress.tet_count - options.target_tet_count);
+    if (best_miss < 0 || miss < best_miss) {
+      best_miss = miss;
+      best_size_m = size_m;
+    }
+    if (miss <= options.count_tolerance * options.target_tet_count) return read_gmsh_model();
+    size_m *= std::cbrt(static_cast<double>(progress.tet_count) / options.target_tet_count);
+  }
+  // None within the tolerance: the closest.
+  gmsh::option::setNumber("Mesh.MeshSizeMin", best_size_m);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", best_size_m);
+  gmsh::model::mesh::clear({{3, volume}});  // the surface's triangles stay
+  gmsh::model::mesh::generate(3);
+  return read_gmsh_model();
+}
+
+}  // namespace
+}  // namespace liversim
