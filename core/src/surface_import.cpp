@@ -111,6 +111,63 @@ TetMesh read_gmsh_model() {
   return mesh;
 }
 
+TetMesh mesh_with_gmsh(const TriangleSurface& surface, const SurfaceMeshingOptions& options) {
+  const double volume_m3 = std::abs(surface.volume_m3());
+  gmsh::model::add("organ");
+  const int discrete = gmsh::model::addDiscreteEntity(2);
+  std::vector<std::size_t> node_tags(surface.vertices_m.size());
+  std::vector<double> coord;
+  coord.reserve(3 * surface.vertices_m.size());
+  for (std::size_t i = 0; i < surface.vertices_m.size(); ++i) {
+    node_tags[i] = i + 1;
+    for (int k = 0; k < 3; ++k) coord.push_back(surface.vertices_m[i][k]);
+  }
+  gmsh::model::mesh::addNodes(2, discrete, node_tags, coord);
+  std::vector<std::size_t> triangle_nodes;
+  triangle_nodes.reserve(3 * surface.triangles.size());
+  for (const auto& t : surface.triangles)
+    for (int k = 0; k < 3; ++k) triangle_nodes.push_back(static_cast<std::size_t>(t[k]) + 1);
+  gmsh::model::mesh::addElementsByType(discrete, 2, {}, triangle_nodes);
+  // The surface's own triangles bound the volume (Gmsh would remesh it only after splitting it
+  // into patches it can parametrise, which fails on coarse organ models); the interior is
+  // meshed at the element size.
+  const int loop = gmsh::model::geo::addSurfaceLoop({discrete});
+  const int volume = gmsh::model::geo::addVolume({loop});
+  gmsh::model::geo::synchronize();
+  gmsh::option::setNumber("Mesh.Optimize",
+                          1);  // Gmsh's own: fewer flat elements, a longer stable step
+
+  // First guess: V/h³ regular tetrahedra of edge h fill 6√2 ≈ 8.5 per h³; each next attempt
+  // scales h by the cube root of the miss.
+  double size_m = std::cbrt(8.5 * volume_m3 / options.target_tet_count);
+  int best_miss = -1;
+  double best_size_m = size_m;
+  for (int attempt = 1; attempt <= options.max_attempts; ++attempt) {
+    MeshingProgress progress{attempt, options.max_attempts, size_m * 1e3, 0};
+    if (options.progress && !options.progress(progress)) throw SurfaceMeshingCancelled();
+    gmsh::option::setNumber("Mesh.MeshSizeMin", size_m);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", size_m);
+    gmsh::model::mesh::clear({{3, volume}});  // the surface's triangles stay
+    gmsh::model::mesh::generate(3);
+    progress.tet_count = count_tets();
+    if (options.progress && !options.progress(progress)) throw SurfaceMeshingCancelled();
+    if (progress.tet_count == 0) throw SurfaceImportError("Gmsh made no elements of the solid");
+    const int miss = std::abs(progress.tet_count - options.target_tet_count);
+    if (best_miss < 0 || miss < best_miss) {
+      best_miss = miss;
+      best_size_m = size_m;
+    }
+    if (miss <= options.count_tolerance * options.target_tet_count) return read_gmsh_model();
+    size_m *= std::cbrt(static_cast<double>(progress.tet_count) / options.target_tet_count);
+  }
+  // None within the tolerance: the closest.
+  gmsh::option::setNumber("Mesh.MeshSizeMin", best_size_m);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", best_size_m);
+  gmsh::model::mesh::clear({{3, volume}});  // the surface's triangles stay
+  gmsh::model::mesh::generate(3);
+  return read_gmsh_model();
+}
+
 }  // namespace
 
 double TriangleSurface::volume_m3() const {
@@ -268,10 +325,6 @@ void orient_outward(TriangleSurface& surface) {
   for (auto& t : surface.triangles) std::swap(t[1], t[2]);
 }
 
-namespace {
-TetMesh mesh_with_gmsh(const TriangleSurface& surface, const SurfaceMeshingOptions& options);
-}  // namespace
-
 TetMesh tetrahedralise_surface(const TriangleSurface& surface,
                                const SurfaceMeshingOptions& options) {
   if (options.target_tet_count < 4 || options.max_attempts < 1 || !(options.count_tolerance > 0))
@@ -290,64 +343,4 @@ TetMesh tetrahedralise_surface(const TriangleSurface& surface,
   }
 }
 
-namespace {
-
-TetMesh mesh_with_gmsh(const TriangleSurface& surface, const SurfaceMeshingOptions& options) {
-  const double volume_m3 = std::abs(surface.volume_m3());
-  gmsh::model::add("organ");
-  const int discrete = gmsh::model::addDiscreteEntity(2);
-  std::vector<std::size_t> node_tags(surface.vertices_m.size());
-  std::vector<double> coord;
-  coord.reserve(3 * surface.vertices_m.size());
-  for (std::size_t i = 0; i < surface.vertices_m.size(); ++i) {
-    node_tags[i] = i + 1;
-    for (int k = 0; k < 3; ++k) coord.push_back(surface.vertices_m[i][k]);
-  }
-  gmsh::model::mesh::addNodes(2, discrete, node_tags, coord);
-  std::vector<std::size_t> triangle_nodes;
-  triangle_nodes.reserve(3 * surface.triangles.size());
-  for (const auto& t : surface.triangles)
-    for (int k = 0; k < 3; ++k) triangle_nodes.push_back(static_cast<std::size_t>(t[k]) + 1);
-  gmsh::model::mesh::addElementsByType(discrete, 2, {}, triangle_nodes);
-  // The surface's own triangles bound the volume (Gmsh would remesh it only after splitting it
-  // into patches it can parametrise, which fails on coarse organ models); the interior is
-  // meshed at the element size.
-  const int loop = gmsh::model::geo::addSurfaceLoop({discrete});
-  const int volume = gmsh::model::geo::addVolume({loop});
-  gmsh::model::geo::synchronize();
-  gmsh::option::setNumber("Mesh.Optimize",
-                          1);  // Gmsh's own: fewer flat elements, a longer stable step
-
-  // First guess: V/h³ regular tetrahedra of edge h fill 6√2 ≈ 8.5 per h³; each next attempt
-  // scales h by the cube root of the miss.
-  double size_m = std::cbrt(8.5 * volume_m3 / options.target_tet_count);
-  int best_miss = -1;
-  double best_size_m = size_m;
-  for (int attempt = 1; attempt <= options.max_attempts; ++attempt) {
-    MeshingProgress progress{attempt, options.max_attempts, size_m * 1e3, 0};
-    if (options.progress && !options.progress(progress)) throw SurfaceMeshingCancelled();
-    gmsh::option::setNumber("Mesh.MeshSizeMin", size_m);
-    gmsh::option::setNumber("Mesh.MeshSizeMax", size_m);
-    gmsh::model::mesh::clear({{3, volume}});  // the surface's triangles stay
-    gmsh::model::mesh::generate(3);
-    progress.tet_count = count_tets();
-    if (options.progress && !options.progress(progress)) throw SurfaceMeshingCancelled();
-    if (progress.tet_count == 0) throw SurfaceImportError("Gmsh made no elements of the solid");
-    const int miss = std::abs(progress.tet_count - options.target_tet_count);
-    if (best_miss < 0 || miss < best_miss) {
-      best_miss = miss;
-      best_size_m = size_m;
-    }
-    if (miss <= options.count_tolerance * options.target_tet_count) return read_gmsh_model();
-    size_m *= std::cbrt(static_cast<double>(progress.tet_count) / options.target_tet_count);
-  }
-  // None within the tolerance: the closest.
-  gmsh::option::setNumber("Mesh.MeshSizeMin", best_size_m);
-  gmsh::option::setNumber("Mesh.MeshSizeMax", best_size_m);
-  gmsh::model::mesh::clear({{3, volume}});  // the surface's triangles stay
-  gmsh::model::mesh::generate(3);
-  return read_gmsh_model();
-}
-
-}  // namespace
 }  // namespace liversim
