@@ -1,6 +1,7 @@
 #include "liversim/core/performance.h"
 
 #include "liversim/core/integrator.h"
+#include "liversim/core/seed_experiments.h"
 
 #include <algorithm>
 #include <chrono>
@@ -171,6 +172,18 @@ SteppingTiming time_stepping(const SimModel& model, SimState& state, const StepI
     timing.wall_s = seconds_since(start);
   } while (timing.wall_s < min_wall_s);
   return timing;
+}
+
+SteppingTiming time_scene_under_pull(const SceneSetup& scene, double min_wall_s,
+                                     std::shared_ptr<WorkerPool> workers) {
+  const SimModel model = build_model(scene.mesh, scene.model_options);
+  SimState state = make_rest_state(model, std::move(workers));
+  std::vector<PointLoad> pull;
+  spread_load(make_load_patch(scene.mesh, model, anterior_marked_node(scene.mesh), 0.02),
+              kSeedPullDirection * 0.5, pull);
+  constexpr double kInterval_s = 1e-3;
+  advance(model, state, {pull, {}}, kInterval_s);  // warm-up: first factorisation, caches
+  return time_stepping(model, state, {pull, {}}, kInterval_s, min_wall_s);
 }
 
 }  // namespace liversim

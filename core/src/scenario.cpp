@@ -31,9 +31,6 @@ constexpr std::pair<OrganGeometry, std::string_view> kGeometryNameList[] = {
     {OrganGeometry::tet_mesh_file, "tet-mesh-file"},
     {OrganGeometry::surface_file, "surface-file"},
 };
-// A surface model's length unit, as written, and its metres.
-constexpr std::pair<double, std::string_view> kLengthUnitList[] = {
-    {1e-3, "mm"}, {1e-2, "cm"}, {1.0, "m"}};
 constexpr std::pair<TaskKind, std::string_view> kTaskNameList[] = {
     {TaskKind::palpate_lesion, "palpate-lesion"},
     {TaskKind::retract_lobe, "retract-lobe"},
@@ -318,7 +315,7 @@ OrganSpec read_organ(const Json& value, std::vector<ScenarioError>& errors) {
   if (surface_file) {
     const std::optional<std::string> unit = f.text("length_unit", true);
     bool known = false;
-    for (const auto& [metres, name] : kLengthUnitList)
+    for (const auto& [name, metres] : kLengthUnits)
       if (unit && *unit == name) {
         organ.metres_per_unit = metres;
         known = true;
@@ -679,8 +676,9 @@ std::vector<ScenarioError> validate(const Scenario& s) {
       fail("organ.file",
            "\"" + s.organ.file + "\" is invalid: expected a surface model (" + formats + ")");
     }
-    if (std::none_of(std::begin(kLengthUnitList), std::end(kLengthUnitList),
-                     [&](const auto& unit) { return unit.first == s.organ.metres_per_unit; }))
+    if (std::none_of(std::begin(kLengthUnits), std::end(kLengthUnits), [&](const LengthUnit& unit) {
+          return unit.metres == s.organ.metres_per_unit;
+        }))
       fail("organ.length_unit",
            format_number(s.organ.metres_per_unit) + " m is invalid: expected mm, cm or m");
   }
@@ -845,7 +843,7 @@ std::string write_scenario(const Scenario& s) {
     if (!s.organ.fixed_node_set.empty()) organ["fixed_node_set"] = s.organ.fixed_node_set;
   } else {
     organ["file"] = s.organ.file;
-    for (const auto& [metres, name] : kLengthUnitList)
+    for (const auto& [name, metres] : kLengthUnits)
       if (metres == s.organ.metres_per_unit) organ["length_unit"] = name;
     organ["target_tet_count"] = s.organ.target_tet_count;
   }

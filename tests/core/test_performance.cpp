@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace liversim {
 namespace {
 
@@ -44,6 +46,19 @@ TEST(Performance, TheTimersCountWhatTheyRan) {
   EXPECT_GE(steps.simulated_s, 1e-3);
   EXPECT_GE(steps.steps.substeps, 1);
   EXPECT_NEAR(state.time_s, steps.simulated_s, 1e-12);
+}
+
+TEST(Performance, AScenesCostIsMeasuredOnItsOwnModelInWholeMillisecondIntervals) {
+  SceneSetup scene = default_scene(1000);
+  const SteppingTiming timing = time_scene_under_pull(scene, 1e-3);
+  // Whole 1 ms intervals; the explicit step is below 1 ms, so each takes at least one substep.
+  EXPECT_GE(timing.simulated_s, 1e-3);
+  EXPECT_NEAR(timing.simulated_s / 1e-3, std::round(timing.simulated_s / 1e-3), 1e-9);
+  EXPECT_GE(timing.steps.substeps, std::lround(timing.simulated_s / 1e-3));
+  EXPECT_GT(timing.steps_per_s(), 0.0);
+  // A model that cannot be built is reported as build_model reports it.
+  scene.model_options.regions[0].tissue.poisson_ratio = 0.7;
+  EXPECT_THROW(time_scene_under_pull(scene, 1e-3), std::invalid_argument);
 }
 
 }  // namespace

@@ -3,11 +3,13 @@
 // the time of one internal-force evaluation, the rate of whole steps, and the memory a model and
 // its state hold. Timing is wall-clock on the calling thread; tests never assert it.
 
+#include "liversim/core/default_scene.h"
 #include "liversim/core/forces.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/state.h"
 
 #include <cstddef>
+#include <memory>
 
 namespace liversim {
 
@@ -63,5 +65,12 @@ struct SteppingTiming {
 // wall time has passed.
 SteppingTiming time_stepping(const SimModel& model, SimState& state, const StepInputs& inputs,
                              double interval_s, double min_wall_s);
+
+// What a scene costs to simulate (the editor's "effects and their cost"): its model built, then
+// stepped from rest in 1 ms intervals under the seed's 0.5 N pull (spread within 20 mm of the
+// anterior marked point, as the benchmark's stepping rows) for at least min_wall_s on `workers`
+// (none: this thread). Throws what build_model throws.
+SteppingTiming time_scene_under_pull(const SceneSetup& scene, double min_wall_s,
+                                     std::shared_ptr<WorkerPool> workers = nullptr);
 
 }  // namespace liversim

@@ -1,8 +1,10 @@
 #pragma once
 // An organ from a surface model (the seed built its liver in 3ds Max): a triangle surface read
 // through assimp (OBJ, STL, PLY, glTF/GLB, FBX, 3DS and more), checked to bound a solid, and
-// tetrahedralised at a requested element count by Gmsh (its Delaunay mesher with Netgen
-// optimisation; the surface is first remeshed at the element size, so the count is the volume's).
+// tetrahedralised at a requested element count by Gmsh (its Delaunay mesher and optimiser). The
+// model's own triangles are kept as the boundary (Gmsh's remeshing of them fails on real livers),
+// so a coarse model caps how small the elements near it can be: a surface too coarse for the count
+// asked gives fewer elements, which the meshing reports.
 
 #include "liversim/core/tet_mesh.h"
 
@@ -14,6 +16,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace liversim {
@@ -30,6 +33,15 @@ struct TriangleSurface {
   std::vector<std::array<std::int32_t, 3>> triangles;  // counter-clockwise from outside
   double volume_m3() const;  // signed: positive when the triangles face outward
 };
+
+// The units a surface model's lengths can be in (a scenario's organ.length_unit, the CLI's
+// --length-unit): a model file does not say its unit reliably, so it is always given, never
+// guessed.
+struct LengthUnit {
+  std::string_view name;
+  double metres;
+};
+inline constexpr LengthUnit kLengthUnits[] = {{"mm", 1e-3}, {"cm", 1e-2}, {"m", 1.0}};
 
 // The file formats the importer reads, by extension (lower case, with the dot).
 const std::vector<std::string>& surface_file_extensions();
