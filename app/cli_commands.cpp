@@ -17,12 +17,16 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace liversim::cli {
@@ -98,11 +102,66 @@ ExperimentScene build_scene(int tet_count, const IntegratorSettings& integrator,
 
 namespace {
 
+// A surface model's file does not say its unit reliably: it is never guessed.
+double metres_per_unit(const std::filesystem::path& surface,
+                       const std::optional<std::string>& unit) {
+  if (!unit)
+    throw std::invalid_argument("--surface " + surface.string() +
+                                " needs --length-unit mm, cm or m (the unit of its lengths)");
+  for (const auto& [name, metres] : kLengthUnits)
+    if (*unit == name) return metres;
+  throw std::invalid_argument(surface.string() + ": --length-unit '" + *unit +
+                              "' is unknown: expected mm, cm or m");
+}
+
+// Reads, checks and meshes a surface model, printing each finished meshing attempt and the
+// wall time of reading and checking the surface and of meshing it.
+SceneSetup mesh_surface(const std::filesystem::path& file, const std::optional<std::string>& unit,
+                        int target_tet_count) {
+  const double metres = metres_per_unit(file, unit);
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  std::optional<Clock::time_point> meshing_start;  // when Gmsh's first attempt begins
+  int attempts = 0;
+  auto progress = [&](const MeshingProgress& attempt) {
+    if (attempt.tet_count == 0) {  // about to mesh
+      if (!meshing_start) meshing_start = Clock::now();
+      return true;
+    }
+    ++attempts;
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(2) << "meshing attempt " << attempt.attempt << "/"
+         << attempt.max_attempts << ": element size " << attempt.element_size_mm << " mm, "
+         << attempt.tet_count << " tetrahedra\n";
+    std::cout << line.str() << std::flush;
+    return true;
+  };
+  SceneSetup scene = scene_from_surface(file, metres, target_tet_count, progress);
+  const Clock::time_point end = Clock::now();
+  const Clock::time_point meshed_from = meshing_start.value_or(end);
+  std::ostringstream summary;
+  summary << std::fixed << std::setprecision(3) << "surface read and checked in "
+          << std::chrono::duration<double>(meshed_from - start).count() << " s; meshed in "
+          << std::chrono::duration<double>(end - meshed_from).count() << " s wall time, "
+          << attempts << (attempts == 1 ? " attempt" : " attempts") << " (target "
+          << target_tet_count << " tetrahedra)\n";
+  const int tets = static_cast<int>(scene.mesh.tet_count());
+  if (std::abs(tets - target_tet_count) >
+      SurfaceMeshingOptions{}.count_tolerance * target_tet_count)
+    summary << "note: " << tets << " tetrahedra are off the target by more than the mesher's "
+            << number(SurfaceMeshingOptions{}.count_tolerance * 100.0)
+            << " %: the model's own triangles bound the mesh, so their size limits the count\n";
+  std::cout << summary.str();
+  return scene;
+}
+
 SceneSetup load_scene(const MeshSource& source) {
+  if (source.length_unit && !source.surface)
+    throw std::invalid_argument("--length-unit applies to --surface only");
   if (source.scenario) {
-    if (source.file || source.fixed_set)
+    if (source.file || source.fixed_set || source.surface)
       throw std::invalid_argument(
-          "--scenario names its own organ: leave out --mesh and --fixed-set");
+          "--scenario names its own organ: leave out --mesh, --surface and --fixed-set");
     const ScenarioReading reading = read_scenario_file(*source.scenario);
     if (!reading.scenario) {
       std::string message = source.scenario->string() + " is not a valid scenario:";
@@ -111,9 +170,30 @@ SceneSetup load_scene(const MeshSource& source) {
     }
     return build_scene(*reading.scenario, source.scenario->parent_path());
   }
+  if (source.file && source.surface)
+    throw std::invalid_argument("--mesh and --surface are two organs: give one of them");
   if (source.file) return scene_from_file(*source.file, source.fixed_set);
   if (source.fixed_set) throw std::invalid_argument("--fixed-set needs --mesh");
+  if (source.surface) return mesh_surface(*source.surface, source.length_unit, source.tet_count);
   return default_scene(source.tet_count);
+}
+
+// The mesh's boundary as a Wavefront OBJ in millimetres, triangles counter-clockwise from outside
+// (what --surface reads back with --length-unit mm).
+std::string boundary_obj(const SceneSetup& scene) {
+  const BoundarySurface boundary = extract_surface(scene.mesh);
+  std::ostringstream obj;
+  obj << "# Boundary of " << scene.description << ": " << boundary.nodes.size() << " vertices, "
+      << boundary.triangles.size()
+      << " triangles, counter-clockwise from outside; lengths in millimetres.\n"
+      << std::setprecision(10);
+  for (NodeIndex n : boundary.nodes) {
+    const Eigen::Vector3d p = scene.mesh.rest_position_m.at(n) * 1e3;
+    obj << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+  }
+  for (const auto& t : boundary.triangles)
+    obj << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+  return obj.str();
 }
 
 // What a material test records and the closed form it is compared with.
@@ -148,9 +228,9 @@ constexpr double kMaxMaterialSteps = 1e7;
 
 }  // namespace
 
-int mesh_report(const MeshSource& mesh) {
+int mesh_report(const MeshReportOptions& options) {
   return guarded([&] {
-    const SceneSetup scene = load_scene(mesh);
+    const SceneSetup scene = load_scene(options.mesh);
     std::cout << scene.description << "\n" << assess_quality(scene.mesh);
     std::cout << "fixed nodes " << scene.model_options.fixed_nodes.size() << "\n";
     std::vector<double> visual_xyz;
@@ -175,6 +255,7 @@ int mesh_report(const MeshSource& mesh) {
               << " x 2/omega, E = " << std::setprecision(0)
               << model.regions[0].tissue.youngs_modulus_pa << " Pa, nu = " << std::setprecision(3)
               << model.regions[0].tissue.poisson_ratio << ")\n";
+    if (options.surface_output) return write_report(*options.surface_output, boundary_obj(scene));
     return 0;
   });
 }

@@ -15,10 +15,17 @@
 namespace liversim::cli {
 
 struct MeshSource {
-  int tet_count = 5406;                           // built-in liver at this element count
+  int tet_count = 5406;  // built-in liver at this element count (the target count of `surface`)
   std::optional<std::filesystem::path> file;      // or a .inp / .msh file
   std::optional<std::string> fixed_set;           // node set of `file` held fixed
   std::optional<std::filesystem::path> scenario;  // or a scenario file (organ, tissue, lesions)
+  std::optional<std::filesystem::path> surface;   // or a surface model, meshed at `tet_count`
+  std::optional<std::string> length_unit;         // of `surface` (mm, cm or m): required with it
+};
+
+struct MeshReportOptions {
+  MeshSource mesh;
+  std::optional<std::filesystem::path> surface_output;  // the mesh's boundary as OBJ, in mm
 };
 
 struct SimulateOptions {
@@ -68,7 +75,8 @@ struct ScreenshotOptions {
   int height = 768;
 };
 
-int mesh_report(const MeshSource& mesh);
+// Prints the mesh's quality report (and, for a surface model, its meshing attempts and time).
+int mesh_report(const MeshReportOptions& options);
 int simulate(const SimulateOptions& options);
 // Reads and checks scenario files; prints each error as "FILE: field.path: message". Exit status 0
 // when every file is valid, 1 otherwise.

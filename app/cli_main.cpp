@@ -15,7 +15,9 @@
 namespace {
 
 void add_mesh_options(CLI::App& command, liversim::cli::MeshSource& mesh) {
-  command.add_option("--tets", mesh.tet_count, "Element count of the built-in liver")
+  command
+      .add_option("--tets", mesh.tet_count,
+                  "Element count of the built-in liver, or the one --surface is meshed at")
       ->check(CLI::Range(100, 2'000'000))
       ->capture_default_str();
   command.add_option("--mesh", mesh.file, "Tetrahedral mesh file (.inp or .msh) instead")
@@ -25,6 +27,13 @@ void add_mesh_options(CLI::App& command, liversim::cli::MeshSource& mesh) {
       .add_option("--scenario", mesh.scenario,
                   "Scenario file (scenarios/*.json): its organ, tissue, lesions and integrator")
       ->check(CLI::ExistingFile);
+  command
+      .add_option("--surface", mesh.surface,
+                  "Closed surface model (.obj, .stl, .ply, .gltf, .glb, .fbx, .3ds) instead, "
+                  "tetrahedralised by Gmsh at about --tets elements; nothing is held fixed")
+      ->check(CLI::ExistingFile);
+  command.add_option("--length-unit", mesh.length_unit,
+                     "Unit of the --surface file's lengths: mm, cm or m (required with --surface)");
 }
 
 }  // namespace
@@ -37,9 +46,12 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("liversim-cli ") + LIVERSIM_VERSION);
   app.require_subcommand(1);
 
-  MeshSource report_mesh;
+  MeshReportOptions report_options;
   auto* report = app.add_subcommand("mesh-report", "Print the quality report of a mesh");
-  add_mesh_options(*report, report_mesh);
+  add_mesh_options(*report, report_options.mesh);
+  report->add_option("--write-surface", report_options.surface_output,
+                     "Also write the mesh's boundary as a Wavefront OBJ in millimetres (what "
+                     "--surface reads with --length-unit mm)");
 
   std::vector<std::filesystem::path> scenario_files;
   auto* validate_cmd = app.add_subcommand(
@@ -165,7 +177,7 @@ int main(int argc, char** argv) {
   if (auto exit_code = run_cut_bench()) return *exit_code;
   if (auto exit_code = run_servo_bench()) return *exit_code;
   if (auto exit_code = run_sessions()) return *exit_code;
-  if (report->parsed()) return mesh_report(report_mesh);
+  if (report->parsed()) return mesh_report(report_options);
   if (simulate_cmd->parsed()) return simulate(sim);
   if (validate_cmd->parsed()) return validate_scenarios(scenario_files);
   if (screenshot_cmd->parsed()) return screenshot(shot);
