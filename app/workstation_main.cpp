@@ -16,7 +16,9 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <optional>
 #include <string>
 
@@ -27,6 +29,7 @@ struct Options {
   std::optional<double> quit_after_s;  // close this long after the window is shown (unattended)
   std::optional<liversim::Scenario> scenario;  // validated
   std::string scenario_file;
+  std::string scenario_text;  // its exact content
   QString sessions_database;  // empty: sessions.sqlite in the user's data directory
 };
 
@@ -103,6 +106,9 @@ Options parse_options(int argc, char** argv) {
       std::exit(2);
     }
     options.scenario = std::move(reading.scenario);
+    // The exact text, which recorded sessions store with the scenario.
+    std::ifstream in(options.scenario_file, std::ios::binary);
+    options.scenario_text.assign(std::istreambuf_iterator<char>(in), {});
   }
   if (parser.isSet(database)) options.sessions_database = parser.value(database);
   return options;
@@ -133,7 +139,8 @@ int main(int argc, char** argv) {
       const std::filesystem::path file = std::filesystem::absolute(options.scenario_file);
       setup = liversim::build_scene(*options.scenario, file.parent_path());
       opened = liversim::OpenedScenario{std::move(*options.scenario),
-                                        QString::fromStdString(file.string())};
+                                        QString::fromStdString(file.string()),
+                                        std::move(options.scenario_text)};
     } else {
       setup = liversim::default_scene(options.tet_count);
     }

@@ -3,7 +3,9 @@
 #include "accuracy_panel.h"
 #include "calibration_dialog.h"
 #include "device_panel.h"
+#include "recent_scenarios.h"
 #include "render/liver_scene.h"
+#include "scenario_editor.h"
 #include "scenario_panel.h"
 #include "tool_panel.h"
 #include "vtk_viewport.h"
@@ -124,7 +126,7 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   });
   connect(devicePanel_, &DevicePanel::calibrateRequested, this, [this] { openCalibration(); });
 
-  if (scenario_) rememberScenario(scenario_->file);
+  if (scenario_) rememberScenarioFile(scenario_->file);
   buildMenus();
   showScenarioDetails();
 
@@ -197,7 +199,16 @@ void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> 
 
 bool MainWindow::openScenario(const QString& file) {
   if (changingIntegrator_ || openingScenario_) return false;
-  const ScenarioReading reading = read_scenario_file(file.toStdString());
+  // The exact text is what a recorded session refers to, so it is read once, here.
+  QFile in(file);
+  ScenarioReading reading;
+  std::string text;
+  if (in.open(QIODevice::ReadOnly)) {
+    text = in.readAll().toStdString();
+    reading = read_scenario(text);
+  } else {
+    reading = read_scenario_file(file.toStdString());  // names why it cannot be read
+  }
   if (!reading.scenario) {
     QStringList errors;
     for (const ScenarioError& error : reading.errors)
@@ -205,19 +216,30 @@ bool MainWindow::openScenario(const QString& file) {
     refuseScenario(file, errors.join('\n'));
     return true;
   }
+  const QString absolute = QFileInfo(file).absoluteFilePath();
+  buildScenario({*reading.scenario, absolute, std::move(text)}, QFileInfo(absolute).absolutePath());
+  return true;
+}
+
+bool MainWindow::tryScenario(const Scenario& scenario, const QString& file) {
+  if (changingIntegrator_ || openingScenario_) return false;
+  const QString folder = file.isEmpty() ? QDir::currentPath() : QFileInfo(file).absolutePath();
+  buildScenario({scenario, file, write_scenario(scenario)}, folder);
+  return true;
+}
+
+void MainWindow::buildScenario(OpenedScenario opened, const QString& folder) {
   if (modelBuilder_.joinable()) modelBuilder_.join();  // the last one has reported back
   openingScenario_ = true;
   accuracyPanel_->setBusy(true);
-  statusBar()->showMessage(tr("Building the scene of %1…").arg(QFileInfo(file).fileName()));
-  OpenedScenario opened{*reading.scenario, QFileInfo(file).absoluteFilePath()};
-  modelBuilder_ = std::thread([this, opened = std::move(opened)] {
+  statusBar()->showMessage(tr("Building the scene of %1…").arg(scenarioName(opened)));
+  modelBuilder_ = std::thread([this, opened = std::move(opened), folder] {
     std::shared_ptr<SceneSetup> setup;
     std::shared_ptr<const SimModel> model;
     QString error;
     try {
       // A surface model is meshed first: each attempt at its element count is shown.
-      const auto progress = [this,
-                             name = QFileInfo(opened.file).fileName()](const MeshingProgress& p) {
+      const auto progress = [this, name = scenarioName(opened)](const MeshingProgress& p) {
         const QString text =
             p.tet_count == 0
                 ? tr("Building the scene of %1: meshing the organ, attempt %2 of at most %3 "
@@ -235,8 +257,7 @@ bool MainWindow::openScenario(const QString& file) {
         return true;
       };
       setup = std::make_shared<SceneSetup>(
-          build_scene(opened.scenario,
-                      std::filesystem::path(opened.file.toStdString()).parent_path(), progress));
+          build_scene(opened.scenario, std::filesystem::path(folder.toStdString()), progress));
       model = std::make_shared<const SimModel>(build_model(setup->mesh, setup->model_options));
     } catch (const std::exception& e) {
       error = QString::fromUtf8(e.what());
@@ -247,7 +268,6 @@ bool MainWindow::openScenario(const QString& file) {
         [this, opened, setup, model, error] { finishScenarioOpen(opened, setup, model, error); },
         Qt::QueuedConnection);
   });
-  return true;
 }
 
 void MainWindow::finishScenarioOpen(const OpenedScenario& opened, std::shared_ptr<SceneSetup> setup,
@@ -255,7 +275,7 @@ void MainWindow::finishScenarioOpen(const OpenedScenario& opened, std::shared_pt
   modelBuilder_.join();  // it ends right after posting this
   openingScenario_ = false;
   accuracyPanel_->setBusy(false);
-  if (!model) return refuseScenario(opened.file, error);
+  if (!model) return refuseScenario(scenarioName(opened), error);
   // The device stays; its session was of the old scene: it ends (with the old scene's outcome)
   // and another begins on the new one.
   const bool recording = recorder_ != nullptr;
@@ -265,7 +285,7 @@ void MainWindow::finishScenarioOpen(const OpenedScenario& opened, std::shared_pt
   } catch (const std::exception& e) {
     simulation_->start();  // nothing was replaced: the old scene goes on
     if (recording) beginRecording();
-    return refuseScenario(opened.file, QString::fromUtf8(e.what()));
+    return refuseScenario(scenarioName(opened), QString::fromUtf8(e.what()));
   }
   scenario_ = opened;
   attachDevice();
@@ -273,11 +293,19 @@ void MainWindow::finishScenarioOpen(const OpenedScenario& opened, std::shared_pt
   if (recording) beginRecording();
   accuracyPanel_->setSettings(setup_.model_options.integrator);
   showScenarioDetails();
-  rememberScenario(opened.file);
-  updateRecentMenu();
-  statusBar()->showMessage(tr("Opened %1.").arg(QFileInfo(opened.file).fileName()));
+  if (!opened.file.isEmpty()) {
+    rememberScenarioFile(opened.file);
+    updateRecentMenu();
+  }
+  statusBar()->showMessage(tr("Opened %1.").arg(scenarioName(opened)));
   viewport_->scheduleRender();
   emit scenarioOpenFinished(true);
+}
+
+QString MainWindow::scenarioName(const OpenedScenario& opened) {
+  return opened.file.isEmpty() ? tr("“%1” (from the editor, not saved)")
+                                     .arg(QString::fromStdString(opened.scenario.title))
+                               : QFileInfo(opened.file).fileName();
 }
 
 void MainWindow::refuseScenario(const QString& file, const QString& why) {
@@ -304,23 +332,11 @@ void MainWindow::showScenarioDetails() {
   toolPanel_->setAvailableTools(scenario_ ? scenario_->scenario.tools : Scenario{}.tools);
 }
 
-QStringList MainWindow::recentScenarios() {
-  return QSettings().value("scenarios/recent").toStringList();
-}
-
-void MainWindow::rememberScenario(const QString& file) {
-  QStringList recent = recentScenarios();
-  recent.removeAll(file);
-  recent.prepend(file);
-  while (recent.size() > kRecentScenarioCount) recent.removeLast();
-  QSettings().setValue("scenarios/recent", recent);
-}
-
 void MainWindow::buildMenus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
   file->setObjectName("fileMenu");
   QAction* open = file->addAction(tr("&Open Scenario…"), this, [this] {
-    const QStringList recent = recentScenarios();
+    const QStringList recent = recentScenarioFiles();
     const QString folder =
         recent.isEmpty() ? QDir::currentPath() : QFileInfo(recent.front()).absolutePath();
     const QString chosen = QFileDialog::getOpenFileName(
@@ -332,6 +348,11 @@ void MainWindow::buildMenus() {
   recentMenu_ = file->addMenu(tr("Open &Recent"));
   recentMenu_->setObjectName("recentScenariosMenu");
   updateRecentMenu();
+  QAction* editor =
+      file->addAction(tr("Scenario &Editor…"), this, [this] { openScenarioEditor(); });
+  editor->setObjectName("scenarioEditorAction");
+  editor->setToolTip(tr("Instructors: author the scenario shown, or a new one"));
+  editor->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_E));
   file->addSeparator();
   QAction* quit = file->addAction(tr("&Quit"), this, &QWidget::close);
   quit->setObjectName("quitAction");
@@ -354,6 +375,28 @@ void MainWindow::buildMenus() {
          "is (graded at the session's end)"));
 }
 
+ScenarioEditor* MainWindow::openScenarioEditor() {
+  if (!editor_) {
+    editor_ = new ScenarioEditor(this);
+    editor_->setWindowFlag(Qt::Window);
+    editor_->setAttribute(Qt::WA_DeleteOnClose);
+    // The scenario running here, to start from (a tried one keeps its editor's document).
+    if (scenario_ && !scenario_->file.isEmpty())
+      editor_->document().reset(scenario_->scenario, scenario_->file);
+    connect(editor_, &ScenarioEditor::tryScenario, this,
+            [this](const Scenario& scenario, const QString& file) {
+              if (!tryScenario(scenario, file))
+                statusBar()->showMessage(
+                    tr("A scene is still being built; try the scenario after it."));
+              raise();
+              activateWindow();
+            });
+  }
+  editor_->show();
+  editor_->raise();
+  return editor_;
+}
+
 void MainWindow::openScenarioFromMenu(const QString& file) {
   if (!openScenario(file))
     statusBar()->showMessage(tr("A scene is still being built; open the scenario after it."));
@@ -361,7 +404,7 @@ void MainWindow::openScenarioFromMenu(const QString& file) {
 
 void MainWindow::updateRecentMenu() {
   recentMenu_->clear();
-  const QStringList recent = recentScenarios();
+  const QStringList recent = recentScenarioFiles();
   for (const QString& file : recent) {
     QAction* action = recentMenu_->addAction(QFileInfo(file).fileName(), this,
                                              [this, file] { openScenarioFromMenu(file); });
@@ -853,9 +896,8 @@ void MainWindow::beginRecording() {
   SessionStart start;
   start.trainee = traineeName().toStdString();
   if (scenario_) {
-    QFile file(scenario_->file);
     start.scenario_title = scenario_->scenario.title;
-    if (file.open(QIODevice::ReadOnly)) start.scenario_text = file.readAll().toStdString();
+    start.scenario_text = scenario_->text;
   } else {
     // Free practice has no file: the text names the scene it ran.
     start.scenario_title = tr("Free practice").toStdString();

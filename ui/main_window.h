@@ -40,15 +40,18 @@ class AccuracyPanel;
 class CalibrationDialog;
 class DevicePanel;
 class LiverScene;
+class ScenarioEditor;
 class ScenarioPanel;
 class SessionReviewWindow;
 class ToolPanel;
 class VtkViewport;
 
-// A scenario as the window runs it, and the file it came from.
+// A scenario as the window runs it, the file it came from (none: tried from the editor unsaved)
+// and the exact text it was read from, which a recorded session stores.
 struct OpenedScenario {
   Scenario scenario;
   QString file;
+  std::string text;
 };
 
 class MainWindow : public QMainWindow {
@@ -84,11 +87,14 @@ class MainWindow : public QMainWindow {
   // way. scenarioOpenFinished tells which. Returns false, and does nothing, while a model is being
   // built.
   bool openScenario(const QString& file);
+  // Runs a scenario from the instructor's editor ("Try it") as openScenario() runs a file's:
+  // `file` is where it is saved (its organ file is named relative to that folder), or empty.
+  bool tryScenario(const Scenario& scenario, const QString& file);
+  // The instructor's scenario editor (File menu), on the scenario shown if it has a file, else
+  // on a new one; its "Try it" runs here.
+  ScenarioEditor* openScenarioEditor();
   const std::optional<OpenedScenario>& scenario() const { return scenario_; }
   ScenarioPanel* scenarioPanel() const { return scenarioPanel_; }
-  // Scenario files opened before, newest first (kept in the settings).
-  static QStringList recentScenarios();
-  static constexpr int kRecentScenarioCount = 8;
 
   // Haptic devices (Device panel). Each drives the tool through the 1 kHz servo: the mouse puts
   // the Tool panel's tool on the liver where it presses and moves it while held (its session is
@@ -147,11 +153,12 @@ class MainWindow : public QMainWindow {
   // Runs `model` of `setup` from rest, in place of the scene shown (if any): a new simulation,
   // liver picture and tool interaction; the device in use stays attached.
   void installScene(SceneSetup setup, std::shared_ptr<const SimModel> model);
+  void buildScenario(OpenedScenario opened, const QString& folder);  // on modelBuilder_
+  static QString scenarioName(const OpenedScenario& opened);         // for messages
   void finishScenarioOpen(const OpenedScenario& opened, std::shared_ptr<SceneSetup> setup,
                           std::shared_ptr<const SimModel> model, const QString& error);
   void refuseScenario(const QString& file, const QString& why);
   void showScenarioDetails();  // title, panel and allowed tools of scenario_
-  static void rememberScenario(const QString& file);
   void buildMenus();
   void openScenarioFromMenu(const QString& file);  // says so when a scene is still being built
   void updateRecentMenu();
@@ -246,6 +253,7 @@ class MainWindow : public QMainWindow {
   // The trainee's summary of a session just ended, for the Scenario panel.
   static QString sessionResultText(const RubricResult& rubric,
                                    const std::vector<MetricValue>& metrics);
+  QPointer<ScenarioEditor> editor_;
   QPointer<SessionReviewWindow> review_;
   QPointer<SessionReviewWindow> history_;
   QString sessionsProblem_;

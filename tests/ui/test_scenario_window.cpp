@@ -26,6 +26,7 @@
 #include "liversim/core/scenario.h"
 #include "liversim/core/surface.h"
 #include "main_window.h"
+#include "recent_scenarios.h"
 #include "scenario_panel.h"
 #include "tool_panel.h"
 
@@ -112,8 +113,8 @@ TEST_F(ScenarioWindowTest, OpeningAScenarioRunsItsSceneInPlaceOfTheOldOne) {
   EXPECT_EQ(window_->accuracyPanel()->settingsInUse().kind, expected.integrator.kind);
 
   const QString absolute = QFileInfo(kSmallScenario).absoluteFilePath();
-  ASSERT_FALSE(MainWindow::recentScenarios().isEmpty());
-  EXPECT_EQ(MainWindow::recentScenarios().front(), absolute);
+  ASSERT_FALSE(recentScenarioFiles().isEmpty());
+  EXPECT_EQ(recentScenarioFiles().front(), absolute);
   auto* recent = window_->findChild<QMenu*>("recentScenariosMenu");
   ASSERT_NE(recent, nullptr);
   ASSERT_EQ(recent->actions().size(), 1);
@@ -124,7 +125,7 @@ TEST_F(ScenarioWindowTest, OpeningAScenarioRunsItsSceneInPlaceOfTheOldOne) {
   recent->actions().front()->trigger();
   ASSERT_TRUE(finished.wait(kBuildTimeoutMs));
   EXPECT_TRUE(finished.first().first().toBool());
-  EXPECT_EQ(MainWindow::recentScenarios().size(), 1);  // not listed twice
+  EXPECT_EQ(recentScenarioFiles().size(), 1);  // not listed twice
   EXPECT_TRUE(waitSimulated(0.02));
 }
 
@@ -204,7 +205,7 @@ TEST_F(ScenarioWindowTest, ABadScenarioIsRefusedWithItsErrorsAndTheSceneGoesOn) 
   EXPECT_FALSE(window_->scenario());
   EXPECT_EQ(window_->windowTitle(), title);
   EXPECT_TRUE(waitSimulated(0.02));
-  EXPECT_TRUE(MainWindow::recentScenarios().isEmpty());
+  EXPECT_TRUE(recentScenarioFiles().isEmpty());
 }
 
 TEST_F(ScenarioWindowTest, AScenarioWhoseMeshCannotBeBuiltIsRefusedAndTheSceneGoesOn) {

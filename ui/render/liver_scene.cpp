@@ -166,14 +166,26 @@ void LiverScene::update_positions(const NodeArray& position_m) {
   polydata_->Modified();
 }
 
-void LiverScene::reset_camera() {
+void LiverScene::reset_camera(double aspect) {
   vtkCamera* camera = renderer_->GetActiveCamera();
   camera->SetFocalPoint(0.0, 0.0, 0.0);
   camera->SetPosition(0.05, 0.12, 0.55);  // anterior, slightly from above and the left
   camera->SetViewUp(0.0, 1.0, 0.0);
   camera->SetViewAngle(30.0);
   renderer_->ResetCamera(polydata_->GetBounds());
+  // ResetCamera fits the organ's bounding sphere in the vertical view angle only.
+  if (aspect > 0.0 && aspect < 1.0) camera->Dolly(aspect);
   renderer_->ResetCameraClippingRange();
+}
+
+void LiverScene::set_opacity(double opacity) {
+  vtkProperty* tissue = liver_actor_->GetProperty();
+  tissue->SetOpacity(opacity);
+  tissue->SetBackfaceCulling(opacity < 1.0);
+}
+
+double LiverScene::opacity() const {
+  return liver_actor_->GetProperty()->GetOpacity();
 }
 
 void LiverScene::show_grab_marker(const std::optional<Eigen::Vector3d>& point_m) {

@@ -52,8 +52,13 @@ class LiverScene {
                    const NodeArray& position_m);
   // Moves the surface to these node positions (all mesh nodes). Allocates nothing after the first.
   void update_positions(const NodeArray& position_m);
-  // Anterior view of the whole organ.
-  void reset_camera();
+  // Anterior view of the whole organ, in a view `aspect` (width / height) wide: a view narrower
+  // than tall backs off so that the organ fits across it too.
+  void reset_camera(double aspect = 1.0);
+  // See-through: the organ at `opacity` (< 1), front faces only, so what lies inside it (lesions:
+  // scenario_overlay.h) shows through one clean layer; 1 is solid.
+  void set_opacity(double opacity);
+  double opacity() const;
   // A small sphere at the grabbed point, or none.
   void show_grab_marker(const std::optional<Eigen::Vector3d>& point_m);
   // The tool's parts (tools.h: tool_capsules) as steel-grey rods with rounded ends; none hides it.

@@ -1,0 +1,217 @@
+#pragma once
+// The instructor's scenario editor: the organ seen through (lesions inside it), with the lesions
+// placed, moved and resized by mouse on it, the planned resection plane drawn across it, fixed
+// regions painted on its surface and the fibre direction shown; panels for every parameter with
+// units, ranges and tooltips; the effects with what they cost, measured; "Try it" runs the
+// scenario in the workstation. Every edit can be undone; saving validates.
+
+#include "scenario_document.h"
+
+#include "liversim/core/default_scene.h"
+
+#include <QMainWindow>
+#include <QPoint>
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <thread>
+
+class QAction;
+class QActionGroup;
+class QCheckBox;
+class QComboBox;
+class QDockWidget;
+class QFormLayout;
+class QHBoxLayout;
+class QDoubleSpinBox;
+class QLabel;
+class QLineEdit;
+class QListWidget;
+class QMenu;
+class QPlainTextEdit;
+class QPushButton;
+class QSpinBox;
+
+namespace liversim {
+
+class LiverScene;
+class ScenarioOverlay;
+class VtkViewport;
+
+class ScenarioEditor : public QMainWindow {
+  Q_OBJECT
+
+ public:
+  // What a left press on the organ does (a press on a lesion always takes the lesion).
+  enum class Mode {
+    view,         // turns the view
+    placeLesion,  // puts a new lesion under the surface there
+    drawPlane,    // drags the planned resection plane's trace across the view
+    paintFixed,   // paints fixed regions (ligament attachments) on the surface
+  };
+
+  // A new scenario (ScenarioDocument::newScenario).
+  explicit ScenarioEditor(QWidget* parent = nullptr);
+  ~ScenarioEditor() override;
+
+  ScenarioDocument& document() { return document_; }
+  VtkViewport* viewport() const { return viewport_; }
+  LiverScene* scene() const { return scene_.get(); }  // null while the organ cannot be built
+  const ScenarioOverlay* overlay() const { return overlay_.get(); }
+  QString organProblem() const { return organProblem_; }
+
+  void setMode(Mode mode);
+  Mode mode() const { return mode_; }
+  int selectedLesion() const { return selectedLesion_; }  // -1: none
+  void selectLesion(int index);
+
+  // File actions. openFile refuses a file with errors (shown, document unchanged). save and
+  // saveAs validate first: a scenario with errors is not written, they are shown (the box
+  // "saveErrorsBox") and false returned. Both ask first when there are unsaved changes.
+  bool openFile(const QString& file);
+  bool save();  // to its file, or asks where
+  bool saveAs(const QString& file);
+  void newScenario();
+  // With unsaved changes, asks (the box "unsavedChangesBox": save, discard or cancel); true when
+  // the document may be replaced or closed.
+  bool maybeSave();
+
+  // The effects' cost: steps per second of the scenario as it is now, measured on a worker (the
+  // model built and stepped under a pull for half a second). Remeasured after every change of
+  // the effects, the tissue, the lesions or the organ.
+  QString costText() const;
+  int costMeasurementCount() const { return costMeasurements_; }
+  std::optional<double> stepsPerSecond() const { return stepsPerSecond_; }
+
+ signals:
+  // "Try it": run this scenario in the workstation (`file`: where it is saved, or empty).
+  void tryScenario(const Scenario& scenario, const QString& file);
+  void costMeasured();
+
+ protected:
+  void closeEvent(QCloseEvent* event) override;
+  void showEvent(QShowEvent* event) override;
+
+ private:
+  void buildActions();
+  QWidget* buildLesionPanel();
+  QWidget* buildTaskPanel();
+  QWidget* buildTissuePanel();
+  QDockWidget* addDock(const QString& title, const char* name, QWidget* panel);
+  void fitCamera();     // the whole organ in the view
+  void rebuildOrgan();  // the organ's mesh, after organChanged
+  void showDocument();  // panels and overlay from the document
+  void showOverlay();
+  void updateTitle();
+  void showErrors(const QString& title, const char* boxName,
+                  const std::vector<ScenarioError>& errors);
+  void updateRecentMenu();
+  void tryIt();
+
+  // Mouse on the viewport (VTK display coordinates).
+  bool pressAt(QPoint display, Qt::MouseButton button, Qt::KeyboardModifiers modifiers);
+  void moveTo(QPoint display);
+  void releaseAt(QPoint display);
+  int lesionAt(QPoint display) const;  // -1: none
+  Eigen::Vector3d viewDirection() const;
+  Eigen::Vector3d organCentre_m() const;
+  void paintAt(QPoint display);
+
+  // A label of what is set, and a button that clears it (an edit named `editText`).
+  QHBoxLayout* clearableRow(QLabel*& label, const char* labelName, const QString& buttonText,
+                            const char* buttonName, const QString& editText,
+                            std::function<void(Scenario&)> clear);
+  // A spin box's entered value as an edit (`set` puts it in the scenario).
+  void bindSpinBox(QDoubleSpinBox* box, const QString& text, int mergeKey,
+                   std::function<void(Scenario&, double)> set);
+  // A lesion's value that defaults to the parenchyma's (`field`), in the range named `range`.
+  QDoubleSpinBox* optionalLesionValue(QFormLayout* form, std::string_view range,
+                                      const QString& suffix, const char* name, const QString& label,
+                                      const QString& editText, int mergeKey,
+                                      std::optional<double> LesionSpec::*field);
+  // A new lesion, named "lesion N", centred at `point_m`, or with depth_mm > 0 that much deeper
+  // than its radius along the view; it is selected.
+  void addLesion(const QString& text, const Eigen::Vector3d& point_m, double depth_mm);
+  // Edits of the selected lesion (`change` its spec).
+  void editLesion(const QString& text, int mergeKey,
+                  const std::function<void(LesionSpec&)>& change);
+
+  void measureCost();  // (again) after the current measurement
+  void finishCostMeasurement(std::optional<double> stepsPerSecond, double realTimeFactor,
+                             int tetCount, QString problem);
+
+  ScenarioDocument document_;
+  VtkViewport* viewport_ = nullptr;
+  std::optional<SceneSetup> organ_;  // the organ's mesh as shown
+  std::unique_ptr<LiverScene> scene_;
+  std::unique_ptr<ScenarioOverlay> overlay_;
+  QString organProblem_;
+  Mode mode_ = Mode::view;
+  int selectedLesion_ = -1;
+  bool shown_ = false;
+  bool refreshing_ = false;  // panels being filled from the document: their signals are not edits
+
+  // The drag the mouse is doing.
+  enum class Drag { none, moveLesion, resizeLesion, plane, paint };
+  Drag drag_ = Drag::none;
+  QPoint pressAt_;
+  LesionSpec lesionAtPress_;
+  Eigen::Vector3d dragOffset_m_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d planeStart_m_ = Eigen::Vector3d::Zero();
+  std::optional<Eigen::Vector3d> lastPaint_m_;
+
+  QActionGroup* modes_ = nullptr;
+  QAction* viewAction_ = nullptr;
+  QAction* placeLesionAction_ = nullptr;
+  QAction* drawPlaneAction_ = nullptr;
+  QAction* paintFixedAction_ = nullptr;
+  QMenu* recentMenu_ = nullptr;
+
+  // Lesion panel.
+  QListWidget* lesionList_ = nullptr;
+  QLineEdit* lesionName_ = nullptr;
+  QDoubleSpinBox* lesionCentre_[3] = {};
+  QDoubleSpinBox* lesionRadius_[3] = {};
+  QDoubleSpinBox* lesionStiffness_ = nullptr;   // kPa
+  QDoubleSpinBox* lesionYieldLimit_ = nullptr;  // Pa; its minimum: the parenchyma's
+  QDoubleSpinBox* lesionViscosity_ = nullptr;   // Pa·s; its minimum: the parenchyma's
+  QCheckBox* lesionHidden_ = nullptr;
+  QPushButton* removeLesion_ = nullptr;
+  QWidget* lesionFields_ = nullptr;
+
+  // Task panel.
+  QLineEdit* title_ = nullptr;
+  QPlainTextEdit* description_ = nullptr;
+  QComboBox* taskKind_ = nullptr;
+  QLineEdit* instructions_ = nullptr;
+  QDoubleSpinBox* timeLimit_ = nullptr;
+  QComboBox* taskLesion_ = nullptr;
+  QDoubleSpinBox* margin_ = nullptr;
+  QLabel* plane_ = nullptr;
+  QCheckBox* tools_[3] = {};
+  QDoubleSpinBox* safeForce_ = nullptr;
+
+  // Tissue and effects panel.
+  QDoubleSpinBox* youngsModulus_ = nullptr;
+  QDoubleSpinBox* poissonRatio_ = nullptr;
+  QCheckBox* effects_[4] = {};  // near-incompressibility, viscoelastic, viscoplastic, fibres
+  QDoubleSpinBox* fibreDirection_[3] = {};
+  QPushButton* fibreAlongView_ = nullptr;
+  QDoubleSpinBox* brushRadius_ = nullptr;
+  QLabel* fixedRegions_ = nullptr;
+  QCheckBox* fixLigament_ = nullptr;
+  QLabel* cost_ = nullptr;
+
+  // The cost measurement on its worker.
+  std::thread costWorker_;
+  bool costBusy_ = false;
+  bool costAgain_ = false;                // the scenario changed during the measurement
+  std::optional<Scenario> costScenario_;  // measured, or being measured
+  int costMeasurements_ = 0;
+  std::optional<double> stepsPerSecond_;
+  std::optional<double> previousStepsPerSecond_;
+  std::shared_ptr<std::atomic<bool>> alive_ = std::make_shared<std::atomic<bool>>(true);
+};
+
+}  // namespace liversim
