@@ -1,5 +1,6 @@
 #include "scenario_editor.h"
 
+#include "accuracy_panel.h"
 #include "recent_scenarios.h"
 #include "render/liver_scene.h"
 #include "render/scenario_overlay.h"
@@ -7,6 +8,7 @@
 
 #include "liversim/core/parameter_ranges.h"
 #include "liversim/core/performance.h"
+#include "liversim/core/surface_import.h"
 
 #include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>
@@ -28,6 +30,7 @@
 #include <QFormLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
+#include <QHeaderView>
 #include <QLabel>
 #include <QLineEdit>
 #include <QListWidget>
@@ -36,7 +39,9 @@
 #include <QPlainTextEdit>
 #include <QPushButton>
 #include <QSignalBlocker>
+#include <QSpinBox>
 #include <QStatusBar>
+#include <QTableWidget>
 #include <QToolBar>
 #include <QVBoxLayout>
 
@@ -68,6 +73,19 @@ enum MergeKey {
   kYoungsModulus,
   kPoissonRatio,
   kFibreDirection,
+  kViscoelasticE1,
+  kViscoelasticEta1,
+  kYieldLimit,
+  kViscoplasticEta2,
+  kCreepIndex,
+  kFibreK1,
+  kFibreK2,
+  kTargetTetCount,
+  kRubricWeight,
+  kRubricThreshold = kRubricWeight + 1000,  // one key per criterion
+  kDamageTension = kRubricThreshold + 1000,
+  kDamageCompression,
+  kLift,
 };
 
 constexpr double kMetresPerMm = 1e-3;
@@ -142,7 +160,11 @@ ScenarioEditor::ScenarioEditor(QWidget* parent) : QMainWindow(parent) {
   addDock(tr("Lesions"), "lesionDock", buildLesionPanel());
   QDockWidget* task = addDock(tr("Task"), "taskDock", buildTaskPanel());
   QDockWidget* tissue = addDock(tr("Tissue and effects"), "tissueDock", buildTissuePanel());
+  QDockWidget* organ = addDock(tr("Organ and accuracy"), "organDock", buildOrganPanel());
+  QDockWidget* grading = addDock(tr("Grading"), "gradingDock", buildGradingPanel());
   tabifyDockWidget(task, tissue);
+  tabifyDockWidget(tissue, organ);
+  tabifyDockWidget(organ, grading);
   task->raise();
 
   connect(&document_, &ScenarioDocument::organChanged, this, &ScenarioEditor::rebuildOrgan);
@@ -397,8 +419,22 @@ QWidget* ScenarioEditor::buildTaskPanel() {
     if (refreshing_) return;
     const auto kind = TaskKind(taskKind_->itemData(index).toInt());
     document_.edit(tr("Change the task"), [&](Scenario& s) {
-      s.task.kind = kind;
-      if (kind != TaskKind::resect_lesion) s.task.planned_plane.reset();  // a resection's only
+      // A field of another task is not written (docs/scenario-format.md): it goes back to its
+      // default, so that what is saved reads back equal.
+      TaskSpec& t = s.task;
+      const TaskSpec defaults;
+      t.kind = kind;
+      if (kind == TaskKind::retract_lobe) {
+        t.lesion.clear();
+      } else {
+        t.grasp_point_mm = defaults.grasp_point_mm;
+        t.lift_mm = defaults.lift_mm;
+        if (t.lesion.empty() && !s.lesions.empty()) t.lesion = s.lesions.front().name;
+      }
+      if (kind != TaskKind::resect_lesion) {
+        t.margin_mm = defaults.margin_mm;
+        t.planned_plane.reset();
+      }
     });
   });
   instructions_ = new QLineEdit;
@@ -543,6 +579,53 @@ QWidget* ScenarioEditor::buildTissuePanel() {
   effectsLayout->addWidget(cost_);
   layout->addWidget(effects);
 
+  // The laws' parameters: shown while their effect is on (kept, not shown, while it is off).
+  auto* laws = new QGroupBox(tr("Laws of the effects"));
+  auto* lawForm = new QFormLayout(laws);
+  const auto law = [&](QDoubleSpinBox*& box, std::string_view range, double scale,
+                       const QString& suffix, int decimals, const char* name, const QString& label,
+                       int mergeKey, std::function<void(TissueSpec&, double)> set) {
+    box = rangeSpinBox(range, scale, suffix, decimals);
+    box->setObjectName(name);
+    lawForm->addRow(label, box);
+    bindSpinBox(box, tr("Change %1").arg(label), mergeKey,
+                [set](Scenario& s, double v) { set(s.parenchyma, v); });
+  };
+  law(viscoelasticE1_, parameter::e1, 1.0, " Pa", 0, "viscoelasticE1", tr("Maxwell arm E1"),
+      kViscoelasticE1, [](TissueSpec& t, double v) {
+        // E = E1 + E2 stays the parenchyma's E.
+        if (!t.viscoelastic) return;
+        t.viscoelastic->e1_pa = v;
+        t.viscoelastic->e2_pa = t.elastic.youngs_modulus_pa - v;
+      });
+  viscoelasticE1_->setToolTip(viscoelasticE1_->toolTip() +
+                              tr(" E2 = E − E1 follows, so that E stays the parenchyma's."));
+  law(viscoelasticEta1_, parameter::eta1, 1.0, " Pa·s", 0, "viscoelasticEta1", tr("Maxwell arm η1"),
+      kViscoelasticEta1, [](TissueSpec& t, double v) {
+        if (t.viscoelastic) t.viscoelastic->eta1_pa_s = v;
+      });
+  law(yieldLimit_, parameter::yield_limit, 1.0, " Pa", 0, "viscoplasticYieldLimit",
+      tr("Yield limit σs"), kYieldLimit, [](TissueSpec& t, double v) {
+        if (t.viscoplastic) t.viscoplastic->yield_limit_pa = v;
+      });
+  law(viscoplasticEta2_, parameter::eta2, 1.0, " Pa·sⁿ", 0, "viscoplasticEta2",
+      tr("Viscoplastic η2"), kViscoplasticEta2, [](TissueSpec& t, double v) {
+        if (t.viscoplastic) t.viscoplastic->eta2_pa_s_pow_n = v;
+      });
+  law(creepIndex_, parameter::creep_index, 1.0, QString(), 2, "creepIndex", tr("Creep index n"),
+      kCreepIndex, [](TissueSpec& t, double v) {
+        if (t.viscoplastic) t.viscoplastic->creep_index_n = v;
+      });
+  law(fibreK1_, parameter::fibre_k1, 1.0, " Pa", 0, "fibreK1", tr("Fibre k1"), kFibreK1,
+      [](TissueSpec& t, double v) {
+        if (t.fibres) t.fibres->k1_pa = v;
+      });
+  law(fibreK2_, parameter::fibre_k2, 1.0, QString(), 2, "fibreK2", tr("Fibre k2"), kFibreK2,
+      [](TissueSpec& t, double v) {
+        if (t.fibres) t.fibres->k2 = v;
+      });
+  layout->addWidget(laws);
+
   auto* fibres = new QGroupBox(tr("Fibre direction"));
   auto* fibreLayout = new QHBoxLayout(fibres);
   static const char* const axes[3] = {"x", "y", "z"};
@@ -603,6 +686,253 @@ QWidget* ScenarioEditor::buildTissuePanel() {
   return panel;
 }
 
+QWidget* ScenarioEditor::buildOrganPanel() {
+  auto* panel = new QWidget;
+  auto* layout = new QVBoxLayout(panel);
+  auto* form = new QFormLayout;
+  organGeometry_ = new QComboBox;
+  organGeometry_->setObjectName("organGeometry");
+  organGeometry_->addItem(tr("Built-in liver"), int(OrganGeometry::built_in_liver));
+  organGeometry_->addItem(tr("Surface model (OBJ, STL, PLY, glTF, FBX, 3DS)"),
+                          int(OrganGeometry::surface_file));
+  organGeometry_->addItem(tr("Tetrahedral mesh (.inp, .msh)"), int(OrganGeometry::tet_mesh_file));
+  form->addRow(tr("Organ"), organGeometry_);
+  connect(organGeometry_, &QComboBox::currentIndexChanged, this, [this](int index) {
+    if (refreshing_) return;
+    const auto geometry = OrganGeometry(organGeometry_->itemData(index).toInt());
+    document_.edit(tr("Change the organ"), [&](Scenario& s) {
+      // Fields of another geometry are not written: back to their defaults.
+      OrganSpec& o = s.organ;
+      const OrganSpec defaults;
+      o.geometry = geometry;
+      if (geometry == OrganGeometry::built_in_liver) o.file.clear();
+      if (geometry != OrganGeometry::tet_mesh_file) o.fixed_node_set.clear();
+      if (geometry != OrganGeometry::surface_file) o.metres_per_unit = defaults.metres_per_unit;
+      if (geometry != OrganGeometry::built_in_liver) o.fix_ligament = defaults.fix_ligament;
+      if (geometry == OrganGeometry::tet_mesh_file) o.target_tet_count = defaults.target_tet_count;
+    });
+  });
+  organFile_ = new QLineEdit;
+  organFile_->setObjectName("organFile");
+  organFile_->setToolTip(tr("The organ's file: relative to the scenario's folder, or absolute"));
+  auto* choose = new QPushButton(tr("Choose…"));
+  choose->setObjectName("chooseOrganFileButton");
+  auto* fileRow = new QHBoxLayout;
+  fileRow->addWidget(organFile_, 1);
+  fileRow->addWidget(choose);
+  form->addRow(tr("File"), fileRow);
+  const auto setFile = [this](const QString& file) {
+    document_.edit(tr("Choose the organ's file"),
+                   [&](Scenario& s) { s.organ.file = file.toStdString(); });
+  };
+  connect(organFile_, &QLineEdit::editingFinished, this,
+          [this, setFile] { setFile(organFile_->text()); });
+  connect(choose, &QPushButton::clicked, this, [this, setFile] {
+    const bool surface = document_.scenario().organ.geometry == OrganGeometry::surface_file;
+    QStringList patterns;
+    if (surface)
+      for (const std::string& extension : surface_file_extensions())
+        patterns << "*" + QString::fromStdString(extension);
+    else
+      patterns << "*.inp"
+               << "*.msh";
+    const QString folder = QString::fromStdString(document_.organFolder().string());
+    const QString chosen =
+        QFileDialog::getOpenFileName(this, tr("The organ's file"), folder,
+                                     tr("Organ files (%1);;All files (*)").arg(patterns.join(' ')));
+    if (chosen.isEmpty()) return;
+    // Named relative to the scenario's folder when it is saved, so the two move together.
+    setFile(document_.file().isEmpty() ? chosen : QDir(folder).relativeFilePath(chosen));
+  });
+  lengthUnit_ = new QComboBox;
+  lengthUnit_->setObjectName("organLengthUnit");
+  for (const LengthUnit& unit : kLengthUnits)
+    lengthUnit_->addItem(QString::fromUtf8(unit.name.data(), int(unit.name.size())), unit.metres);
+  lengthUnit_->setToolTip(tr("The unit of the surface model's lengths (never guessed)"));
+  form->addRow(tr("Length unit"), lengthUnit_);
+  connect(lengthUnit_, &QComboBox::currentIndexChanged, this, [this](int index) {
+    if (refreshing_) return;
+    const double metres = lengthUnit_->itemData(index).toDouble();
+    document_.edit(tr("Change the organ's unit"),
+                   [&](Scenario& s) { s.organ.metres_per_unit = metres; });
+  });
+  targetTetCount_ = new QSpinBox;
+  targetTetCount_->setObjectName("targetTetCount");
+  targetTetCount_->setRange(1000, 50000);
+  targetTetCount_->setSingleStep(500);
+  targetTetCount_->setKeyboardTracking(false);
+  targetTetCount_->setToolTip(
+      tr("Elements of the organ's mesh: 1000 to 50000 (more is more accurate and slower: see "
+         "the cost in Tissue and effects)"));
+  form->addRow(tr("Elements"), targetTetCount_);
+  connect(targetTetCount_, &QSpinBox::valueChanged, this, [this](int count) {
+    if (!refreshing_)
+      document_.edit(
+          tr("Change the element count"), [&](Scenario& s) { s.organ.target_tet_count = count; },
+          kTargetTetCount);
+  });
+  fixedNodeSet_ = new QLineEdit;
+  fixedNodeSet_->setObjectName("fixedNodeSet");
+  fixedNodeSet_->setToolTip(tr("A node set of the mesh file held fixed (empty: none)"));
+  form->addRow(tr("Fixed node set"), fixedNodeSet_);
+  connect(fixedNodeSet_, &QLineEdit::editingFinished, this, [this] {
+    const std::string set = fixedNodeSet_->text().toStdString();
+    document_.edit(tr("Change the fixed node set"),
+                   [&](Scenario& s) { s.organ.fixed_node_set = set; });
+  });
+  organStatus_ = new QLabel;
+  organStatus_->setObjectName("organStatus");
+  organStatus_->setWordWrap(true);
+  form->addRow(QString(), organStatus_);
+  layout->addLayout(form);
+
+  accuracy_ = new AccuracyPanel;
+  accuracy_->setObjectName("accuracyPanel");
+  connect(
+      accuracy_, &AccuracyPanel::applyRequested, this, [this](const IntegratorSettings& settings) {
+        document_.edit(tr("Change the integrator"), [&](Scenario& s) { s.integrator = settings; });
+      });
+  layout->addWidget(accuracy_);
+  layout->addStretch(1);
+  return panel;
+}
+
+QWidget* ScenarioEditor::buildGradingPanel() {
+  auto* panel = new QWidget;
+  auto* layout = new QVBoxLayout(panel);
+  rubricTable_ = new QTableWidget(0, 4);
+  rubricTable_->setObjectName("rubricTable");
+  rubricTable_->setHorizontalHeaderLabels(
+      {tr("Metric"), tr("Weight"), tr("Pass if"), tr("Threshold")});
+  rubricTable_->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Stretch);
+  rubricTable_->verticalHeader()->hide();
+  rubricTable_->setSelectionBehavior(QAbstractItemView::SelectRows);
+  rubricTable_->setToolTip(
+      tr("The rubric: each criterion passes when its metric is at most or at least the "
+         "threshold; the score is the passed criteria's share of the weights"));
+  layout->addWidget(rubricTable_, 1);
+  auto* buttons = new QHBoxLayout;
+  auto* add = new QPushButton(tr("Add criterion"));
+  add->setObjectName("addCriterionButton");
+  auto* remove = new QPushButton(tr("Remove"));
+  remove->setObjectName("removeCriterionButton");
+  buttons->addWidget(add);
+  buttons->addWidget(remove);
+  layout->addLayout(buttons);
+  connect(add, &QPushButton::clicked, this, [this] {
+    document_.edit(tr("Add a criterion"), [](Scenario& s) {
+      // The first metric not graded yet.
+      RubricCriterion c;
+      c.metric = std::string(gradable_metrics().front().name);
+      for (const MetricInfo& m : gradable_metrics())
+        if (std::none_of(s.rubric.begin(), s.rubric.end(),
+                         [&](const RubricCriterion& r) { return r.metric == m.name; })) {
+          c.metric = std::string(m.name);
+          break;
+        }
+      s.rubric.push_back(c);
+    });
+  });
+  connect(remove, &QPushButton::clicked, this, [this] {
+    const int row = rubricTable_->currentRow();
+    if (row < 0 || row >= int(document_.scenario().rubric.size())) return;
+    document_.edit(tr("Remove a criterion"),
+                   [&](Scenario& s) { s.rubric.erase(s.rubric.begin() + row); });
+  });
+
+  auto* form = new QFormLayout;
+  damageTension_ = spinBox("damageTensionStrain", 0.05, 2.0, 2, QString(),
+                           tr("Tissue stretched past 1 + this is damaged (graded): 0.05 to 2"));
+  form->addRow(tr("Damage in tension"), damageTension_);
+  bindSpinBox(damageTension_, tr("Change the damage strain"), kDamageTension,
+              [](Scenario& s, double v) { s.task.damage_tension_strain = v; });
+  damageCompression_ =
+      spinBox("damageCompressionStrain", 0.05, 0.95, 2, QString(),
+              tr("Tissue squeezed below 1 − this is damaged (graded): 0.05 to 0.95"));
+  form->addRow(tr("Damage in compression"), damageCompression_);
+  bindSpinBox(damageCompression_, tr("Change the damage strain"), kDamageCompression,
+              [](Scenario& s, double v) { s.task.damage_compression_strain = v; });
+  graspPoint_ = new QLabel;
+  graspPoint_->setObjectName("graspPoint");
+  graspPoint_->setWordWrap(true);
+  auto* pick = new QPushButton(tr("Pick on the organ"));
+  pick->setObjectName("pickGraspPointButton");
+  pick->setToolTip(tr("Retraction: click where the lobe is to be grasped"));
+  connect(pick, &QPushButton::clicked, this, [this] { setMode(Mode::pickGraspPoint); });
+  auto* graspRow = new QHBoxLayout;
+  graspRow->addWidget(graspPoint_, 1);
+  graspRow->addWidget(pick);
+  form->addRow(tr("Grasp point"), graspRow);
+  lift_ = spinBox("liftMm", 5.0, 100.0, 0, " mm", tr("Retraction: how far to lift: 5 to 100 mm"));
+  form->addRow(tr("Lift"), lift_);
+  bindSpinBox(lift_, tr("Change the lift"), kLift,
+              [](Scenario& s, double v) { s.task.lift_mm = v; });
+  layout->addLayout(form);
+  return panel;
+}
+
+void ScenarioEditor::showRubric() {
+  const std::vector<RubricCriterion>& rubric = document_.scenario().rubric;
+  if (shownRubric_ && *shownRubric_ == rubric) return;  // the table made this edit itself
+  shownRubric_ = rubric;
+  rubricTable_->setRowCount(int(rubric.size()));
+  // An edit in a row: the table shows it already, so it is not rebuilt under the editing widget.
+  const auto editRow = [this](int row, const QString& text, int mergeKey,
+                              std::function<void(RubricCriterion&)> change) {
+    if (refreshing_) return;
+    std::vector<RubricCriterion> next = document_.scenario().rubric;
+    change(next.at(row));
+    shownRubric_ = next;
+    document_.edit(
+        text, [&](Scenario& s) { s.rubric = next; }, mergeKey);
+  };
+  for (int row = 0; row < int(rubric.size()); ++row) {
+    const RubricCriterion& c = rubric[row];
+    auto* metric = new QComboBox;
+    for (const MetricInfo& m : gradable_metrics())
+      metric->addItem(QString::fromUtf8(m.name.data(), int(m.name.size())));
+    metric->setCurrentText(QString::fromStdString(c.metric));
+    const MetricInfo* info = find_metric(c.metric);
+    if (info)
+      metric->setToolTip(QString::fromUtf8(info->meaning.data(), int(info->meaning.size())));
+    auto* weight = spinBox("", 0.0, 100.0, 1, QString(), tr("The criterion's weight in the score"));
+    weight->setValue(c.weight);
+    auto* rule = new QComboBox;
+    rule->addItem(tr("at most"), int(PassRule::at_most));
+    rule->addItem(tr("at least"), int(PassRule::at_least));
+    rule->setCurrentIndex(c.rule == PassRule::at_most ? 0 : 1);
+    const QString unit = info && !info->unit.empty()
+                             ? " " + QString::fromUtf8(info->unit.data(), int(info->unit.size()))
+                             : QString();
+    auto* threshold = spinBox("", -1e6, 1e6, 2, unit, tr("The threshold, in the metric's unit"));
+    threshold->setValue(c.threshold);
+    rubricTable_->setCellWidget(row, 0, metric);
+    rubricTable_->setCellWidget(row, 1, weight);
+    rubricTable_->setCellWidget(row, 2, rule);
+    rubricTable_->setCellWidget(row, 3, threshold);
+    connect(metric, &QComboBox::currentTextChanged, this, [=](const QString& name) {
+      editRow(row, tr("Change a criterion's metric"), kNoMerge,
+              [&](RubricCriterion& r) { r.metric = name.toStdString(); });
+      shownRubric_.reset();  // the unit of the threshold changes with it
+      QMetaObject::invokeMethod(
+          this, [this] { showRubric(); }, Qt::QueuedConnection);
+    });
+    connect(weight, &QDoubleSpinBox::valueChanged, this, [=](double v) {
+      editRow(row, tr("Change a criterion's weight"), kRubricWeight + row,
+              [&](RubricCriterion& r) { r.weight = v; });
+    });
+    connect(rule, &QComboBox::currentIndexChanged, this, [=](int index) {
+      const auto pass = PassRule(rule->itemData(index).toInt());
+      editRow(row, tr("Change a criterion's rule"), kNoMerge,
+              [&](RubricCriterion& r) { r.rule = pass; });
+    });
+    connect(threshold, &QDoubleSpinBox::valueChanged, this, [=](double v) {
+      editRow(row, tr("Change a criterion's threshold"), kRubricThreshold + row,
+              [&](RubricCriterion& r) { r.threshold = v; });
+    });
+  }
+}
+
 void ScenarioEditor::rebuildOrgan() {
   // The organ alone: lesions and fixed regions do not change its mesh, and a lesion not (yet) in
   // it must not keep it from being shown.
@@ -622,6 +952,7 @@ void ScenarioEditor::rebuildOrgan() {
   QApplication::restoreOverrideCursor();
   if (!organ) {
     statusBar()->showMessage(organProblem_);
+    organStatus_->setText(organProblem_ + tr(" (the organ shown is the one before)"));
     return;  // the organ shown before stays
   }
   if (scene_) viewport_->renderWindow()->RemoveRenderer(scene_->renderer());
@@ -633,6 +964,7 @@ void ScenarioEditor::rebuildOrgan() {
   viewport_->renderWindow()->AddRenderer(scene_->renderer());
   fitCamera();
   showOverlay();
+  organStatus_->setText(QString::fromStdString(organ_->description));
   statusBar()->showMessage(tr("Organ: %1").arg(QString::fromStdString(organ_->description)));
 }
 
@@ -715,11 +1047,47 @@ void ScenarioEditor::showDocument() {
     if (s.parenchyma.fibres) fibreDirection_[k]->setValue(s.parenchyma.fibres->direction[k]);
   }
   fibreAlongView_->setEnabled(s.parenchyma.fibres.has_value());
+  const TissueSpec& t = s.parenchyma;
+  const auto showLaw = [](QDoubleSpinBox* box, bool on, double value) {
+    box->setEnabled(on);
+    if (on) box->setValue(value);
+  };
+  const bool ve = s.effects.viscoelastic && t.viscoelastic,
+             vp = s.effects.viscoplastic && t.viscoplastic, fi = s.effects.fibres && t.fibres;
+  showLaw(viscoelasticE1_, ve, ve ? t.viscoelastic->e1_pa : 0.0);
+  showLaw(viscoelasticEta1_, ve, ve ? t.viscoelastic->eta1_pa_s : 0.0);
+  showLaw(yieldLimit_, vp, vp ? t.viscoplastic->yield_limit_pa : 0.0);
+  showLaw(viscoplasticEta2_, vp, vp ? t.viscoplastic->eta2_pa_s_pow_n : 0.0);
+  showLaw(creepIndex_, vp, vp ? t.viscoplastic->creep_index_n : 0.0);
+  showLaw(fibreK1_, fi, fi ? t.fibres->k1_pa : 0.0);
+  showLaw(fibreK2_, fi, fi ? t.fibres->k2 : 0.0);
   fixedRegions_->setText(tr("%n ball(s)", "", int(s.organ.fixed_balls.size())));
   fixLigament_->setChecked(s.organ.fix_ligament);
   fixLigament_->setEnabled(s.organ.geometry == OrganGeometry::built_in_liver);
+  const OrganSpec& o = s.organ;
+  organGeometry_->setCurrentIndex(organGeometry_->findData(int(o.geometry)));
+  organFile_->setText(QString::fromStdString(o.file));
+  organFile_->setEnabled(o.geometry != OrganGeometry::built_in_liver);
+  lengthUnit_->setCurrentIndex(lengthUnit_->findData(o.metres_per_unit));
+  lengthUnit_->setEnabled(o.geometry == OrganGeometry::surface_file);
+  targetTetCount_->setValue(o.target_tet_count);
+  targetTetCount_->setEnabled(o.geometry != OrganGeometry::tet_mesh_file);
+  fixedNodeSet_->setText(QString::fromStdString(o.fixed_node_set));
+  fixedNodeSet_->setEnabled(o.geometry == OrganGeometry::tet_mesh_file);
+  accuracy_->setSettings(s.integrator);
+  damageTension_->setValue(s.task.damage_tension_strain);
+  damageCompression_->setValue(s.task.damage_compression_strain);
+  const bool retract = s.task.kind == TaskKind::retract_lobe;
+  graspPoint_->setText(retract ? tr("(%1, %2, %3) mm")
+                                     .arg(s.task.grasp_point_mm[0], 0, 'f', 1)
+                                     .arg(s.task.grasp_point_mm[1], 0, 'f', 1)
+                                     .arg(s.task.grasp_point_mm[2], 0, 'f', 1)
+                               : tr("retraction tasks only"));
+  lift_->setValue(s.task.lift_mm);
+  lift_->setEnabled(retract);
   blockers.clear();
   refreshing_ = false;
+  showRubric();  // after the blockers: it may delete the widgets they hold
 
   showOverlay();
   measureCost();
@@ -778,6 +1146,11 @@ void ScenarioEditor::updateTitle() {
 
 void ScenarioEditor::setMode(Mode mode) {
   mode_ = mode;
+  if (mode == Mode::pickGraspPoint) {  // a one-click mode, not on the toolbar
+    mode_ = mode;
+    statusBar()->showMessage(tr("Click where the lobe is to be grasped."));
+    return;
+  }
   QAction* action = mode == Mode::view          ? viewAction_
                     : mode == Mode::placeLesion ? placeLesionAction_
                     : mode == Mode::drawPlane   ? drawPlaneAction_
@@ -926,6 +1299,13 @@ bool ScenarioEditor::pressAt(QPoint display, Qt::MouseButton button,
       addLesion(tr("Place a lesion"), hit->point_m, 2.0);
       return true;
     }
+    case Mode::pickGraspPoint:
+      if (!hit) return true;
+      document_.edit(tr("Set the grasp point"),
+                     [&](Scenario& e) { e.task.grasp_point_mm = millimetres(hit->point_m); });
+      setMode(Mode::view);
+      statusBar()->showMessage(tr("The grasp point is set."));
+      return true;
     case Mode::drawPlane:
       planeStart_m_ =
           hit ? hit->point_m : scene_->display_to_world(display.x(), display.y(), organCentre_m());

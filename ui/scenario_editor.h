@@ -32,9 +32,11 @@ class QMenu;
 class QPlainTextEdit;
 class QPushButton;
 class QSpinBox;
+class QTableWidget;
 
 namespace liversim {
 
+class AccuracyPanel;
 class LiverScene;
 class ScenarioOverlay;
 class VtkViewport;
@@ -45,10 +47,11 @@ class ScenarioEditor : public QMainWindow {
  public:
   // What a left press on the organ does (a press on a lesion always takes the lesion).
   enum class Mode {
-    view,         // turns the view
-    placeLesion,  // puts a new lesion under the surface there
-    drawPlane,    // drags the planned resection plane's trace across the view
-    paintFixed,   // paints fixed regions (ligament attachments) on the surface
+    view,            // turns the view
+    placeLesion,     // puts a new lesion under the surface there
+    drawPlane,       // drags the planned resection plane's trace across the view
+    paintFixed,      // paints fixed regions (ligament attachments) on the surface
+    pickGraspPoint,  // the next click sets a retraction's grasp point, then back to view
   };
 
   // A new scenario (ScenarioDocument::newScenario).
@@ -98,6 +101,9 @@ class ScenarioEditor : public QMainWindow {
   QWidget* buildLesionPanel();
   QWidget* buildTaskPanel();
   QWidget* buildTissuePanel();
+  QWidget* buildOrganPanel();
+  QWidget* buildGradingPanel();
+  void showRubric();  // rebuilt only when the rubric differs from what the table shows
   QDockWidget* addDock(const QString& title, const char* name, QWidget* panel);
   void fitCamera();     // the whole organ in the view
   void rebuildOrgan();  // the organ's mesh, after organChanged
@@ -196,12 +202,36 @@ class ScenarioEditor : public QMainWindow {
   QDoubleSpinBox* youngsModulus_ = nullptr;
   QDoubleSpinBox* poissonRatio_ = nullptr;
   QCheckBox* effects_[4] = {};  // near-incompressibility, viscoelastic, viscoplastic, fibres
+  QDoubleSpinBox* viscoelasticE1_ = nullptr;
+  QDoubleSpinBox* viscoelasticEta1_ = nullptr;
+  QDoubleSpinBox* yieldLimit_ = nullptr;
+  QDoubleSpinBox* viscoplasticEta2_ = nullptr;
+  QDoubleSpinBox* creepIndex_ = nullptr;
+  QDoubleSpinBox* fibreK1_ = nullptr;
+  QDoubleSpinBox* fibreK2_ = nullptr;
   QDoubleSpinBox* fibreDirection_[3] = {};
   QPushButton* fibreAlongView_ = nullptr;
   QDoubleSpinBox* brushRadius_ = nullptr;
   QLabel* fixedRegions_ = nullptr;
   QCheckBox* fixLigament_ = nullptr;
   QLabel* cost_ = nullptr;
+
+  // Organ and accuracy panel.
+  QComboBox* organGeometry_ = nullptr;
+  QLineEdit* organFile_ = nullptr;
+  QComboBox* lengthUnit_ = nullptr;
+  QSpinBox* targetTetCount_ = nullptr;
+  QLineEdit* fixedNodeSet_ = nullptr;
+  QLabel* organStatus_ = nullptr;
+  AccuracyPanel* accuracy_ = nullptr;
+
+  // Grading panel.
+  QTableWidget* rubricTable_ = nullptr;
+  std::optional<std::vector<RubricCriterion>> shownRubric_;
+  QDoubleSpinBox* damageTension_ = nullptr;
+  QDoubleSpinBox* damageCompression_ = nullptr;
+  QLabel* graspPoint_ = nullptr;
+  QDoubleSpinBox* lift_ = nullptr;
 
   // The cost measurement on its worker.
   std::thread costWorker_;

@@ -8,11 +8,14 @@
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFile>
+#include <QLabel>
 #include <QLineEdit>
 #include <QMessageBox>
 #include <QPushButton>
 #include <QSettings>
 #include <QSignalSpy>
+#include <QSpinBox>
+#include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
 #include <QTimer>
@@ -273,6 +276,95 @@ TEST_F(ScenarioEditorTest, ADrawnPlaneHoldsTheLineAndTheDirectionOfView) {
   EXPECT_FALSE(scenario().task.planned_plane);
   trigger("undoAction");
   EXPECT_TRUE(scenario().task.planned_plane);
+}
+
+TEST_F(ScenarioEditorTest, TheRubricTheLawsTheIntegratorAndTheGraspPointAreEditedAndSaved) {
+  // Grading: a criterion added, its rule and threshold set in the table.
+  ASSERT_TRUE(scenario().rubric.empty());
+  field<QPushButton>("addCriterionButton")->click();
+  ASSERT_EQ(scenario().rubric.size(), 1u);
+  auto* table = field<QTableWidget>("rubricTable");
+  ASSERT_EQ(table->rowCount(), 1);
+  auto* rule = qobject_cast<QComboBox*>(table->cellWidget(0, 2));
+  auto* threshold = qobject_cast<QDoubleSpinBox*>(table->cellWidget(0, 3));
+  ASSERT_TRUE(rule && threshold);
+  rule->setCurrentIndex(1);
+  threshold->setValue(2.5);
+  EXPECT_EQ(scenario().rubric[0].rule, PassRule::at_least);
+  EXPECT_EQ(scenario().rubric[0].threshold, 2.5);
+  EXPECT_EQ(table->cellWidget(0, 3), threshold);  // not rebuilt under the widget being edited
+  trigger("undoAction");
+  EXPECT_EQ(scenario().rubric[0].threshold, 0.0);
+  EXPECT_EQ(qobject_cast<QDoubleSpinBox*>(table->cellWidget(0, 3))->value(), 0.0);
+  trigger("redoAction");
+
+  // The laws: viscoplasticity brings viscoelasticity; E1 keeps E = E1 + E2.
+  field<QCheckBox>("effectViscoplastic")->setChecked(true);
+  ASSERT_TRUE(scenario().effects.viscoelastic && scenario().effects.viscoplastic);
+  field<QDoubleSpinBox>("viscoplasticYieldLimit")->setValue(120.0);
+  field<QDoubleSpinBox>("viscoelasticE1")->setValue(2500.0);
+  const TissueSpec& t = scenario().parenchyma;
+  EXPECT_EQ(t.viscoplastic->yield_limit_pa, 120.0);
+  EXPECT_EQ(t.viscoelastic->e1_pa, 2500.0);
+  EXPECT_DOUBLE_EQ(t.viscoelastic->e1_pa + t.viscoelastic->e2_pa, t.elastic.youngs_modulus_pa);
+
+  // The integrator, through the same panel as the workstation's.
+  auto* accuracy = field<QWidget>("accuracyPanel");
+  auto* integrator = accuracy->findChild<QComboBox*>("integratorChoice");
+  auto* step = accuracy->findChild<QDoubleSpinBox*>("integratorStepMs");
+  ASSERT_TRUE(integrator && step);
+  integrator->setCurrentIndex(integrator->findData(int(IntegratorKind::bdf2)));
+  ASSERT_GE(integrator->currentIndex(), 0);
+  step->setValue(1.0);
+  accuracy->findChild<QPushButton*>("applyAccuracy")->click();
+  EXPECT_EQ(scenario().integrator.kind, IntegratorKind::bdf2);
+  EXPECT_EQ(scenario().integrator.step_s, 1e-3);
+
+  // A retraction's grasp point, picked on the organ.
+  auto* kind = field<QComboBox>("taskKind");
+  kind->setCurrentIndex(kind->findData(int(TaskKind::retract_lobe)));
+  EXPECT_TRUE(scenario().task.lesion.empty());
+  field<QPushButton>("pickGraspPointButton")->click();
+  const QPoint at = organMiddle() + QPoint(60, 10);
+  const auto hit = pickAt(at);
+  ASSERT_TRUE(hit);
+  click(at);
+  EXPECT_LT((metres(scenario().task.grasp_point_mm) - hit->point_m).norm(), 1e-9);
+  EXPECT_EQ(editor_->mode(), ScenarioEditor::Mode::view);
+  field<QDoubleSpinBox>("liftMm")->setValue(40.0);
+
+  const QString file = folder_.filePath("edited.json");
+  ASSERT_TRUE(editor_->saveAs(file));
+  const ScenarioReading reading = read_scenario_file(file.toStdString());
+  ASSERT_TRUE(reading.scenario);
+  EXPECT_EQ(*reading.scenario, scenario());
+  EXPECT_EQ(reading.scenario->task.lift_mm, 40.0);
+}
+
+TEST_F(ScenarioEditorTest, TheOrganIsRebuiltFromASurfaceModelAndABadFileKeepsTheOldOne) {
+  const std::size_t builtInTriangles = editor_->scene()->surface().triangles.size();
+  auto* geometry = field<QComboBox>("organGeometry");
+  geometry->setCurrentIndex(geometry->findData(int(OrganGeometry::surface_file)));
+  // No file yet: it cannot be built; the organ shown stays.
+  EXPECT_FALSE(editor_->organProblem().isEmpty());
+  ASSERT_NE(editor_->scene(), nullptr);
+  EXPECT_EQ(editor_->scene()->surface().triangles.size(), builtInTriangles);
+  EXPECT_TRUE(field<QLabel>("organStatus")->text().contains("cannot be built"));
+
+  auto* file = field<QLineEdit>("organFile");
+  file->setText(QStringLiteral(LIVERSIM_TEST_DATA_DIR) + "/cube-40mm.obj");
+  emit file->editingFinished();
+  auto* count = field<QSpinBox>("targetTetCount");
+  count->setValue(1000);
+  EXPECT_TRUE(editor_->organProblem().isEmpty()) << editor_->organProblem().toStdString();
+  // The cube's own 192 triangles are the organ's surface now.
+  EXPECT_EQ(editor_->scene()->surface().triangles.size(), 192u);
+  EXPECT_EQ(scenario().organ.metres_per_unit, 1e-3);  // mm, the first unit offered
+  trigger("undoAction");
+  trigger("undoAction");
+  trigger("undoAction");
+  EXPECT_EQ(scenario().organ.geometry, OrganGeometry::built_in_liver);
+  EXPECT_EQ(editor_->scene()->surface().triangles.size(), builtInTriangles);
 }
 
 TEST_F(ScenarioEditorTest, SavingIsRefusedWithTheErrorsOfTheScenarioAndWritesNothing) {
