@@ -507,11 +507,8 @@ int run_bench(const BenchOptions& o) {
   std::optional<double> target_size_factor;  // central difference, 10583 tets, most threads
   for (int tets : o.stepping_tet_counts) {
     const SceneSetup scene = default_scene(tets);
-    // The seed's pull: spread over the surface within 20 mm of the marked point, as a tool's jaws.
-    std::vector<PointLoad> pull;
-    spread_load(make_load_patch(scene.mesh, build_model(scene.mesh, scene.model_options),
-                                anterior_marked_node(scene.mesh), 0.02),
-                kSeedPullDirection * 0.5, pull);
+    const std::vector<PointLoad> pull =
+        seed_pull_loads(scene.mesh, build_model(scene.mesh, scene.model_options));
     for (std::size_t t = 0; t < thread_counts.size(); ++t)
       for (IntegratorKind kind : kAllIntegrators) {
         ModelOptions options = scene.model_options;

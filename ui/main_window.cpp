@@ -5,6 +5,7 @@
 #include "device_panel.h"
 #include "recent_scenarios.h"
 #include "render/liver_scene.h"
+#include "scenario_document.h"
 #include "scenario_editor.h"
 #include "scenario_panel.h"
 #include "tool_panel.h"
@@ -210,10 +211,7 @@ bool MainWindow::openScenario(const QString& file) {
     reading = read_scenario_file(file.toStdString());  // names why it cannot be read
   }
   if (!reading.scenario) {
-    QStringList errors;
-    for (const ScenarioError& error : reading.errors)
-      errors << QString::fromStdString(error.text());
-    refuseScenario(file, errors.join('\n'));
+    refuseScenario(file, scenarioErrorsText(reading.errors));
     return true;
   }
   const QString absolute = QFileInfo(file).absoluteFilePath();
@@ -927,7 +925,7 @@ void MainWindow::beginRecording() {
   std::optional<Eigen::Vector3d> lift_point_m;
   if (scenario_ && scenario_->scenario.task.kind == TaskKind::retract_lobe) {
     const Millimetres3& mm = scenario_->scenario.task.grasp_point_mm;
-    lift_point_m = Eigen::Vector3d(mm[0], mm[1], mm[2]) * 1e-3;
+    lift_point_m = to_metres(mm);
   }
   // The scenario's grading thresholds (free practice: the defaults).
   const TaskSpec task = scenario_ ? scenario_->scenario.task : TaskSpec{};

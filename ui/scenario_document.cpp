@@ -62,6 +62,20 @@ void ScenarioDocument::edit(const QString& text, const std::function<void(Scenar
       new ScenarioEditCommand(*this, text, scenario_, std::move(after), mergeKey, mergeRun_));
 }
 
+std::vector<ScenarioError> ScenarioDocument::problems(const Scenario& scenario) {
+  // What the file will say must read back as this scenario: the reader's checks (the parser's
+  // ranges too), not only validate()'s.
+  std::vector<ScenarioError> errors = validate(scenario);
+  if (errors.empty()) errors = read_scenario(write_scenario(scenario)).errors;
+  return errors;
+}
+
+QString scenarioErrorsText(const std::vector<ScenarioError>& errors) {
+  QStringList lines;
+  for (const ScenarioError& error : errors) lines << QString::fromStdString(error.text());
+  return lines.join('\n');
+}
+
 std::filesystem::path ScenarioDocument::organFolder() const {
   return file_.isEmpty() ? std::filesystem::current_path()
                          : std::filesystem::path(file_.toStdString()).parent_path();
@@ -102,11 +116,7 @@ std::vector<ScenarioError> ScenarioDocument::saveAs(const QString& file) {
         std::filesystem::relative(from, std::filesystem::absolute(file.toStdString()).parent_path())
             .generic_string();
   }
-  // What the file will say must read back as this scenario: the reader's checks (the parser's
-  // ranges too), not only validate()'s.
-  std::vector<ScenarioError> errors = validate(saved);
-  if (errors.empty()) errors = read_scenario(write_scenario(saved)).errors;
-  if (!errors.empty()) return errors;
+  if (std::vector<ScenarioError> errors = problems(saved); !errors.empty()) return errors;
   try {
     write_scenario_file(saved, file.toStdString());
   } catch (const std::exception& e) {

@@ -43,6 +43,9 @@ class ScenarioDocument : public QObject {
   // Returns the errors of a file that cannot be read; the document is then unchanged.
   std::vector<ScenarioError> open(const QString& file);
   void reset(Scenario scenario, const QString& file);
+  // Why `scenario` cannot be saved (or run): validate()'s errors and the reader's own on its JSON
+  // text, so that what is saved always reads back. Empty: none.
+  static std::vector<ScenarioError> problems(const Scenario& scenario);
   // Validates and writes to `file`. With errors nothing is written and they are returned; a write
   // that fails (a full disk, a folder that is not writable) is one error naming the file.
   std::vector<ScenarioError> saveAs(const QString& file);
@@ -63,6 +66,9 @@ class ScenarioDocument : public QObject {
   QUndoStack undoStack_;
   int mergeRun_ = 0;
 };
+
+// The errors, one per line, as the workstation and the editor show them.
+QString scenarioErrorsText(const std::vector<ScenarioError>& errors);
 
 // Whether two organs are meshed alike (the same geometry, file, unit and element count); fixed
 // regions and the ligament do not change the mesh.

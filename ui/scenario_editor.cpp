@@ -89,30 +89,6 @@ enum MergeKey {
 };
 
 constexpr double kMetresPerMm = 1e-3;
-Eigen::Vector3d metres(const Millimetres3& mm) {
-  return Eigen::Vector3d(mm[0], mm[1], mm[2]) * kMetresPerMm;
-}
-Millimetres3 millimetres(const Eigen::Vector3d& m) {
-  return {m.x() / kMetresPerMm, m.y() / kMetresPerMm, m.z() / kMetresPerMm};
-}
-
-// A spin box over a documented parameter range (parameter_ranges.h) shown in `scale` × its unit.
-QDoubleSpinBox* rangeSpinBox(std::string_view key, double scale, const QString& suffix,
-                             int decimals) {
-  const ParameterRange& range = parameter_range(key);
-  auto* box = new QDoubleSpinBox;
-  box->setDecimals(decimals);
-  box->setRange(range.min / scale, range.max / scale);
-  box->setSuffix(suffix);
-  box->setToolTip(QString::fromUtf8("%1: %2 to %3%4. %5")
-                      .arg(QString::fromUtf8(range.label.data(), int(range.label.size())))
-                      .arg(range.min / scale)
-                      .arg(range.max / scale)
-                      .arg(suffix)
-                      .arg(QString::fromUtf8(range.why.data(), int(range.why.size()))));
-  box->setKeyboardTracking(false);
-  return box;
-}
 
 QDoubleSpinBox* spinBox(const char* name, double min, double max, int decimals,
                         const QString& suffix, const QString& tip) {
@@ -126,14 +102,21 @@ QDoubleSpinBox* spinBox(const char* name, double min, double max, int decimals,
   return box;
 }
 
-QDoubleSpinBox* lengthSpinBox(double min_mm, double max_mm, const QString& tip) {
-  return spinBox("", min_mm, max_mm, 1, " mm", tip);
+// A spin box over a documented parameter range (parameter_ranges.h) shown in `scale` × its unit.
+QDoubleSpinBox* rangeSpinBox(std::string_view key, double scale, const QString& suffix,
+                             int decimals) {
+  const ParameterRange& range = parameter_range(key);
+  return spinBox("", range.min / scale, range.max / scale, decimals, suffix,
+                 QString::fromUtf8("%1: %2 to %3%4. %5")
+                     .arg(QString::fromUtf8(range.label.data(), int(range.label.size())))
+                     .arg(range.min / scale)
+                     .arg(range.max / scale)
+                     .arg(suffix)
+                     .arg(QString::fromUtf8(range.why.data(), int(range.why.size()))));
 }
 
-QString problemsText(const std::vector<ScenarioError>& errors) {
-  QStringList lines;
-  for (const ScenarioError& error : errors) lines << QString::fromStdString(error.text());
-  return lines.join('\n');
+QDoubleSpinBox* lengthSpinBox(double min_mm, double max_mm, const QString& tip) {
+  return spinBox("", min_mm, max_mm, 1, " mm", tip);
 }
 
 // The parts of a scenario that decide its cost.
@@ -300,7 +283,7 @@ QWidget* ScenarioEditor::buildLesionPanel() {
   buttons->addWidget(removeLesion_);
   layout->addLayout(buttons);
   connect(addButton, &QPushButton::clicked, this,
-          [this] { addLesion(tr("Add a lesion"), organCentre_m(), 0.0); });
+          [this] { addLesion(tr("Add a lesion"), organCentre_m_, 0.0); });
   connect(removeLesion_, &QPushButton::clicked, this, [this] {
     const int index = selectedLesion_;
     if (index < 0) return;
@@ -958,6 +941,11 @@ void ScenarioEditor::rebuildOrgan() {
   if (scene_) viewport_->renderWindow()->RemoveRenderer(scene_->renderer());
   overlay_.reset();
   organ_ = std::move(organ);
+  const NodeArray& p = organ_->mesh.rest_position_m;
+  organCentre_m_.setZero();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    organCentre_m_ += Eigen::Vector3d(p.x[i], p.y[i], p.z[i]);
+  if (p.size() > 0) organCentre_m_ /= double(p.size());
   scene_ = std::make_unique<LiverScene>(organ_->mesh, organ_->visual);
   scene_->set_opacity(0.35);
   overlay_ = std::make_unique<ScenarioOverlay>(scene_->renderer());
@@ -966,14 +954,6 @@ void ScenarioEditor::rebuildOrgan() {
   showOverlay();
   organStatus_->setText(QString::fromStdString(organ_->description));
   statusBar()->showMessage(tr("Organ: %1").arg(QString::fromStdString(organ_->description)));
-}
-
-Eigen::Vector3d ScenarioEditor::organCentre_m() const {
-  if (!organ_) return Eigen::Vector3d::Zero();
-  const NodeArray& p = organ_->mesh.rest_position_m;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < p.size(); ++i) sum += Eigen::Vector3d(p.x[i], p.y[i], p.z[i]);
-  return p.size() ? Eigen::Vector3d(sum / double(p.size())) : sum;
 }
 
 void ScenarioEditor::showDocument() {
@@ -1098,16 +1078,16 @@ void ScenarioEditor::showOverlay() {
   const Scenario& s = document_.scenario();
   std::vector<LesionMarker> lesions;
   for (std::size_t i = 0; i < s.lesions.size(); ++i)
-    lesions.push_back(
-        {metres(s.lesions[i].centre_mm), metres(s.lesions[i].radii_mm), int(i) == selectedLesion_});
+    lesions.push_back({to_metres(s.lesions[i].centre_mm), to_metres(s.lesions[i].radii_mm),
+                       int(i) == selectedLesion_});
   overlay_->show_lesions(lesions);
   std::vector<std::pair<Eigen::Vector3d, double>> balls;
   for (const FixedBall& b : s.organ.fixed_balls)
-    balls.emplace_back(metres(b.centre_mm), b.radius_mm * kMetresPerMm);
+    balls.emplace_back(to_metres(b.centre_mm), b.radius_mm * kMetresPerMm);
   overlay_->show_fixed_balls(balls);
   if (s.task.planned_plane)
     overlay_->show_plane(PlaneMarker{
-        metres(s.task.planned_plane->point_mm),
+        to_metres(s.task.planned_plane->point_mm),
         Eigen::Vector3d(s.task.planned_plane->normal[0], s.task.planned_plane->normal[1],
                         s.task.planned_plane->normal[2])});
   else if (drag_ != Drag::plane)
@@ -1116,7 +1096,7 @@ void ScenarioEditor::showOverlay() {
     const auto& d = s.parenchyma.fibres->direction;
     const Eigen::Vector3d direction(d[0], d[1], d[2]);
     if (direction.norm() > 0.0)
-      overlay_->show_fibre_direction(ArrowMarker{organCentre_m(), direction.normalized(), 0.08});
+      overlay_->show_fibre_direction(ArrowMarker{organCentre_m_, direction.normalized(), 0.08});
     else
       overlay_->show_fibre_direction(std::nullopt);
   } else {
@@ -1219,7 +1199,7 @@ void ScenarioEditor::addLesion(const QString& text, const Eigen::Vector3d& point
   int n = int(s.lesions.size()) + 1;
   while (taken("lesion " + std::to_string(n))) ++n;
   lesion.name = "lesion " + std::to_string(n);
-  lesion.centre_mm = millimetres(
+  lesion.centre_mm = to_millimetres(
       depth_mm > 0.0 ? point_m + viewDirection() * (lesion.radii_mm[0] + depth_mm) * kMetresPerMm
                      : point_m);
   const int index = int(s.lesions.size());
@@ -1257,7 +1237,7 @@ int ScenarioEditor::lesionAt(QPoint display) const {
   int best = -1;
   double bestDistance = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < s.lesions.size(); ++i) {
-    const Eigen::Vector3d centre = metres(s.lesions[i].centre_mm);
+    const Eigen::Vector3d centre = to_metres(s.lesions[i].centre_mm);
     const double radius_m =
         *std::max_element(s.lesions[i].radii_mm.begin(), s.lesions[i].radii_mm.end()) *
         kMetresPerMm;
@@ -1283,7 +1263,7 @@ bool ScenarioEditor::pressAt(QPoint display, Qt::MouseButton button,
     if (const int lesion = lesionAt(display); lesion >= 0) {
       selectLesion(lesion);
       lesionAtPress_ = s.lesions[lesion];
-      const Eigen::Vector3d centre = metres(lesionAtPress_.centre_mm);
+      const Eigen::Vector3d centre = to_metres(lesionAtPress_.centre_mm);
       dragOffset_m_ = centre - scene_->display_to_world(display.x(), display.y(), centre);
       drag_ = modifiers & Qt::ShiftModifier ? Drag::resizeLesion : Drag::moveLesion;
       return true;
@@ -1302,13 +1282,13 @@ bool ScenarioEditor::pressAt(QPoint display, Qt::MouseButton button,
     case Mode::pickGraspPoint:
       if (!hit) return true;
       document_.edit(tr("Set the grasp point"),
-                     [&](Scenario& e) { e.task.grasp_point_mm = millimetres(hit->point_m); });
+                     [&](Scenario& e) { e.task.grasp_point_mm = to_millimetres(hit->point_m); });
       setMode(Mode::view);
       statusBar()->showMessage(tr("The grasp point is set."));
       return true;
     case Mode::drawPlane:
       planeStart_m_ =
-          hit ? hit->point_m : scene_->display_to_world(display.x(), display.y(), organCentre_m());
+          hit ? hit->point_m : scene_->display_to_world(display.x(), display.y(), organCentre_m_);
       drag_ = Drag::plane;
       return true;
     case Mode::paintFixed:
@@ -1331,7 +1311,7 @@ void ScenarioEditor::paintAt(QPoint display) {
   document_.edit(
       tr("Paint a fixed region"),
       [&](Scenario& s) {
-        s.organ.fixed_balls.push_back(FixedBall{millimetres(hit->point_m), radius_mm});
+        s.organ.fixed_balls.push_back(FixedBall{to_millimetres(hit->point_m), radius_mm});
       },
       kPaint);
 }
@@ -1340,18 +1320,18 @@ void ScenarioEditor::moveTo(QPoint display) {
   if (!scene_ || drag_ == Drag::none) return;
   switch (drag_) {
     case Drag::moveLesion: {
-      const Eigen::Vector3d centre = metres(lesionAtPress_.centre_mm);
+      const Eigen::Vector3d centre = to_metres(lesionAtPress_.centre_mm);
       const Eigen::Vector3d moved =
           scene_->display_to_world(display.x(), display.y(), centre) + dragOffset_m_;
       const int index = selectedLesion_;
       document_.edit(
           tr("Move the lesion"),
-          [&](Scenario& s) { s.lesions.at(index).centre_mm = millimetres(moved); }, kMoveLesion);
+          [&](Scenario& s) { s.lesions.at(index).centre_mm = to_millimetres(moved); }, kMoveLesion);
       break;
     }
     case Drag::resizeLesion: {
       // The radii scale with the cursor's distance from the centre on the screen.
-      const Eigen::Vector2d c = scene_->world_to_display(metres(lesionAtPress_.centre_mm));
+      const Eigen::Vector2d c = scene_->world_to_display(to_metres(lesionAtPress_.centre_mm));
       const double from = (Eigen::Vector2d(pressAt_.x(), pressAt_.y()) - c).norm();
       const double to = (Eigen::Vector2d(display.x(), display.y()) - c).norm();
       if (from < 1.0) return;
@@ -1394,7 +1374,8 @@ void ScenarioEditor::releaseAt(QPoint display) {
       const Eigen::Vector3d middle = 0.5 * (planeStart_m_ + end);
       drag_ = Drag::none;
       document_.edit(tr("Draw the planned plane"), [&](Scenario& s) {
-        s.task.planned_plane = PlaneSpec{millimetres(middle), {normal.x(), normal.y(), normal.z()}};
+        s.task.planned_plane =
+            PlaneSpec{to_millimetres(middle), {normal.x(), normal.y(), normal.z()}};
       });
     }
   }
@@ -1409,8 +1390,8 @@ void ScenarioEditor::showErrors(const QString& title, const char* boxName,
                                 const std::vector<ScenarioError>& errors) {
   statusBar()->showMessage(title);
   // Window-modal but not blocking, so that the caller (and a test) goes on.
-  auto* box =
-      new QMessageBox(QMessageBox::Warning, title, problemsText(errors), QMessageBox::Ok, this);
+  auto* box = new QMessageBox(QMessageBox::Warning, title, scenarioErrorsText(errors),
+                              QMessageBox::Ok, this);
   box->setObjectName(boxName);
   box->setAttribute(Qt::WA_DeleteOnClose);
   box->open();
@@ -1496,8 +1477,7 @@ void ScenarioEditor::updateRecentMenu() {
 
 void ScenarioEditor::tryIt() {
   // What would be refused on saving is refused here too, with the same messages.
-  std::vector<ScenarioError> errors = validate(document_.scenario());
-  if (errors.empty()) errors = read_scenario(write_scenario(document_.scenario())).errors;
+  const std::vector<ScenarioError> errors = ScenarioDocument::problems(document_.scenario());
   if (!errors.empty()) {
     showErrors(tr("The scenario cannot run: fix these first"), "tryErrorsBox", errors);
     return;

@@ -121,7 +121,6 @@ class ScenarioEditor : public QMainWindow {
   void releaseAt(QPoint display);
   int lesionAt(QPoint display) const;  // -1: none
   Eigen::Vector3d viewDirection() const;
-  Eigen::Vector3d organCentre_m() const;
   void paintAt(QPoint display);
 
   // A label of what is set, and a button that clears it (an edit named `editText`).
@@ -149,7 +148,8 @@ class ScenarioEditor : public QMainWindow {
 
   ScenarioDocument document_;
   VtkViewport* viewport_ = nullptr;
-  std::optional<SceneSetup> organ_;  // the organ's mesh as shown
+  std::optional<SceneSetup> organ_;                          // the organ's mesh as shown
+  Eigen::Vector3d organCentre_m_ = Eigen::Vector3d::Zero();  // the mean of its nodes
   std::unique_ptr<LiverScene> scene_;
   std::unique_ptr<ScenarioOverlay> overlay_;
   QString organProblem_;

@@ -174,13 +174,18 @@ SteppingTiming time_stepping(const SimModel& model, SimState& state, const StepI
   return timing;
 }
 
+std::vector<PointLoad> seed_pull_loads(const TetMesh& mesh, const SimModel& model) {
+  std::vector<PointLoad> pull;
+  spread_load(make_load_patch(mesh, model, anterior_marked_node(mesh), 0.02),
+              kSeedPullDirection * 0.5, pull);
+  return pull;
+}
+
 SteppingTiming time_scene_under_pull(const SceneSetup& scene, double min_wall_s,
                                      std::shared_ptr<WorkerPool> workers) {
   const SimModel model = build_model(scene.mesh, scene.model_options);
   SimState state = make_rest_state(model, std::move(workers));
-  std::vector<PointLoad> pull;
-  spread_load(make_load_patch(scene.mesh, model, anterior_marked_node(scene.mesh), 0.02),
-              kSeedPullDirection * 0.5, pull);
+  const std::vector<PointLoad> pull = seed_pull_loads(scene.mesh, model);
   constexpr double kInterval_s = 1e-3;
   advance(model, state, {pull, {}}, kInterval_s);  // warm-up: first factorisation, caches
   return time_stepping(model, state, {pull, {}}, kInterval_s, min_wall_s);

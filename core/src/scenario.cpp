@@ -564,10 +564,6 @@ bool nearly_equal(double a, double b) {
   return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b));
 }
 
-Eigen::Vector3d metres(const Millimetres3& mm) {
-  return Eigen::Vector3d(mm[0], mm[1], mm[2]) * 1e-3;
-}
-
 // Where a point sits relative to a lesion's ellipsoid: < 1 inside.
 double ellipsoid_measure(const LesionSpec& lesion, const Eigen::Vector3d& point_m) {
   double sum = 0.0;
@@ -698,7 +694,7 @@ std::vector<ScenarioError> validate(const Scenario& s) {
                format_number(ratio.min) + " to " + format_number(ratio.max) +
                " times the parenchyma's " + format_number(t.elastic.youngs_modulus_pa) + " Pa (" +
                std::string(ratio.why) + ")");
-    if (built_in && !(liver.value(metres(lesion.centre_mm)) < 0.0))
+    if (built_in && !(liver.value(to_metres(lesion.centre_mm)) < 0.0))
       fail(at + ".centre_mm", "(" + format_number(lesion.centre_mm[0]) + ", " +
                                   format_number(lesion.centre_mm[1]) + ", " +
                                   format_number(lesion.centre_mm[2]) +
@@ -724,7 +720,7 @@ std::vector<ScenarioError> validate(const Scenario& s) {
       fail("tools", "task " + std::string(task_name(kind)) + " needs the " +
                         std::string(tool_name(tool)) + ": expected it among the tools");
   if (built_in && task.kind == TaskKind::retract_lobe &&
-      !(liver.value(metres(task.grasp_point_mm)) < 0.01))
+      !(liver.value(to_metres(task.grasp_point_mm)) < 0.01))
     fail("task.grasp_point_mm",
          "is invalid: expected a point on or inside the built-in liver "
          "(within 10 mm of its surface)");
@@ -993,7 +989,8 @@ SceneSetup build_scene(const Scenario& s, const std::filesystem::path& scenario_
     for (NodeIndex n : options.fixed_nodes) fixed[n] = 1;
     for (NodeIndex n : surface.nodes)
       for (const FixedBall& ball : s.organ.fixed_balls)
-        if ((mesh.rest_position_m.at(n) - metres(ball.centre_mm)).norm() <= ball.radius_mm * 1e-3)
+        if ((mesh.rest_position_m.at(n) - to_metres(ball.centre_mm)).norm() <=
+            ball.radius_mm * 1e-3)
           fixed[n] = 1;
     options.fixed_nodes.clear();
     for (std::size_t n = 0; n < fixed.size(); ++n)

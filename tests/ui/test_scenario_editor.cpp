@@ -38,10 +38,6 @@ namespace {
 
 constexpr int kTimeoutMs = 60'000;
 
-Eigen::Vector3d metres(const Millimetres3& mm) {
-  return Eigen::Vector3d(mm[0], mm[1], mm[2]) * 1e-3;
-}
-
 class ScenarioEditorTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -147,7 +143,7 @@ TEST_F(ScenarioEditorTest, ALesionPlacedByClickingIsEditedUndoneRedoneSavedAndRe
   // Under the clicked point, away from the viewer by its radius and 2 mm.
   const Eigen::Vector3d expected =
       hit->point_m + viewDirection() * (placed.radii_mm[0] + 2.0) * 1e-3;
-  EXPECT_LT((metres(placed.centre_mm) - expected).norm(), 1e-6);
+  EXPECT_LT((to_metres(placed.centre_mm) - expected).norm(), 1e-6);
   EXPECT_EQ(editor_->overlay()->shown_lesion_count(), before + 1);
 
   // Its stiffness, typed into the Lesion panel.
@@ -193,17 +189,18 @@ TEST_F(ScenarioEditorTest, ALesionPlacedByClickingIsEditedUndoneRedoneSavedAndRe
 TEST_F(ScenarioEditorTest, DraggingALesionMovesItInTheViewPlaneAndShiftDraggingResizesIt) {
   ASSERT_FALSE(scenario().lesions.empty());
   const LesionSpec start = scenario().lesions[0];
-  const QPoint centre = toWidget(scene().world_to_display(metres(start.centre_mm)));
+  const QPoint centre = toWidget(scene().world_to_display(to_metres(start.centre_mm)));
   const QPoint to = centre + QPoint(30, 12);
   const Eigen::Vector3d expected =
-      scene().display_to_world(toDisplay(to).x(), toDisplay(to).y(), metres(start.centre_mm));
+      scene().display_to_world(toDisplay(to).x(), toDisplay(to).y(), to_metres(start.centre_mm));
   drag(centre, to);
   const LesionSpec moved = scenario().lesions[0];
   // Within the pixel rounding of a 2 cm-wide view.
-  EXPECT_LT((metres(moved.centre_mm) - expected).norm(), 1e-3);
-  EXPECT_GT((metres(moved.centre_mm) - metres(start.centre_mm)).norm(), 5e-3);
+  EXPECT_LT((to_metres(moved.centre_mm) - expected).norm(), 1e-3);
+  EXPECT_GT((to_metres(moved.centre_mm) - to_metres(start.centre_mm)).norm(), 5e-3);
   // In the plane facing the viewer: no move along the view.
-  EXPECT_NEAR((metres(moved.centre_mm) - metres(start.centre_mm)).dot(viewDirection()), 0.0, 1e-6);
+  EXPECT_NEAR((to_metres(moved.centre_mm) - to_metres(start.centre_mm)).dot(viewDirection()), 0.0,
+              1e-6);
   EXPECT_EQ(moved.radii_mm, start.radii_mm);
   trigger("undoAction");  // the whole drag is one step
   EXPECT_EQ(scenario().lesions[0], start);
@@ -228,13 +225,13 @@ TEST_F(ScenarioEditorTest, PaintingAStrokeHoldsTheSurfaceUnderItAsOneStep) {
   for (std::size_t i = 0; i < balls.size(); ++i) {
     EXPECT_EQ(balls[i].radius_mm, 8.0);
     // Each on the surface: where a pick along the view meets it.
-    const Eigen::Vector2d d = scene().world_to_display(metres(balls[i].centre_mm));
+    const Eigen::Vector2d d = scene().world_to_display(to_metres(balls[i].centre_mm));
     const auto hit = scene().pick(int(std::lround(d.x())), int(std::lround(d.y())));
     ASSERT_TRUE(hit);
-    EXPECT_LT((hit->point_m - metres(balls[i].centre_mm)).norm(), 2e-3);
+    EXPECT_LT((hit->point_m - to_metres(balls[i].centre_mm)).norm(), 2e-3);
     // Half a brush radius apart at least: a stroke, not a pile.
     if (i > 0)
-      EXPECT_GE((metres(balls[i].centre_mm) - metres(balls[i - 1].centre_mm)).norm(), 4e-3);
+      EXPECT_GE((to_metres(balls[i].centre_mm) - to_metres(balls[i - 1].centre_mm)).norm(), 4e-3);
   }
   EXPECT_EQ(editor_->overlay()->shown_fixed_ball_count(), balls.size());
   // The painted balls hold nodes in the built model.
@@ -270,7 +267,7 @@ TEST_F(ScenarioEditorTest, ADrawnPlaneHoldsTheLineAndTheDirectionOfView) {
   const Eigen::Vector3d end =
       scene().display_to_world(toDisplay(to).x(), toDisplay(to).y(), start->point_m);
   EXPECT_NEAR(n.dot((end - start->point_m).normalized()), 0.0, 1e-9);
-  EXPECT_NEAR(n.dot(start->point_m - metres(plane.point_mm)), 0.0, 1e-9);  // the line in it
+  EXPECT_NEAR(n.dot(start->point_m - to_metres(plane.point_mm)), 0.0, 1e-9);  // the line in it
   // Another task drops it: a plane belongs to a resection.
   kind->setCurrentIndex(kind->findData(int(TaskKind::palpate_lesion)));
   EXPECT_FALSE(scenario().task.planned_plane);
@@ -329,7 +326,7 @@ TEST_F(ScenarioEditorTest, TheRubricTheLawsTheIntegratorAndTheGraspPointAreEdite
   const auto hit = pickAt(at);
   ASSERT_TRUE(hit);
   click(at);
-  EXPECT_LT((metres(scenario().task.grasp_point_mm) - hit->point_m).norm(), 1e-9);
+  EXPECT_LT((to_metres(scenario().task.grasp_point_mm) - hit->point_m).norm(), 1e-9);
   EXPECT_EQ(editor_->mode(), ScenarioEditor::Mode::view);
   field<QDoubleSpinBox>("liftMm")->setValue(40.0);
 

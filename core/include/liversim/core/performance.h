@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 namespace liversim {
 
@@ -66,9 +67,12 @@ struct SteppingTiming {
 SteppingTiming time_stepping(const SimModel& model, SimState& state, const StepInputs& inputs,
                              double interval_s, double min_wall_s);
 
+// The stepping benchmarks' load: the seed's 0.5 N pull, spread over the free surface within
+// 20 mm of the anterior marked point (anterior_marked_node), as a tool's jaws would hold it.
+std::vector<PointLoad> seed_pull_loads(const TetMesh& mesh, const SimModel& model);
+
 // What a scene costs to simulate (the editor's "effects and their cost"): its model built, then
-// stepped from rest in 1 ms intervals under the seed's 0.5 N pull (spread within 20 mm of the
-// anterior marked point, as the benchmark's stepping rows) for at least min_wall_s on `workers`
+// stepped from rest in 1 ms intervals under seed_pull_loads for at least min_wall_s on `workers`
 // (none: this thread). Throws what build_model throws.
 SteppingTiming time_scene_under_pull(const SceneSetup& scene, double min_wall_s,
                                      std::shared_ptr<WorkerPool> workers = nullptr);

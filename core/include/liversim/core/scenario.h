@@ -25,6 +25,12 @@ inline constexpr std::string_view kScenarioFormatName = "liversim-scenario";
 
 using Millimetres3 =
     std::array<double, 3>;  // a point or a size, in mm, scene axes (liver_geometry.h)
+inline Eigen::Vector3d to_metres(const Millimetres3& mm) {
+  return Eigen::Vector3d(mm[0], mm[1], mm[2]) * 1e-3;
+}
+inline Millimetres3 to_millimetres(const Eigen::Vector3d& m) {
+  return {m.x() * 1e3, m.y() * 1e3, m.z() * 1e3};
+}
 
 enum class OrganGeometry {
   built_in_liver,  // the generated liver (liver_geometry.h) at target_tet_count
