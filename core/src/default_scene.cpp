@@ -26,6 +26,7 @@ SceneSetup default_scene(int tet_count) {
     on_shape.push_back(shape.closest_surface_point(setup.mesh.rest_position_m.at(n)));
   setup.visual = embed_visual_surface(setup.mesh, surface, on_shape);
   setup.description = "built-in liver, " + std::to_string(setup.mesh.tet_count()) + " tetrahedra";
+  setup.built_in_liver_tets = tet_count;
   return setup;
 }
 

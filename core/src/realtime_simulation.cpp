@@ -416,12 +416,48 @@ void RealtimeSimulation::replay(std::span<const SimulationInput> inputs) {
         change_tool(input.tool);
         break;
       case SimulationInput::Kind::springs:
+        // A log from another model (or a damaged one) must not index past this one's nodes.
+        for (const NodeSpring& spring : input.springs)
+          if (spring.node < 0 || static_cast<std::size_t>(spring.node) >= model_->node_count)
+            throw std::invalid_argument("replay: a spring holds node " +
+                                        std::to_string(spring.node) + " of a model of " +
+                                        std::to_string(model_->node_count) + " nodes");
         active_springs_.assign(input.springs.begin(), input.springs.end());
         break;
       case SimulationInput::Kind::cycle:
-        if (!halted_.load()) advance_cycle(input.steps, input.check_energy);
+        if (halted_.load()) break;
+        advance_cycle(input.steps, input.check_energy);
+        publish_cycle();  // as the live loop does: the snapshot shows the replayed cycle
         break;
     }
+}
+
+void RealtimeSimulation::publish_cycle() {
+  const bool tool_acts = tools_ && active_tool_;
+  SimulationSnapshot& out = snapshots_.back();
+  // Same size: copies without allocating (a cut's new size allocates once).
+  out.position_m.x = state_.position_m.x;
+  out.position_m.y = state_.position_m.y;
+  out.position_m.z = state_.position_m.z;
+  out.time_s = state_.time_s;
+  out.step_count = state_.step_count;
+  // The local model of the force on the tool: its F0 is the snapshot's tool force.
+  const LocalForceModel force_model =
+      tool_acts ? tool_force_model(tools_->springs(), state_.position_m,
+                                   active_tool_->pose.origin_m, haptic_servo_period_s())
+                : LocalForceModel{};
+  out.tool_force_n = force_model.force_n;
+  out.tool_grasping = tool_acts && tools_->grasping();
+  out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
+  out.blade_cutting = tool_acts && blade_in_tissue_;
+  out.tool = tool_acts ? active_tool_ : std::nullopt;
+  out.device_sample = device_sample_;
+  if (haptic_servo_) haptic_servo_->publish(force_model);
+  observe_outcome();
+  out.model = model_;
+  out.topology_version = topology_version_;
+  out.resected_volume_m3 = resected_volume_m3_;
+  snapshots_.publish();
 }
 
 void RealtimeSimulation::run() {
@@ -460,36 +496,17 @@ void RealtimeSimulation::run() {
       const bool check_energy = close_books;  // one pass over the elements, once per window
       close_books = false;
       if (logging_inputs_.load(std::memory_order_relaxed))
-        log_input({SimulationInput::Kind::cycle, std::nullopt, {}, due.steps, check_energy});
+        log_input(
+            {SimulationInput::Kind::cycle,
+             std::nullopt,
+             {},
+             due.steps,
+             check_energy,
+             haptic_servo_ ? haptic_servo_->now_s() : std::numeric_limits<double>::quiet_NaN()});
       const GuardedReport guarded = advance_cycle(due.steps, check_energy);
-      const bool tool_acts = tools_ && active_tool_;
-      const StepReport& report = guarded.steps;
       window_integrating_s += Seconds(Clock::now() - cycle_start).count();
-      accumulate(window_report, report);
-      SimulationSnapshot& out = snapshots_.back();
-      // Same size: copies without allocating (a cut's new size allocates once).
-      out.position_m.x = state_.position_m.x;
-      out.position_m.y = state_.position_m.y;
-      out.position_m.z = state_.position_m.z;
-      out.time_s = state_.time_s;
-      out.step_count = state_.step_count;
-      // The local model of the force on the tool: its F0 is the snapshot's tool force.
-      const LocalForceModel force_model =
-          tool_acts ? tool_force_model(tools_->springs(), state_.position_m,
-                                       active_tool_->pose.origin_m, haptic_servo_period_s())
-                    : LocalForceModel{};
-      out.tool_force_n = force_model.force_n;
-      out.tool_grasping = tool_acts && tools_->grasping();
-      out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
-      out.blade_cutting = tool_acts && blade_in_tissue_;
-      out.tool = tool_acts ? active_tool_ : std::nullopt;
-      out.device_sample = device_sample_;
-      if (haptic_servo_) haptic_servo_->publish(force_model);
-      observe_outcome();
-      out.model = model_;
-      out.topology_version = topology_version_;
-      out.resected_volume_m3 = resected_volume_m3_;
-      snapshots_.publish();
+      accumulate(window_report, guarded.steps);
+      publish_cycle();
     } else {
       // Sleep towards the next step, but wake often enough to stop and to pick up springs.
       const double sleep_s = std::clamp(clock.time_to_next_step_s(), 0.5e-3, 2e-3);

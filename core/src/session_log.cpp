@@ -9,10 +9,11 @@ namespace liversim {
 
 namespace {
 
-constexpr std::array<std::string_view, 9> kEventNames = {
-    "grasp",           "release",       "cut",
-    "excessive_force", "lesion_breach", "simulation_recovery",
-    "device_fault",    "tool_selected", "lesion_marked"};
+constexpr std::array<std::string_view, 10> kEventNames = {"grasp",         "release",
+                                                          "cut",           "excessive_force",
+                                                          "lesion_breach", "simulation_recovery",
+                                                          "device_fault",  "tool_selected",
+                                                          "lesion_marked", "integrator_changed"};
 
 // Layout 1: "LSF1", the frame count (u32), then one column per quantity, frame by frame: time,
 // position x, y, z, velocity x, y, z, force x, y, z (IEEE doubles), buttons (u32). Columns keep
@@ -168,6 +169,168 @@ std::vector<ServoFrame> decode_frame_chunk(std::span<const std::uint8_t> bytes) 
     frames[i].sample.buttons = get_u32(bytes.data() + kHeaderBytes + 80 * n + i * 4);
   }
   return frames;
+}
+
+namespace {
+
+// Input chunk layout 1: "LSI1", the input count (u32), then one record per input, little-endian:
+// its kind (u8: 0 tool, 1 springs, 2 cycle) and
+// - tool: present (u8); if 1: tool kind (u8), blade armed (u8) and 16 doubles: origin x, y, z (m),
+//   orientation w, x, y, z, jaw opening, then ToolGeometry's 8 lengths in declaration order;
+// - springs: count (u32), then per spring: node (i32), anchor x, y, z (m), stiffness (N/m),
+//   damping (N·s/m) as doubles;
+// - cycle: steps (u32), energy books closed (u8), servo time (double, s).
+constexpr std::array<char, 4> kInputMagic = {'L', 'S', 'I', '1'};
+
+template <typename Visit>
+void for_each_tool_double(Tool& tool, Visit&& visit) {
+  ToolGeometry& g = tool.geometry;
+  for (double* value :
+       {&tool.pose.origin_m.x(), &tool.pose.origin_m.y(), &tool.pose.origin_m.z(),
+        &tool.pose.orientation.w(), &tool.pose.orientation.x(), &tool.pose.orientation.y(),
+        &tool.pose.orientation.z(), &tool.jaw_opening, &g.shaft_radius_m, &g.shaft_length_m,
+        &g.probe_tip_radius_m, &g.jaw_length_m, &g.jaw_radius_m, &g.max_jaw_angle_rad,
+        &g.blade_length_m, &g.blade_half_thickness_m})
+    visit(*value);
+}
+
+class ByteWriter {
+ public:
+  void u8(std::uint8_t value) { bytes_.push_back(value); }
+  void u32(std::uint32_t value) {
+    bytes_.resize(bytes_.size() + 4);
+    put_u32(bytes_.data() + bytes_.size() - 4, value);
+  }
+  void f64(double value) {
+    bytes_.resize(bytes_.size() + 8);
+    put_f64(bytes_.data() + bytes_.size() - 8, value);
+  }
+  std::vector<std::uint8_t>& bytes() { return bytes_; }
+
+ private:
+  std::vector<std::uint8_t> bytes_;
+};
+
+// Reads with bounds checks: running out names the input being read.
+class ByteReader {
+ public:
+  explicit ByteReader(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
+  std::uint8_t u8() { return *take(1); }
+  std::uint32_t u32() { return get_u32(take(4)); }
+  double f64() { return get_f64(take(8)); }
+  std::size_t remaining() const { return bytes_.size() - at_; }
+  std::size_t input = 0;  // the input being read, for messages
+
+ private:
+  const std::uint8_t* take(std::size_t n) {
+    if (remaining() < n)
+      throw StorageError("an input chunk ends inside input " + std::to_string(input));
+    at_ += n;
+    return bytes_.data() + at_ - n;
+  }
+  std::span<const std::uint8_t> bytes_;
+  std::size_t at_ = 0;
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_input_chunk(std::span<const SimulationInput> inputs) {
+  ByteWriter out;
+  for (char c : kInputMagic) out.u8(static_cast<std::uint8_t>(c));
+  out.u32(static_cast<std::uint32_t>(inputs.size()));
+  for (const SimulationInput& input : inputs) {
+    out.u8(static_cast<std::uint8_t>(input.kind));
+    switch (input.kind) {
+      case SimulationInput::Kind::tool: {
+        out.u8(input.tool ? 1 : 0);
+        if (!input.tool) break;
+        Tool tool = *input.tool;
+        out.u8(static_cast<std::uint8_t>(tool.kind));
+        out.u8(tool.blade_armed ? 1 : 0);
+        for_each_tool_double(tool, [&](double value) { out.f64(value); });
+        break;
+      }
+      case SimulationInput::Kind::springs:
+        out.u32(static_cast<std::uint32_t>(input.springs.size()));
+        for (const NodeSpring& spring : input.springs) {
+          out.u32(static_cast<std::uint32_t>(spring.node));
+          for (double value : {spring.anchor_m.x(), spring.anchor_m.y(), spring.anchor_m.z(),
+                               spring.stiffness_n_per_m, spring.damping_n_s_per_m})
+            out.f64(value);
+        }
+        break;
+      case SimulationInput::Kind::cycle:
+        out.u32(static_cast<std::uint32_t>(input.steps));
+        out.u8(input.check_energy ? 1 : 0);
+        out.f64(input.servo_time_s);
+        break;
+    }
+  }
+  return std::move(out.bytes());
+}
+
+std::vector<SimulationInput> decode_input_chunk(std::span<const std::uint8_t> bytes) {
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kInputMagic.data(), kInputMagic.size()) != 0)
+    throw StorageError("an input chunk does not start with the layout-1 mark \"LSI1\"");
+  ByteReader in(bytes.subspan(4));
+  const std::uint32_t count = in.u32();
+  // Every input takes at least 2 bytes: a count beyond that is a damaged header.
+  if (count > in.remaining() / 2)
+    throw StorageError("an input chunk claims " + std::to_string(count) + " inputs in " +
+                       std::to_string(bytes.size()) + " bytes");
+  std::vector<SimulationInput> inputs(count);
+  for (SimulationInput& input : inputs) {
+    const std::uint8_t kind = in.u8();
+    switch (kind) {
+      case 0: {
+        input.kind = SimulationInput::Kind::tool;
+        if (in.u8() == 0) break;
+        Tool tool;
+        const std::uint8_t tool_kind = in.u8();
+        if (tool_kind >= kToolKinds.size())
+          throw StorageError("input " + std::to_string(in.input) + " of an input chunk has tool " +
+                             std::to_string(tool_kind) + ", which is no tool");
+        tool.kind = static_cast<ToolKind>(tool_kind);
+        tool.blade_armed = in.u8() != 0;
+        for_each_tool_double(tool, [&](double& value) { value = in.f64(); });
+        input.tool = tool;
+        break;
+      }
+      case 1: {
+        input.kind = SimulationInput::Kind::springs;
+        const std::uint32_t springs = in.u32();
+        if (springs > in.remaining() / 44)
+          throw StorageError("an input chunk ends inside input " + std::to_string(in.input));
+        input.springs.resize(springs);
+        for (NodeSpring& spring : input.springs) {
+          spring.node = static_cast<NodeIndex>(in.u32());
+          for (double* value : {&spring.anchor_m.x(), &spring.anchor_m.y(), &spring.anchor_m.z(),
+                                &spring.stiffness_n_per_m, &spring.damping_n_s_per_m})
+            *value = in.f64();
+        }
+        break;
+      }
+      case 2:
+        input.kind = SimulationInput::Kind::cycle;
+        input.steps = static_cast<int>(in.u32());
+        // The live loop's cap is far below this; more would be a damaged record.
+        if (input.steps < 1 || input.steps > 1'000'000)
+          throw StorageError("input " + std::to_string(in.input) +
+                             " of an input chunk is a cycle of " + std::to_string(input.steps) +
+                             " steps");
+        input.check_energy = in.u8() != 0;
+        input.servo_time_s = in.f64();
+        break;
+      default:
+        throw StorageError("input " + std::to_string(in.input) + " of an input chunk has kind " +
+                           std::to_string(kind) + ", which is none of tool, springs or cycle");
+    }
+    ++in.input;
+  }
+  if (in.remaining() != 0)
+    throw StorageError("an input chunk has " + std::to_string(in.remaining()) +
+                       " bytes after its last input");
+  return inputs;
 }
 
 }  // namespace liversim

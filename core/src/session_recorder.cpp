@@ -1,6 +1,7 @@
 #include "liversim/core/session_recorder.h"
 
 #include <chrono>
+#include <iterator>
 #include <stdexcept>
 
 namespace liversim {
@@ -24,6 +25,15 @@ SessionRecorder::~SessionRecorder() {
 void SessionRecorder::record_event(SessionEvent event) {
   std::lock_guard lock(mutex_);
   events_.push_back(std::move(event));
+}
+
+void SessionRecorder::record_inputs(std::vector<SimulationInput> inputs) {
+  if (inputs.empty()) return;
+  std::lock_guard lock(mutex_);
+  if (inputs_.empty())
+    inputs_ = std::move(inputs);
+  else
+    std::move(inputs.begin(), inputs.end(), std::back_inserter(inputs_));
 }
 
 std::string SessionRecorder::error() const {
@@ -61,11 +71,13 @@ bool SessionRecorder::write_waiting() {
   {
     std::lock_guard lock(mutex_);
     event_batch_.swap(events_);
+    input_batch_.swap(inputs_);
   }
   try {
     if (!frame_batch_.empty()) store_.append_frames(session_, frame_batch_);
     if (!event_batch_.empty()) store_.append_events(session_, event_batch_);
-    if (!frame_batch_.empty() || !event_batch_.empty()) store_.commit();
+    if (!input_batch_.empty()) store_.append_inputs(session_, input_batch_);
+    if (!frame_batch_.empty() || !event_batch_.empty() || !input_batch_.empty()) store_.commit();
   } catch (const StorageError& e) {
     std::lock_guard lock(mutex_);
     error_ = e.what();
@@ -73,6 +85,7 @@ bool SessionRecorder::write_waiting() {
   }
   frames_written_ += static_cast<std::int64_t>(frame_batch_.size());
   event_batch_.clear();
+  input_batch_.clear();
   return true;
 }
 

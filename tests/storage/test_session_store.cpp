@@ -209,52 +209,177 @@ TEST(SessionStore, GradesAndCommentsAreKeptPerSessionAndReadBackAfterReopening) 
 // made by that version's code) opens for writing, migrated, with everything it held; for
 // reading only it is refused until migrated. Sessions of earlier versions have no mapping; new
 // ones keep theirs exactly.
-TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
-  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 2) << "add a file of the version before";
-  const fs::path file = fresh_database("migrated-from-v1");
-  fs::copy_file(fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "sessions-v1.sqlite", file);
-  const std::string message = open_error(file, SqliteSessionStore::Access::read_only);
-  EXPECT_NE(message.find("schema version 1 needs migrating"), std::string::npos) << message;
-  WorkspaceMapping mapping;
-  mapping.scale = 1.5;
-  mapping.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()));
-  mapping.offset_m = {0.01, -0.02, 0.03};
-  std::int64_t added = 0;
-  {
-    SqliteSessionStore store(file);
-    SessionStart start = start_of("Trainee C", "{}");
-    start.mapping = mapping;
-    added = store.begin_session(start);
-  }
+int user_version(const fs::path& file) {
   sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  EXPECT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
   sqlite3_stmt* version = nullptr;
-  ASSERT_EQ(sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &version, nullptr), SQLITE_OK);
-  ASSERT_EQ(sqlite3_step(version), SQLITE_ROW);
-  EXPECT_EQ(sqlite3_column_int(version, 0), 2);
+  EXPECT_EQ(sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &version, nullptr), SQLITE_OK);
+  EXPECT_EQ(sqlite3_step(version), SQLITE_ROW);
+  const int result = sqlite3_column_int(version, 0);
   sqlite3_finalize(version);
   sqlite3_close(db);
+  return result;
+}
 
+// A file of every earlier version, written by that version's code (the writer child, then a
+// metric, an event and a grade added in SQL; the v2 file's mapping too): everything in it survives
+// the migration to the current version, and a session added after has everything the current
+// version stores.
+TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
+  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 3) << "add a file of the version before";
+  struct Earlier {
+    int version;
+    double peak_force_n;
+    std::string event_detail, grade_comment;
+    std::optional<double> mapping_scale;
+  };
+  for (const Earlier& earlier : {Earlier{1, 0.75, "probe", "v1 grade", std::nullopt},
+                                 Earlier{2, 0.5, "scalpel", "v2 grade", 2.0}}) {
+    const std::string name = "sessions-v" + std::to_string(earlier.version) + ".sqlite";
+    SCOPED_TRACE(name);
+    const fs::path file = fresh_database("migrated-from-v" + std::to_string(earlier.version));
+    fs::copy_file(fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / name, file);
+    ASSERT_EQ(user_version(file), earlier.version);
+    const std::string message = open_error(file, SqliteSessionStore::Access::read_only);
+    EXPECT_NE(
+        message.find("schema version " + std::to_string(earlier.version) + " needs migrating"),
+        std::string::npos)
+        << message;
+    WorkspaceMapping mapping;
+    mapping.scale = 1.5;
+    mapping.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()));
+    mapping.offset_m = {0.01, -0.02, 0.03};
+    ReplaySetup replay;
+    replay.built_in_liver_tets = 2500;
+    replay.integrator.kind = IntegratorKind::dopri5;
+    replay.integrator.tolerance_m = 2e-7;
+    const SimulationInput cycle{SimulationInput::Kind::cycle, std::nullopt, {}, 3, true, 0.25};
+    std::int64_t added = 0;
+    {
+      SqliteSessionStore store(file);
+      SessionStart start = start_of("Trainee C", "{}");
+      start.mapping = mapping;
+      start.replay = replay;
+      added = store.begin_session(start);
+      store.append_inputs(added, std::span(&cycle, 1));
+      store.commit();
+    }
+    EXPECT_EQ(user_version(file), SqliteSessionStore::kSchemaVersion);
+
+    SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
+    EXPECT_EQ(store.integrity_check(), "ok");
+    const std::vector<SessionSummary> sessions = store.sessions();
+    ASSERT_EQ(sessions.size(), 2u);
+    // The earlier version's session: complete, its 202 frames, metric, event and grade.
+    EXPECT_EQ(sessions[0].status, SessionStatus::complete);
+    EXPECT_EQ(sessions[0].frame_count, 202);
+    EXPECT_EQ(store.frames(sessions[0].id).size(), 202u);
+    EXPECT_EQ(sessions[0].mapping.has_value(), earlier.mapping_scale.has_value());
+    if (sessions[0].mapping) EXPECT_EQ(sessions[0].mapping->scale, *earlier.mapping_scale);
+    EXPECT_EQ(store.metrics(sessions[0].id),
+              (std::vector<MetricValue>{{"peak_force_n", earlier.peak_force_n}}));
+    ASSERT_EQ(store.events(sessions[0].id).size(), 1u);
+    EXPECT_EQ(store.events(sessions[0].id)[0].detail, earlier.event_detail);
+    ASSERT_EQ(store.grades(sessions[0].id).size(), 1u);
+    EXPECT_EQ(store.grades(sessions[0].id)[0].comment, earlier.grade_comment);
+    // Recorded before replays: nothing to replay, and said so (no setup), not an error.
+    EXPECT_FALSE(store.replay_setup(sessions[0].id));
+    EXPECT_TRUE(store.inputs(sessions[0].id).empty());
+    // The new session keeps its mapping and its replay exactly.
+    EXPECT_EQ(sessions[1].id, added);
+    ASSERT_TRUE(sessions[1].mapping);
+    EXPECT_EQ(sessions[1].mapping->scale, 1.5);
+    EXPECT_EQ(sessions[1].mapping->rotation.coeffs(), mapping.rotation.coeffs());
+    EXPECT_EQ(sessions[1].mapping->offset_m, mapping.offset_m);
+    const std::optional<ReplaySetup> read = store.replay_setup(added);
+    ASSERT_TRUE(read);
+    EXPECT_EQ(read->built_in_liver_tets, 2500);
+    EXPECT_EQ(read->integrator.kind, IntegratorKind::dopri5);
+    EXPECT_EQ(read->integrator.tolerance_m, 2e-7);
+    ASSERT_EQ(store.inputs(added).size(), 1u);
+    EXPECT_EQ(store.inputs(added)[0].servo_time_s, 0.25);
+  }
+}
+
+// The simulation's input log goes in chunks, one per commit, and reads back whole and in order,
+// with how the scene was built; a chunk damaged in the file is named with its session.
+TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {
+  const fs::path file = fresh_database("inputs");
+  std::int64_t session = 0;
+  std::vector<SimulationInput> written;
+  Tool probe;
+  probe.pose.origin_m = {0.01, 0.02, 0.03};
+  for (int k = 0; k < 500; ++k) {
+    probe.pose.origin_m.x() += 1e-4;
+    written.push_back({SimulationInput::Kind::tool, probe});
+    if (k % 50 == 0)
+      written.push_back(
+          {SimulationInput::Kind::springs, std::nullopt, {{k, {0.1, 0.2, 0.3}, 300.0, 1.0}}});
+    written.push_back(
+        {SimulationInput::Kind::cycle, std::nullopt, {}, 1 + k % 3, k % 30 == 0, 0.001 * k});
+  }
+  ReplaySetup replay;
+  replay.scenario_folder = "/srv/scenarios/ünïcode 'quoted'";
+  replay.integrator.kind = IntegratorKind::backward_euler;
+  replay.integrator.step_s = 0.005;
+  replay.integrator.newton_tolerance_m = 1e-10;
+  replay.integrator.max_newton_iterations = 12;
+  {
+    SqliteSessionStore store(file);
+    SessionStart start = start_of("Trainee R", "{\"title\": \"R\"}");
+    start.replay = replay;
+    session = store.begin_session(start);
+    // Chunks of uneven sizes, as a recorder's commits are.
+    for (std::size_t at = 0; at < written.size();) {
+      const std::size_t n = std::min<std::size_t>(written.size() - at, 1 + at % 97);
+      store.append_inputs(session, std::span(written).subspan(at, n));
+      store.commit();
+      at += n;
+    }
+    const std::int64_t without = store.begin_session(start_of("Trainee S", "{}"));
+    EXPECT_FALSE(store.replay_setup(without));
+  }
   SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
-  EXPECT_EQ(store.integrity_check(), "ok");
-  const std::vector<SessionSummary> sessions = store.sessions();
-  ASSERT_EQ(sessions.size(), 2u);
-  // The version-1 session: complete, its 202 frames, metric, event and grade, no mapping.
-  EXPECT_EQ(sessions[0].status, SessionStatus::complete);
-  EXPECT_EQ(sessions[0].frame_count, 202);
-  EXPECT_EQ(store.frames(sessions[0].id).size(), 202u);
-  EXPECT_FALSE(sessions[0].mapping);
-  EXPECT_EQ(store.metrics(sessions[0].id), (std::vector<MetricValue>{{"peak_force_n", 0.75}}));
-  ASSERT_EQ(store.events(sessions[0].id).size(), 1u);
-  EXPECT_EQ(store.events(sessions[0].id)[0].detail, "probe");
-  ASSERT_EQ(store.grades(sessions[0].id).size(), 1u);
-  EXPECT_EQ(store.grades(sessions[0].id)[0].comment, "v1 grade");
-  // The new session keeps its mapping exactly.
-  EXPECT_EQ(sessions[1].id, added);
-  ASSERT_TRUE(sessions[1].mapping);
-  EXPECT_EQ(sessions[1].mapping->scale, 1.5);
-  EXPECT_EQ(sessions[1].mapping->rotation.coeffs(), mapping.rotation.coeffs());
-  EXPECT_EQ(sessions[1].mapping->offset_m, mapping.offset_m);
+  const std::optional<ReplaySetup> read_setup = store.replay_setup(session);
+  ASSERT_TRUE(read_setup);
+  EXPECT_FALSE(read_setup->built_in_liver_tets);
+  EXPECT_EQ(read_setup->scenario_folder, replay.scenario_folder);
+  EXPECT_EQ(read_setup->integrator.kind, IntegratorKind::backward_euler);
+  EXPECT_EQ(read_setup->integrator.step_s, 0.005);
+  EXPECT_EQ(read_setup->integrator.newton_tolerance_m, 1e-10);
+  EXPECT_EQ(read_setup->integrator.max_newton_iterations, 12);
+  const std::vector<SimulationInput> read = store.inputs(session);
+  ASSERT_EQ(read.size(), written.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    ASSERT_EQ(read[i].kind, written[i].kind) << i;
+    ASSERT_EQ(read[i].tool.has_value(), written[i].tool.has_value()) << i;
+    if (read[i].tool) ASSERT_EQ(read[i].tool->pose.origin_m, written[i].tool->pose.origin_m) << i;
+    ASSERT_EQ(read[i].springs.size(), written[i].springs.size()) << i;
+    ASSERT_EQ(read[i].steps, written[i].steps) << i;
+    ASSERT_EQ(read[i].check_energy, written[i].check_energy) << i;
+    if (read[i].kind == SimulationInput::Kind::cycle)  // NaN for the others
+      ASSERT_EQ(read[i].servo_time_s, written[i].servo_time_s) << i;
+  }
+
+  // A chunk damaged on disk: named, with its session.
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(
+        sqlite3_exec(db, "UPDATE input_chunks SET data = X'4C534931FFFFFF00' WHERE first_input = 0",
+                     nullptr, nullptr, nullptr),
+        SQLITE_OK);
+    sqlite3_close(db);
+  }
+  SqliteSessionStore damaged(file, SqliteSessionStore::Access::read_only);
+  try {
+    damaged.inputs(session);
+    ADD_FAILURE() << "a damaged input chunk was read";
+  } catch (const StorageError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("session " + std::to_string(session)), std::string::npos) << what;
+    EXPECT_NE(what.find("input chunk"), std::string::npos) << what;
+  }
 }
 
 TEST(SessionRecorder, WritesFramesAndEventsAndEndsTheSessionComplete) {

@@ -1,10 +1,12 @@
 #include "liversim/storage/sqlite_session_store.h"
 
+#include "liversim/core/integrator.h"
 #include "liversim/core/sha256.h"
 
 #include <sqlite3.h>
 
 #include <array>
+#include <iterator>
 
 namespace liversim {
 
@@ -96,7 +98,31 @@ ALTER TABLE sessions ADD COLUMN mapping_offset_y_m REAL;
 ALTER TABLE sessions ADD COLUMN mapping_offset_z_m REAL;
 )sql";
 
-constexpr std::array<const char*, 2> kMigrations = {kSchemaV1, kSchemaV2};
+// Version 3: the simulation's input log, so that a session can be replayed in the viewport
+// (docs/session-storage.md, "Replay"): how its scene was built and its inputs in chunks.
+constexpr const char* kSchemaV3 = R"sql(
+ALTER TABLE sessions ADD COLUMN input_count INTEGER NOT NULL DEFAULT 0;
+CREATE TABLE session_replays (
+  session_id INTEGER PRIMARY KEY REFERENCES sessions (id),
+  built_in_liver_tets INTEGER,
+  scenario_folder TEXT NOT NULL,
+  integrator TEXT NOT NULL,
+  step_s REAL NOT NULL,
+  tolerance_m REAL NOT NULL,
+  newton_tolerance_m REAL NOT NULL,
+  max_newton_iterations INTEGER NOT NULL
+);
+CREATE TABLE input_chunks (
+  session_id INTEGER NOT NULL REFERENCES sessions (id),
+  first_input INTEGER NOT NULL,
+  input_count INTEGER NOT NULL,
+  layout INTEGER NOT NULL,
+  data BLOB NOT NULL,
+  PRIMARY KEY (session_id, first_input)
+) WITHOUT ROWID;
+)sql";
+
+constexpr std::array<const char*, 3> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3};
 static_assert(kMigrations.size() == SqliteSessionStore::kSchemaVersion);
 
 enum StatementId {
@@ -118,6 +144,12 @@ enum StatementId {
   kMetrics,
   kStoreGrade,
   kGrades,
+  kAddReplay,
+  kInputCount,
+  kAddInputChunk,
+  kCountInputs,
+  kReplay,
+  kInputChunks,
   kStatementCount
 };
 
@@ -379,6 +411,26 @@ std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
   }
   add.run("adding the session");
   const std::int64_t session = sqlite3_last_insert_rowid(db_);
+  if (const auto& replay = start.replay) {
+    Statement& add_replay =
+        prepared(kAddReplay,
+                 "INSERT INTO session_replays (session_id, built_in_liver_tets, scenario_folder, "
+                 "integrator, step_s, tolerance_m, newton_tolerance_m, max_newton_iterations) "
+                 "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+    add_replay.bind(1, session);
+    if (replay->built_in_liver_tets)
+      add_replay.bind(2, std::int64_t{*replay->built_in_liver_tets});
+    else
+      add_replay.bind_null(2);
+    const IntegratorSettings& i = replay->integrator;
+    add_replay.bind(3, std::string_view(replay->scenario_folder))
+        .bind(4, integrator_name(i.kind))
+        .bind(5, i.step_s)
+        .bind(6, i.tolerance_m)
+        .bind(7, i.newton_tolerance_m)
+        .bind(8, std::int64_t{i.max_newton_iterations})
+        .run("storing how to replay the session");
+  }
   commit();
   return session;
 }
@@ -419,6 +471,65 @@ void SqliteSessionStore::append_events(std::int64_t session, std::span<const Ses
         .bind(3, session_event_name(event.kind))
         .bind(4, std::string_view(event.detail))
         .run("storing an event");
+}
+
+void SqliteSessionStore::append_inputs(std::int64_t session,
+                                       std::span<const SimulationInput> inputs) {
+  if (inputs.empty()) return;
+  begin_if_needed();
+  const std::int64_t first =
+      prepared(kInputCount, "SELECT input_count FROM sessions WHERE id = ?1")
+          .bind(1, session)
+          .single_integer(("looking up session " + std::to_string(session)).c_str());
+  const std::vector<std::uint8_t> bytes = encode_input_chunk(inputs);
+  prepared(kAddInputChunk,
+           "INSERT INTO input_chunks (session_id, first_input, input_count, layout, data) "
+           "VALUES (?1, ?2, ?3, ?4, ?5)")
+      .bind(1, session)
+      .bind(2, first)
+      .bind(3, static_cast<std::int64_t>(inputs.size()))
+      .bind(4, std::int64_t{kInputChunkLayout})
+      .bind(5, std::span<const std::uint8_t>(bytes))
+      .run("storing the simulation's input");
+  prepared(kCountInputs, "UPDATE sessions SET input_count = input_count + ?2 WHERE id = ?1")
+      .bind(1, session)
+      .bind(2, static_cast<std::int64_t>(inputs.size()))
+      .run("counting the simulation's input");
+}
+
+std::optional<ReplaySetup> SqliteSessionStore::replay_setup(std::int64_t session) {
+  Statement& row = prepared(
+      kReplay,
+      "SELECT built_in_liver_tets, scenario_folder, integrator, step_s, tolerance_m, "
+      "newton_tolerance_m, max_newton_iterations FROM session_replays WHERE session_id = ?1");
+  row.bind(1, session);
+  if (!row.step("reading how to replay the session")) {
+    row.reset();
+    return std::nullopt;
+  }
+  ReplaySetup setup;
+  if (!row.is_null(0)) setup.built_in_liver_tets = static_cast<int>(row.integer(0));
+  setup.scenario_folder = row.text(1);
+  const std::string integrator = row.text(2);
+  const std::optional<IntegratorKind> kind = integrator_from_name(integrator);
+  setup.integrator.step_s = row.real(3);
+  setup.integrator.tolerance_m = row.real(4);
+  setup.integrator.newton_tolerance_m = row.real(5);
+  setup.integrator.max_newton_iterations = static_cast<int>(row.integer(6));
+  row.reset();
+  if (!kind)
+    throw error("session " + std::to_string(session) + " was run with the integrator \"" +
+                integrator + "\", which this version does not know");
+  setup.integrator.kind = *kind;
+  return setup;
+}
+
+std::vector<SimulationInput> SqliteSessionStore::inputs(std::int64_t session) {
+  return chunks_of<SimulationInput>(session,
+                                    prepared(kInputChunks,
+                                             "SELECT first_input, layout, data FROM input_chunks "
+                                             "WHERE session_id = ?1 ORDER BY first_input"),
+                                    "inputs", kInputChunkLayout, decode_input_chunk);
 }
 
 void SqliteSessionStore::end_session(std::int64_t session, std::int64_t ended_unix_ms,
@@ -566,22 +677,22 @@ std::vector<SessionSummary> SqliteSessionStore::sessions() {
   return result;
 }
 
-std::vector<ServoFrame> SqliteSessionStore::frames(std::int64_t session) {
-  Statement& chunks = prepared(kChunks,
-                               "SELECT first_frame, layout, data FROM frame_chunks "
-                               "WHERE session_id = ?1 ORDER BY first_frame");
+template <typename Item, typename Decode>
+std::vector<Item> SqliteSessionStore::chunks_of(std::int64_t session, Statement& chunks,
+                                                const std::string& items, int layout,
+                                                Decode decode) {
   chunks.bind(1, session);
-  std::vector<ServoFrame> result;
+  std::vector<Item> result;
   try {
-    while (chunks.step("reading frames")) {
+    while (chunks.step(("reading " + items).c_str())) {
       if (chunks.integer(0) != static_cast<std::int64_t>(result.size()))
-        throw StorageError("frames " + std::to_string(result.size()) + " to " +
+        throw StorageError(items + " " + std::to_string(result.size()) + " to " +
                            std::to_string(chunks.integer(0)) + " are missing");
-      if (chunks.integer(1) != kFrameChunkLayout)
-        throw StorageError("a chunk has layout " + std::to_string(chunks.integer(1)) +
-                           ", which this version cannot read");
-      const std::vector<ServoFrame> part = decode_frame_chunk(chunks.blob(2));
-      result.insert(result.end(), part.begin(), part.end());
+      if (chunks.integer(1) != layout)
+        throw StorageError("a chunk of " + items + " has layout " +
+                           std::to_string(chunks.integer(1)) + ", which this version cannot read");
+      std::vector<Item> part = decode(chunks.blob(2));
+      std::move(part.begin(), part.end(), std::back_inserter(result));
     }
   } catch (const StorageError& e) {
     chunks.reset();
@@ -589,6 +700,14 @@ std::vector<ServoFrame> SqliteSessionStore::frames(std::int64_t session) {
   }
   chunks.reset();
   return result;
+}
+
+std::vector<ServoFrame> SqliteSessionStore::frames(std::int64_t session) {
+  return chunks_of<ServoFrame>(session,
+                               prepared(kChunks,
+                                        "SELECT first_frame, layout, data FROM frame_chunks "
+                                        "WHERE session_id = ?1 ORDER BY first_frame"),
+                               "frames", kFrameChunkLayout, decode_frame_chunk);
 }
 
 std::vector<SessionEvent> SqliteSessionStore::events(std::int64_t session) {

@@ -20,6 +20,8 @@ struct SceneSetup {
   ModelOptions model_options;
   VisualSurface visual;     // what is rendered: on the smooth organ surface when it is known
   std::string description;  // e.g. "built-in liver, 5450 tetrahedra"
+  // default_scene's: the element count asked for, which builds the same liver again.
+  std::optional<int> built_in_liver_tets;
 };
 
 // Built-in liver at the requested element count, ligament nodes fixed.

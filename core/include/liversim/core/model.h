@@ -66,6 +66,7 @@ struct IntegratorSettings {
   // Implicit schemes: Newton stops when no node moves more than this in an iteration.
   double newton_tolerance_m = 1e-9;
   int max_newton_iterations = 25;
+  bool operator==(const IntegratorSettings&) const = default;
 };
 
 struct ModelOptions {

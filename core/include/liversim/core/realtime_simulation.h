@@ -14,6 +14,7 @@
 #include "liversim/core/model.h"
 #include "liversim/core/outcome_metrics.h"
 #include "liversim/core/servo_loop.h"
+#include "liversim/core/simulation_input.h"
 #include "liversim/core/state.h"
 #include "liversim/core/tools.h"
 #include "liversim/core/triple_buffer.h"
@@ -50,18 +51,6 @@ struct SimulationSnapshot {
   std::shared_ptr<const SimModel> model;
   std::uint64_t topology_version = 0;
   double resected_volume_m3 = 0.0;  // taken out by cuts since the start
-};
-
-// One input the simulation took, in the order it took them: all that changes its state besides
-// its own stepping. Replayed in order on the same model from the same state, they give the same
-// states to the last bit (the engine's loops are deterministic whatever the thread count).
-struct SimulationInput {
-  enum class Kind : std::uint8_t { tool, springs, cycle };
-  Kind kind = Kind::cycle;
-  std::optional<Tool> tool;         // tool: the tool from then on (none: taken away)
-  std::vector<NodeSpring> springs;  // springs: the set springs from then on
-  int steps = 0;                    // cycle: whole steps taken
-  bool check_energy = false;        // cycle: the energy books were closed at its first step
 };
 
 // A session's outcome tracking (outcome_metrics.h) as it stands: the tracker, the model its
@@ -214,7 +203,8 @@ class RealtimeSimulation {
   void log_inputs(bool on);
   std::vector<SimulationInput> take_input_log();
   // While stopped: takes `inputs` (an input log of a simulation built from the same model and
-  // state, with the same tools and cutting enabled) exactly as the loop took them.
+  // state, with the same tools and cutting enabled) exactly as the loop took them, and publishes
+  // a snapshot after each cycle as the loop does.
   void replay(std::span<const SimulationInput> inputs);
 
   // Consumer side (one thread, e.g. the UI): the newest snapshot, if one was published since.
@@ -275,6 +265,8 @@ class RealtimeSimulation {
   void take_tool(const std::optional<Tool>& tool);  // the loop's: logged, then change_tool
   // A cycle's steps, guarded, and the cut of a scalpel in the tissue after them.
   GuardedReport advance_cycle(int steps, bool check_energy);
+  // The snapshot of the cycle just taken (and the force model to the servo, if any).
+  void publish_cycle();
   void log_input(SimulationInput input);  // simulation thread, when logging_inputs_
   std::atomic<bool> logging_inputs_{false};
   std::mutex input_log_mutex_;              // UI ↔ simulation only

@@ -6,6 +6,7 @@
 
 #include "liversim/core/haptics.h"
 #include "liversim/core/servo_loop.h"
+#include "liversim/core/simulation_input.h"
 #include "liversim/core/trace_metrics.h"
 
 #include <cstdint>
@@ -35,6 +36,9 @@ enum class SessionEventKind {
   device_fault,
   tool_selected,  // detail: the tool's name
   lesion_marked,  // palpation: the trainee's mark, detail "x y z" (rest, mm)
+  // The Accuracy panel changed the integrator (detail: its name and step); a replay of the
+  // session's input stops there.
+  integrator_changed,
 };
 std::string_view session_event_name(SessionEventKind kind);
 std::optional<SessionEventKind> session_event_kind(std::string_view name);
@@ -59,6 +63,9 @@ struct SessionStart {
   std::int64_t started_unix_ms = 0;
   // Device → scene for the session (schema 2 on): tissue forces are device forces / its scale.
   std::optional<WorkspaceMapping> mapping;
+  // How to build the session's scene again (schema 3 on); none: the session cannot be replayed
+  // (its simulation input is not recorded).
+  std::optional<ReplaySetup> replay;
 };
 
 // The servo's figures of a session (ServoStats reduced to what is kept).
@@ -120,6 +127,13 @@ std::vector<std::uint8_t> encode_frame_chunk(std::span<const ServoFrame> frames)
 // Throws StorageError when the bytes are not a layout-1 chunk (wrong magic, size or count).
 std::vector<ServoFrame> decode_frame_chunk(std::span<const std::uint8_t> bytes);
 
+// The simulation's input log travels and is stored in chunks too (layout 1, "LSI1",
+// docs/session-storage.md): one record per input, exact.
+inline constexpr int kInputChunkLayout = 1;
+std::vector<std::uint8_t> encode_input_chunk(std::span<const SimulationInput> inputs);
+// Throws StorageError when the bytes are not a layout-1 input chunk, naming what is wrong.
+std::vector<SimulationInput> decode_input_chunk(std::span<const std::uint8_t> bytes);
+
 // Where sessions go. One writer: the recorder's thread calls the writing functions; a writer's
 // appends become durable together at commit(). Every function may throw StorageError.
 class SessionStore {
@@ -131,6 +145,8 @@ class SessionStore {
   // The session's next frames (in order, after those appended before) and events.
   virtual void append_frames(std::int64_t session, std::span<const ServoFrame> frames) = 0;
   virtual void append_events(std::int64_t session, std::span<const SessionEvent> events) = 0;
+  // The simulation's next inputs (in order), for a session begun with a ReplaySetup.
+  virtual void append_inputs(std::int64_t session, std::span<const SimulationInput> inputs) = 0;
   virtual void commit() = 0;
   // Ends the session normally: status complete, end time and servo figures; commits.
   virtual void end_session(std::int64_t session, std::int64_t ended_unix_ms,
@@ -148,6 +164,9 @@ class SessionStore {
   virtual std::vector<MetricValue> metrics(std::int64_t session) = 0;  // by name
   virtual std::vector<ServoFrame> frames(std::int64_t session) = 0;
   virtual std::vector<SessionEvent> events(std::int64_t session) = 0;
+  // What a replay needs: how the scene was built (none: not recorded) and the input log.
+  virtual std::optional<ReplaySetup> replay_setup(std::int64_t session) = 0;
+  virtual std::vector<SimulationInput> inputs(std::int64_t session) = 0;
   // The exact scenario text the session ran.
   virtual std::string scenario_text(std::int64_t session) = 0;
 };

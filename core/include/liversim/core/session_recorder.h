@@ -36,8 +36,11 @@ class SessionRecorder {
 
   std::int64_t session() const { return session_; }
 
-  // Any thread but the servo's (it takes a lock).
+  // Any thread but the servo's (they take a lock).
   void record_event(SessionEvent event);
+  // The simulation's next inputs (RealtimeSimulation::take_input_log), for a session begun with
+  // a ReplaySetup; stored with the next commit.
+  void record_inputs(std::vector<SimulationInput> inputs);
 
   // Writes what is waiting, ends the session as complete with these figures and stops the
   // writer. Returns false (see error()) if storage failed at any point.
@@ -59,10 +62,12 @@ class SessionRecorder {
   std::int64_t session_ = 0;
   std::vector<ServoFrame> frame_batch_;
   std::vector<SessionEvent> event_batch_;
+  std::vector<SimulationInput> input_batch_;
 
-  mutable std::mutex mutex_;  // guards events_, error_, stop_
+  mutable std::mutex mutex_;  // guards events_, inputs_, error_, stop_
   std::condition_variable wake_;
   std::vector<SessionEvent> events_;
+  std::vector<SimulationInput> inputs_;
   std::string error_;
   bool stop_ = false;
   std::atomic<std::int64_t> frames_written_{0};

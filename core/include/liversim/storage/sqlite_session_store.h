@@ -17,7 +17,7 @@ class SqliteSessionStore final : public SessionStore {
   enum class Access { read_write, read_only };
 
   // The schema version this build writes; files at older versions are migrated on opening.
-  static constexpr int kSchemaVersion = 2;
+  static constexpr int kSchemaVersion = 3;
 
   // Opens the file, creating it (read_write) if it does not exist. Throws StorageError naming the
   // file when it cannot be opened, is not a LiverSim database, is damaged, is read-only while
@@ -39,6 +39,7 @@ class SqliteSessionStore final : public SessionStore {
   std::int64_t begin_session(const SessionStart& start) override;
   void append_frames(std::int64_t session, std::span<const ServoFrame> frames) override;
   void append_events(std::int64_t session, std::span<const SessionEvent> events) override;
+  void append_inputs(std::int64_t session, std::span<const SimulationInput> inputs) override;
   void commit() override;
   void end_session(std::int64_t session, std::int64_t ended_unix_ms,
                    const SessionServoFigures& servo) override;
@@ -52,6 +53,8 @@ class SqliteSessionStore final : public SessionStore {
   std::vector<ServoFrame> frames(std::int64_t session) override;
   std::vector<SessionEvent> events(std::int64_t session) override;
   std::string scenario_text(std::int64_t session) override;
+  std::optional<ReplaySetup> replay_setup(std::int64_t session) override;
+  std::vector<SimulationInput> inputs(std::int64_t session) override;
 
  private:
   class Statement;
@@ -61,6 +64,11 @@ class SqliteSessionStore final : public SessionStore {
   StorageError error(const std::string& what) const;
   [[noreturn]] void fail(const std::string& doing);
   Statement& prepared(int which, const char* sql);
+  // The session's chunks of `items` ("frames", "inputs") from `chunks` (first item, layout, data,
+  // in order), decoded and joined; a gap or a layout this version cannot read is named.
+  template <typename Item, typename Decode>
+  std::vector<Item> chunks_of(std::int64_t session, Statement& chunks, const std::string& items,
+                              int layout, Decode decode);
   // The id of the person of that name and role ("trainee", "instructor"), added if new.
   std::int64_t person(std::string_view name, std::string_view role);
 
