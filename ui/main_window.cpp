@@ -15,6 +15,7 @@
 #include "liversim/core/emulated_devices.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/openhaptics_device.h"
+#include "liversim/core/session_replay.h"
 #include "liversim/core/surface.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "session_review_window.h"
@@ -168,20 +169,9 @@ void MainWindow::addPanelDock(const QString& title, const char* name, QWidget* p
 }
 
 void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> model) {
-  auto simulation =
-      std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
   // The visual surface's triangles are the physics boundary's (its vertex i is node nodes[i]).
-  simulation->enable_tools(setup.visual.surface);
-  simulation->enable_cutting();
+  auto simulation = make_scene_simulation(model, setup.visual.surface);
   auto scene = std::make_unique<LiverScene>(setup.mesh, setup.visual);
-  smoothVertexAt_.clear();
-  std::vector<double> smooth_xyz;
-  map_visual_positions(setup.visual, setup.mesh.rest_position_m, smooth_xyz);
-  for (std::size_t v = 0; v < setup.visual.vertex_count(); ++v) {
-    const Eigen::Vector3d node = setup.mesh.rest_position_m.at(setup.visual.surface.nodes[v]);
-    smoothVertexAt_[{node.x(), node.y(), node.z()}] =
-        Eigen::Vector3d(smooth_xyz[3 * v], smooth_xyz[3 * v + 1], smooth_xyz[3 * v + 2]);
-  }
   if (simulation_) {
     // The hand and the mouse's tool let go of the old liver; a device stays attached.
     if (grab_) endGrab();
@@ -195,7 +185,24 @@ void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> 
   simulation_ = std::move(simulation);
   scene_ = std::move(scene);
   setup_ = std::move(setup);
+  sceneModel_ = std::move(model);
   shownTopology_ = 0;
+}
+
+void MainWindow::restartFromRest() {
+  simulation_->stop();
+  // An integrator changed on a cut liver: the scene's model with it, built now.
+  if (!(sceneModel_->integrator == setup_.model_options.integrator))
+    sceneModel_ = std::make_shared<const SimModel>(build_model(setup_.mesh, setup_.model_options));
+  simulation_ = make_scene_simulation(sceneModel_, setup_.visual.surface);
+  if (grab_) simulation_->set_springs(springs_);
+  attachDevice();
+  if (shownTopology_ != 0) {
+    scene_->show_uncut(simulation_->snapshot().position_m);
+    shownTopology_ = 0;
+  }
+  simulation_->log_inputs(true);
+  simulation_->start();
 }
 
 bool MainWindow::openScenario(const QString& file) {
@@ -414,9 +421,9 @@ void MainWindow::updateRecentMenu() {
 
 MainWindow::~MainWindow() {
   if (modelBuilder_.joinable()) modelBuilder_.join();
-  if (metricsWorker_.joinable()) metricsWorker_.join();
   simulation_->stop();
-  detachDevice();  // the servo's last command is a zero force
+  detachDevice();  // the servo's last command is a zero force; a session ends (its metrics start)
+  if (metricsWorker_.joinable()) metricsWorker_.join();
 }
 
 bool MainWindow::applyIntegratorSettings(const IntegratorSettings& settings) {
@@ -478,6 +485,11 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
     emit integratorChangeFinished(false);
     return;
   }
+  // A recorded session's input log ends here: a replay does not follow an integrator change.
+  if (recorder_) {
+    simulation_->log_inputs(false);
+    recorder_->record_inputs(simulation_->take_input_log());
+  }
   SimState state = make_rest_state(*model, shared_worker_pool());
   state.position_m = old.position_m;
   state.velocity_m_per_s = old.velocity_m_per_s;
@@ -494,7 +506,8 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
     simulation_ = std::move(replacement);
     if (outcome) simulation_->track_outcome(std::move(*outcome));
   } catch (const std::exception& e) {
-    simulation_->start();  // the old one goes on where it stopped
+    if (recorder_) simulation_->log_inputs(true);  // the old one's log goes on
+    simulation_->start();                          // the old one goes on where it stopped
     accuracyPanel_->showError(QString::fromUtf8(e.what()));
     emit integratorChangeFinished(false);
     return;
@@ -504,7 +517,13 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   simulation_->enable_cutting();
   attachDevice();
   simulation_->start();
+  if (recorder_)
+    recorder_->record_event({servo_->now_s(), SessionEventKind::integrator_changed,
+                             std::string(integrator_name(settings.kind))});
   setup_.model_options.integrator = settings;
+  // Built from the scene's mesh (not a cut one): a restart from rest can use it.
+  if (model->node_count == setup_.mesh.node_count() && shownTopology_ == 0)
+    sceneModel_ = std::move(model);
   accuracyPanel_->setSettings(settings);
   emit integratorChangeFinished(true);
 }
@@ -581,13 +600,14 @@ bool MainWindow::beginTool(ToolKind kind, QPoint pos) {
   tool_ = tool;
   toolPoint_m_ = hit->point_m;
   mouse_->place(tool.pose.origin_m * 1e3, kMouseActionButton);
-  simulation_->set_device_tool(deviceToolSettings(), servo_->now_s());
   // After the placement, so that the frames of the tool's interval are all where it is put. A
-  // session of the mouse begins when it first takes a tool to the liver.
+  // session of the mouse begins when it first takes a tool to the liver (and restarts the
+  // simulation from rest: the device tool is set on the simulation that runs after).
   if (!recorder_)
     beginRecording();
   else
     recordToolChoice();
+  simulation_->set_device_tool(deviceToolSettings(), servo_->now_s());
   return true;
 }
 
@@ -620,32 +640,18 @@ void MainWindow::endTool() {
 }
 
 void MainWindow::showTool(const std::optional<Tool>& tool) {
-  std::array<Capsule, 3> parts;
-  const int count = tool ? tool_capsules(*tool, parts) : 0;
-  scene_->show_tool(std::span<const Capsule>(parts.data(), static_cast<std::size_t>(count)));
+  scene_->show_tool(tool);
   viewport_->scheduleRender();
 }
 
 void MainWindow::showNewestSnapshot() {
+  if (recorder_) recorder_->record_inputs(simulation_->take_input_log());
   if (simulation_->update_snapshot()) {
     const SimulationSnapshot& snapshot = simulation_->snapshot();
     const bool cut = snapshot.topology_version != shownTopology_ && snapshot.model;
     recordSimulationEvents(snapshot, cut);
     if (cut) {
-      // Cut: the surface is the cut mesh's boundary now, its cut faces in the interior colour.
-      // A node still where a node of the organ's surface was (the same node, or its copy) keeps
-      // that node's smooth visual vertex; the others show where they are.
-      const TetMesh mesh = model_mesh(*snapshot.model);
-      BoundarySurface surface = boundary_surface(*snapshot.model);
-      std::vector<Eigen::Vector3d> vertex_rest(surface.nodes.size());
-      for (std::size_t v = 0; v < surface.nodes.size(); ++v) {
-        const Eigen::Vector3d rest = mesh.rest_position_m.at(surface.nodes[v]);
-        const auto smooth = smoothVertexAt_.find({rest.x(), rest.y(), rest.z()});
-        vertex_rest[v] = smooth != smoothVertexAt_.end() ? smooth->second : rest;
-      }
-      VisualSurface visual = embed_visual_surface(mesh, surface, vertex_rest);
-      const auto cut_faces = cut_face_flags(*snapshot.model, visual.surface);
-      scene_->set_surface(std::move(visual), cut_faces, snapshot.position_m);
+      scene_->show_cut_model(*snapshot.model, snapshot.position_m);
       shownTopology_ = snapshot.topology_version;
     }
     scene_->update_positions(snapshot.position_m);
@@ -905,6 +911,15 @@ void MainWindow::beginRecording() {
   start.device = ownDevice_ ? ownDevice_->name() : omni_ ? omni_->name() : "haptic device";
   start.started_unix_ms = QDateTime::currentMSecsSinceEpoch();
   start.mapping = servo_->mapping();
+  ReplaySetup replay;
+  replay.integrator = setup_.model_options.integrator;
+  if (scenario_)  // as tryScenario: an unsaved scenario's organ file is named from here
+    replay.scenario_folder = (scenario_->file.isEmpty() ? QDir::currentPath()
+                                                        : QFileInfo(scenario_->file).absolutePath())
+                                 .toStdString();
+  else
+    replay.built_in_liver_tets = setup_.built_in_liver_tets;
+  if (scenario_ || setup_.built_in_liver_tets) start.replay = replay;
   ServoLoop* servo = servo_.get();
   // The servo has queued frames since it started (the mouse's, until its first press): the
   // session's are those from now on.
@@ -921,6 +936,8 @@ void MainWindow::beginRecording() {
     return;
   }
   recordToolChoice();
+  // The session starts from rest, its simulation's input logged, so that it can be replayed.
+  restartFromRest();
   // Damage, lift and resection need the simulation: tracked while the session runs.
   std::optional<Eigen::Vector3d> lift_point_m;
   if (scenario_ && scenario_->scenario.task.kind == TaskKind::retract_lobe) {
@@ -1054,6 +1071,10 @@ void MainWindow::recordToolChoice() {
 
 void MainWindow::endRecording() {
   if (!recorder_) return;
+  if (simulation_) {
+    simulation_->log_inputs(false);
+    recorder_->record_inputs(simulation_->take_input_log());
+  }
   const ServoStats stats = servo_ ? servo_->stats() : ServoStats{};
   const std::uint64_t dropped = servo_ ? servo_->dropped_log_frames() - droppedBeforeRecording_ : 0;
   const std::int64_t session = recorder_->session();

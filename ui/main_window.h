@@ -153,6 +153,9 @@ class MainWindow : public QMainWindow {
   // Runs `model` of `setup` from rest, in place of the scene shown (if any): a new simulation,
   // liver picture and tool interaction; the device in use stays attached.
   void installScene(SceneSetup setup, std::shared_ptr<const SimModel> model);
+  // The scene shown starts again from rest, uncut, logging its input (a recorded session starts
+  // so: its replay starts from the same state).
+  void restartFromRest();
   void buildScenario(OpenedScenario opened, const QString& folder);  // on modelBuilder_
   static QString scenarioName(const OpenedScenario& opened);         // for messages
   void finishScenarioOpen(const OpenedScenario& opened, std::shared_ptr<SceneSetup> setup,
@@ -194,6 +197,7 @@ class MainWindow : public QMainWindow {
   static QString formatError(double error_m);
 
   SceneSetup setup_;
+  std::shared_ptr<const SimModel> sceneModel_;  // setup_'s model, uncut, with the integrator in use
   std::unique_ptr<RealtimeSimulation> simulation_;
   std::unique_ptr<LiverScene> scene_;
   VtkViewport* viewport_ = nullptr;
@@ -215,9 +219,6 @@ class MainWindow : public QMainWindow {
   Eigen::Vector3d toolPoint_m_ = Eigen::Vector3d::Zero();  // where the mouse holds the tool
 
   std::uint64_t shownTopology_ = 0;  // the cut the scene shows (SimulationSnapshot)
-  // The smooth visual vertex of each node of the organ's surface, by the node's rest position
-  // (a cut's copy of a node sits where it did).
-  std::map<std::array<double, 3>, Eigen::Vector3d> smoothVertexAt_;
 
   int framesInWindow_ = 0;
   QElapsedTimer frameWindow_;

@@ -1,5 +1,8 @@
 #include "session_review_window.h"
 
+#include "force_curve.h"
+#include "session_replay_window.h"
+
 #include "liversim/core/scenario.h"
 #include "liversim/core/session_export.h"
 #include "liversim/storage/sqlite_session_store.h"
@@ -36,10 +39,6 @@ namespace liversim {
 
 namespace {
 
-// The force curve keeps at most about this many points: each bucket of frames gives its largest
-// force, so no peak is lost.
-constexpr std::size_t kMaxForcePoints = 4000;
-
 std::vector<RubricCriterion> rubric_of(SessionStore& store, std::int64_t session) {
   const ScenarioReading reading = read_scenario(store.scenario_text(session));
   return reading.scenario ? reading.scenario->rubric : std::vector<RubricCriterion>{};
@@ -59,7 +58,7 @@ QTableWidgetItem* cell(const QString& text) {
 
 SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
                                          const std::optional<QString>& trainee, QWidget* parent)
-    : QWidget(parent, Qt::Window), trainee_(trainee) {
+    : QWidget(parent, Qt::Window), trainee_(trainee), databaseFile_(databaseFile) {
   setObjectName(trainee ? "traineeHistoryWindow" : "sessionReviewWindow");
   setWindowTitle(trainee ? tr("Sessions of %1").arg(*trainee)
                          : tr("Sessions — %1").arg(databaseFile));
@@ -100,20 +99,7 @@ SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
   eventSeries_ = new QScatterSeries();
   eventSeries_->setName(tr("Events"));
   eventSeries_->setMarkerSize(8.0);
-  auto* chart = new QChart();
-  chart->addSeries(forceSeries_);
-  chart->addSeries(eventSeries_);
-  auto* time_axis = new QValueAxis();
-  time_axis->setTitleText(tr("Time (s)"));
-  auto* force_axis = new QValueAxis();
-  force_axis->setTitleText(tr("Force (N)"));
-  chart->addAxis(time_axis, Qt::AlignBottom);
-  chart->addAxis(force_axis, Qt::AlignLeft);
-  for (QAbstractSeries* series :
-       {static_cast<QAbstractSeries*>(forceSeries_), static_cast<QAbstractSeries*>(eventSeries_)}) {
-    series->attachAxis(time_axis);
-    series->attachAxis(force_axis);
-  }
+  QChart* chart = force_chart({forceSeries_, eventSeries_});
   forceChart_ = new QChartView(chart, this);
   forceChart_->setObjectName("forceChart");
   forceChart_->setRenderHint(QPainter::Antialiasing);
@@ -155,7 +141,14 @@ SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
   form->addRow(tr("Comment:"), commentEdit_);
   form->addRow(QString(), saveButton_);
   form->addRow(tr("Saved grades:"), gradesLabel_);
+  replayButton_ = new QPushButton(tr("Replay in the Viewport…"), this);
+  replayButton_->setObjectName("replaySession");
+  replayButton_->setToolTip(
+      tr("Play the session back in a viewport from its recorded input, "
+         "with its force plotted in step"));
+  connect(replayButton_, &QPushButton::clicked, this, [this] { openReplay(); });
   auto* exports = new QHBoxLayout();
+  exports->addWidget(replayButton_);
   exports->addWidget(csvButton_);
   exports->addWidget(pdfButton_);
   form->addRow(tr("Export:"), exports);
@@ -327,20 +320,10 @@ void SessionReviewWindow::showOpenedSession() {
     forceSeries_->setName(scale ? tr("Force on the tissue (N)") : tr("Force on the device (N)"));
     const double force_factor = scale ? 1.0 / *scale : 1.0;
     const std::vector<ServoFrame> frames = store_->frames(*opened_);
-    const std::size_t bucket =
-        std::max<std::size_t>(1, (frames.size() + kMaxForcePoints - 1) / kMaxForcePoints);
-    QList<QPointF> points;
-    double largest = 0.0;
     const double t0 = frames.empty() ? 0.0 : frames.front().time_s;
-    for (std::size_t begin = 0; begin < frames.size(); begin += bucket) {
-      std::size_t peak = begin;
-      for (std::size_t i = begin; i < std::min(frames.size(), begin + bucket); ++i)
-        if (frames[i].force_n.norm() > frames[peak].force_n.norm()) peak = i;
-      const double force = frames[peak].force_n.norm() * force_factor;
-      largest = std::max(largest, force);
-      points.append(QPointF(frames[peak].time_s - t0, force));
-    }
-    forceSeries_->replace(points);
+    const ForceCurve curve = force_curve(frames, force_factor, t0);
+    const double largest = curve.largest_n;
+    forceSeries_->replace(curve.points);
     const std::vector<SessionEvent> events = store_->events(*opened_);
     for (const SessionEvent& e : events) {
       const std::string_view kind = session_event_name(e.kind);
@@ -383,6 +366,15 @@ void SessionReviewWindow::showOpenedSession() {
     scoreLabel_->setText(
         tr("Session %1 cannot be read: %2").arg(*opened_).arg(QString::fromUtf8(e.what())));
   }
+}
+
+SessionReplayWindow* SessionReviewWindow::openReplay() {
+  if (!opened_) return nullptr;
+  if (replayWindow_) replayWindow_->close();  // one replay at a time: each holds a whole model
+  replayWindow_ = new SessionReplayWindow(databaseFile_, *opened_, this);
+  replayWindow_->setAttribute(Qt::WA_DeleteOnClose);
+  replayWindow_->show();
+  return replayWindow_;
 }
 
 QString SessionReviewWindow::scoreText() const {

@@ -7,6 +7,7 @@
 #include "liversim/core/grading.h"
 #include "liversim/core/session_log.h"
 
+#include <QPointer>
 #include <QString>
 #include <QStringList>
 #include <QWidget>
@@ -27,6 +28,8 @@ class QScatterSeries;
 class QTableWidget;
 
 namespace liversim {
+
+class SessionReplayWindow;
 
 class SessionReviewWindow : public QWidget {
   Q_OBJECT
@@ -69,6 +72,9 @@ class SessionReviewWindow : public QWidget {
   // file cannot be written; nothing is left half-written under the final name.
   bool exportCsv(const QString& folder);
   bool exportPdf(const QString& file);
+  // The opened session played back in a viewport (its own window, session_replay_window.h);
+  // null when no session is open.
+  SessionReplayWindow* openReplay();
 
  private:
   void showSessions();
@@ -100,6 +106,9 @@ class SessionReviewWindow : public QWidget {
   QPushButton* saveButton_ = nullptr;
   QPushButton* csvButton_ = nullptr;
   QPushButton* pdfButton_ = nullptr;
+  QPushButton* replayButton_ = nullptr;
+  QString databaseFile_;
+  QPointer<SessionReplayWindow> replayWindow_;
   QLabel* gradesLabel_ = nullptr;
 };
 

@@ -38,6 +38,7 @@
 #include "main_window.h"
 #include "render/liver_scene.h"
 #include "tool_panel.h"
+#include "viewport_input.h"
 #include "vtk_viewport.h"
 
 namespace liversim {
@@ -146,18 +147,10 @@ class MainWindowTest : public ::testing::Test {
 
   // VTK display coordinates (device pixels, origin bottom-left) ↔ viewport widget coordinates,
   // the same mapping as VtkViewport's.
-  int deviceHeight() const { return window_->viewport()->renderWindow()->GetSize()[1]; }
   QPoint toWidget(const Eigen::Vector2d& display) const {
-    const double dpr = window_->viewport()->devicePixelRatioF();
-    return {static_cast<int>(std::lround(display.x() / dpr)),
-            static_cast<int>(std::lround((deviceHeight() - 1 - display.y()) / dpr))};
+    return widget_point(*window_->viewport(), display);
   }
-  QPoint toDisplay(QPoint widget) const {
-    const double dpr = window_->viewport()->devicePixelRatioF();
-    return {static_cast<int>(std::lround(widget.x() * dpr)),
-            deviceHeight() - 1 - static_cast<int>(std::lround(widget.y() * dpr))};
-  }
-
+  QPoint toDisplay(QPoint widget) const { return display_point(*window_->viewport(), widget); }
   std::optional<ScenePick> pickAt(QPoint widget) const {
     const QPoint display = toDisplay(widget);
     return window_->scene().pick(display.x(), display.y());
@@ -179,10 +172,7 @@ class MainWindowTest : public ::testing::Test {
   }
 
   void sendMouse(QEvent::Type type, QPoint pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
-    VtkViewport* viewport = window_->viewport();
-    QMouseEvent event(type, QPointF(pos), QPointF(viewport->mapToGlobal(pos)), button, buttons,
-                      Qt::NoModifier);
-    QCoreApplication::sendEvent(viewport, &event);
+    send_mouse(*window_->viewport(), type, pos, button, buttons);
   }
 
   // Presses the left button at `from` and moves to `to` in kDragMoves steps, processing events

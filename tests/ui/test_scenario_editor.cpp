@@ -31,6 +31,7 @@
 #include "render/liver_scene.h"
 #include "render/scenario_overlay.h"
 #include "scenario_editor.h"
+#include "viewport_input.h"
 #include "vtk_viewport.h"
 
 namespace liversim {
@@ -58,19 +59,10 @@ class ScenarioEditorTest : public ::testing::Test {
   VtkViewport* viewport() const { return editor_->viewport(); }
   LiverScene& scene() const { return *editor_->scene(); }
 
-  int deviceHeight() const {
-    return static_cast<int>(std::lround(viewport()->height() * viewport()->devicePixelRatioF()));
-  }
   QPoint toWidget(const Eigen::Vector2d& display) const {
-    const double dpr = viewport()->devicePixelRatioF();
-    return {static_cast<int>(std::lround(display.x() / dpr)),
-            static_cast<int>(std::lround((deviceHeight() - 1 - display.y()) / dpr))};
+    return widget_point(*viewport(), display);
   }
-  QPoint toDisplay(QPoint widget) const {
-    const double dpr = viewport()->devicePixelRatioF();
-    return {static_cast<int>(std::lround(widget.x() * dpr)),
-            deviceHeight() - 1 - static_cast<int>(std::lround(widget.y() * dpr))};
-  }
+  QPoint toDisplay(QPoint widget) const { return display_point(*viewport(), widget); }
   std::optional<ScenePick> pickAt(QPoint widget) const {
     const QPoint display = toDisplay(widget);
     return scene().pick(display.x(), display.y());
@@ -83,9 +75,7 @@ class ScenarioEditorTest : public ::testing::Test {
 
   void sendMouse(QEvent::Type type, QPoint pos, Qt::MouseButton button, Qt::MouseButtons buttons,
                  Qt::KeyboardModifiers modifiers = Qt::NoModifier) {
-    QMouseEvent event(type, QPointF(pos), QPointF(viewport()->mapToGlobal(pos)), button, buttons,
-                      modifiers);
-    QCoreApplication::sendEvent(viewport(), &event);
+    send_mouse(*viewport(), type, pos, button, buttons, modifiers);
   }
   void click(QPoint at) {
     sendMouse(QEvent::MouseButtonPress, at, Qt::LeftButton, Qt::LeftButton);

@@ -2,6 +2,8 @@
 
 #include "render/offscreen_png.h"
 
+#include "liversim/core/cutting.h"
+
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
@@ -37,7 +39,14 @@ constexpr double kBackgroundBottom[3] = {0.05, 0.05, 0.07};
 
 }  // namespace
 
-LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual) {
+LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual) : uncut_visual_(visual) {
+  std::vector<double> smooth_xyz;
+  map_visual_positions(visual, mesh.rest_position_m, smooth_xyz);
+  for (std::size_t v = 0; v < visual.vertex_count(); ++v) {
+    const Eigen::Vector3d node = mesh.rest_position_m.at(visual.surface.nodes[v]);
+    smooth_vertex_at_[{node.x(), node.y(), node.z()}] =
+        Eigen::Vector3d(smooth_xyz[3 * v], smooth_xyz[3 * v + 1], smooth_xyz[3 * v + 2]);
+  }
   points_->SetDataTypeToDouble();
   normals_->SetNumberOfComponents(3);
   normals_->SetName("Normals");
@@ -152,6 +161,30 @@ void LiverScene::set_surface(VisualSurface visual, const std::vector<std::uint8_
   polydata_->SetPolys(triangles);
   face_colours_->Modified();
   update_positions(position_m);
+}
+
+void LiverScene::show_tool(const std::optional<Tool>& tool) {
+  std::array<Capsule, 3> parts;
+  const int count = tool ? tool_capsules(*tool, parts) : 0;
+  show_tool(std::span<const Capsule>(parts.data(), static_cast<std::size_t>(count)));
+}
+
+void LiverScene::show_cut_model(const SimModel& model, const NodeArray& position_m) {
+  const TetMesh mesh = model_mesh(model);
+  BoundarySurface surface = boundary_surface(model);
+  std::vector<Eigen::Vector3d> vertex_rest(surface.nodes.size());
+  for (std::size_t v = 0; v < surface.nodes.size(); ++v) {
+    const Eigen::Vector3d rest = mesh.rest_position_m.at(surface.nodes[v]);
+    const auto smooth = smooth_vertex_at_.find({rest.x(), rest.y(), rest.z()});
+    vertex_rest[v] = smooth != smooth_vertex_at_.end() ? smooth->second : rest;
+  }
+  VisualSurface visual = embed_visual_surface(mesh, surface, vertex_rest);
+  const auto cut_faces = cut_face_flags(model, visual.surface);
+  set_surface(std::move(visual), cut_faces, position_m);
+}
+
+void LiverScene::show_uncut(const NodeArray& position_m) {
+  set_surface(uncut_visual_, {}, position_m);
 }
 
 void LiverScene::update_positions(const NodeArray& position_m) {

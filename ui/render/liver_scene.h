@@ -3,6 +3,7 @@
 // and conversion between the screen and the scene. VTK only (no Qt): the workstation, the CLI and
 // the rendering tests share it.
 
+#include "liversim/core/model.h"
 #include "liversim/core/surface.h"
 #include "liversim/core/tet_mesh.h"
 #include "liversim/core/tools.h"
@@ -13,6 +14,7 @@
 
 #include <array>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <span>
 #include <vector>
@@ -50,6 +52,12 @@ class LiverScene {
   // `cut_faces` (one per triangle; empty: none) in the colour of the organ's interior.
   void set_surface(VisualSurface visual, const std::vector<std::uint8_t>& cut_faces,
                    const NodeArray& position_m);
+  // Shows a cut model's boundary at these positions, its cut faces in the interior colour. A node
+  // still where a node of the organ's first surface was (the same node, or its copy) keeps that
+  // node's smooth visual vertex; the others show where they are.
+  void show_cut_model(const SimModel& model, const NodeArray& position_m);
+  // Shows the organ's first surface again (the scene restarted from rest).
+  void show_uncut(const NodeArray& position_m);
   // Moves the surface to these node positions (all mesh nodes). Allocates nothing after the first.
   void update_positions(const NodeArray& position_m);
   // Anterior view of the whole organ, in a view `aspect` (width / height) wide: a view narrower
@@ -63,6 +71,7 @@ class LiverScene {
   void show_grab_marker(const std::optional<Eigen::Vector3d>& point_m);
   // The tool's parts (tools.h: tool_capsules) as steel-grey rods with rounded ends; none hides it.
   void show_tool(std::span<const Capsule> parts);
+  void show_tool(const std::optional<Tool>& tool);  // its parts (tool_capsules), or none
 
   // Display coordinates are VTK's: pixels from the bottom-left corner of the render window.
   std::optional<ScenePick> pick(int display_x, int display_y) const;
@@ -73,6 +82,9 @@ class LiverScene {
 
  private:
   VisualSurface visual_;
+  const VisualSurface uncut_visual_;
+  // The smooth visual vertex of each node of the first surface, by the node's rest position.
+  std::map<std::array<double, 3>, Eigen::Vector3d> smooth_vertex_at_;
   vtkNew<vtkRenderer> renderer_;
   vtkNew<vtkPoints> points_;
   vtkNew<vtkFloatArray> normals_;

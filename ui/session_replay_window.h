@@ -1,0 +1,95 @@
+#pragma once
+// A recorded session played back in a viewport: its scene built again and its simulation input
+// replayed cycle by cycle on the session's timeline (core/session_replay.h), so the liver goes
+// through the states the trainee saw, cuts included. Play, pause and seek (a seek back replays
+// from the start); the session's recorded force is plotted with a cursor at the replayed time,
+// and the replayed force on the tool beside it.
+
+#include "liversim/core/session_log.h"
+#include "liversim/core/session_replay.h"
+
+#include <QElapsedTimer>
+#include <QString>
+#include <QTimer>
+#include <QWidget>
+
+#include <cstdint>
+#include <memory>
+#include <thread>
+
+class QChartView;
+class QLabel;
+class QLineSeries;
+class QPushButton;
+class QSlider;
+
+namespace liversim {
+
+class LiverScene;
+class VtkViewport;
+
+class SessionReplayWindow : public QWidget {
+  Q_OBJECT
+
+ public:
+  // Reads the session from the database file (its own connection) and builds its scene on a
+  // worker; ready() when it can play. A session that cannot be replayed says why in problem().
+  SessionReplayWindow(const QString& databaseFile, std::int64_t session, QWidget* parent = nullptr);
+  ~SessionReplayWindow() override;
+
+  std::int64_t session() const { return session_; }
+  bool ready() const { return replay_ != nullptr; }
+  QString problem() const { return problem_; }
+  QString statusText() const;
+
+  // The timeline, in seconds from the session's first frame.
+  double durationS() const;
+  double positionS() const;  // of the cycle last replayed
+  bool playing() const { return playing_; }
+  // Seeking: the replay has not yet caught up with the time asked for.
+  bool seeking() const;
+
+  void play();
+  void pause();
+  void seek(double seconds);
+
+  SessionReplay* replay() const { return replay_.get(); }
+  VtkViewport* viewport() const { return viewport_; }
+  int recordedForcePointCount() const;
+  int replayedForcePointCount() const;
+
+ signals:
+  void readyChanged(bool ready);
+
+ private:
+  void finishBuilding(std::shared_ptr<SessionReplay> replay, const QString& error);
+  void tick();          // advances toward the target within a frame's budget, then shows it
+  void showSnapshot();  // the replayed cycle: liver, cut, tool, cursor, force
+  void updateControls();
+
+  std::int64_t session_;
+  std::unique_ptr<SessionReplay> replay_;
+  QString problem_;
+  QString limitNote_;     // what the replay does not cover (an integrator change)
+  double t0_s_ = 0.0;     // servo time of the session's first frame
+  double targetS_ = 0.0;  // where the replay is going, from t0
+  bool playing_ = false;
+  bool seekPending_ = false;                    // a seek the replay has not caught up with yet
+  std::shared_ptr<const SimModel> shownModel_;  // the model the scene shows
+  std::unique_ptr<LiverScene> scene_;
+  VtkViewport* viewport_ = nullptr;
+  QPushButton* playButton_ = nullptr;
+  QSlider* slider_ = nullptr;
+  QLabel* timeLabel_ = nullptr;
+  QLabel* statusLabel_ = nullptr;
+  QChartView* chart_ = nullptr;
+  QLineSeries* recordedForce_ = nullptr;
+  QLineSeries* replayedForce_ = nullptr;
+  QLineSeries* cursor_ = nullptr;
+  double largestForceN_ = 0.1;
+  QTimer timer_;
+  QElapsedTimer wall_;
+  std::thread builder_;
+};
+
+}  // namespace liversim
