@@ -192,7 +192,7 @@ void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> 
 void MainWindow::restartFromRest() {
   simulation_->stop();
   // An integrator changed on a cut liver: the scene's model with it, built now.
-  if (!(sceneModel_->integrator == setup_.model_options.integrator))
+  if (sceneModel_->integrator != setup_.model_options.integrator)
     sceneModel_ = std::make_shared<const SimModel>(build_model(setup_.mesh, setup_.model_options));
   simulation_ = make_scene_simulation(sceneModel_, setup_.visual.surface);
   if (grab_) simulation_->set_springs(springs_);

@@ -150,8 +150,7 @@ void SessionReplayWindow::finishBuilding(std::shared_ptr<SessionReplay> replay,
     updateControls();
     return;
   }
-  // Owned here from now on: the worker is done with it.
-  replay_ = std::make_unique<SessionReplay>(std::move(*replay));
+  replay_ = std::move(replay);  // the worker is done with it
   scene_ = std::make_unique<LiverScene>(replay_->scene().mesh, replay_->scene().visual);
   viewport_->renderWindow()->AddRenderer(scene_->renderer());
   scene_->reset_camera(viewport_->height() > 0
@@ -209,6 +208,7 @@ void SessionReplayWindow::tick() {
   if (!replay_) return;
   const double elapsed_s = wall_.restart() / 1000.0;
   if (playing_ && !seekPending_) targetS_ = std::min(targetS_ + elapsed_s, durationS());
+  const std::size_t taken_before = replay_->taken();
   QElapsedTimer budget;
   budget.start();
   bool arrived = false;
@@ -219,7 +219,7 @@ void SessionReplayWindow::tick() {
   // Playing slower than the session ran, the replay shows every cycle rather than skipping on.
   if (playing_ && !arrived && !seekPending_) targetS_ = positionS();
   if (playing_ && arrived && targetS_ >= durationS()) playing_ = false;
-  showSnapshot();
+  if (replay_->taken() != taken_before) showSnapshot();  // paused: nothing to draw again
   updateControls();
 }
 

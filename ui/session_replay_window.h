@@ -68,7 +68,7 @@ class SessionReplayWindow : public QWidget {
   void updateControls();
 
   std::int64_t session_;
-  std::unique_ptr<SessionReplay> replay_;
+  std::shared_ptr<SessionReplay> replay_;
   QString problem_;
   QString limitNote_;     // what the replay does not cover (an integrator change)
   double t0_s_ = 0.0;     // servo time of the session's first frame

@@ -385,13 +385,26 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   return guarded;
 }
 
+namespace {
+// Room for the loop's log between two takes (a display frame holds a few cycles), so that the
+// simulation thread appends without allocating: the caller of take_input_log allocates it.
+constexpr std::size_t kInputLogReserve = 256;
+}  // namespace
+
 void RealtimeSimulation::log_inputs(bool on) {
+  if (on) {
+    std::lock_guard lock(input_log_mutex_);
+    input_log_.reserve(kInputLogReserve);
+  }
   logging_inputs_.store(on);
 }
 
 std::vector<SimulationInput> RealtimeSimulation::take_input_log() {
+  std::vector<SimulationInput> fresh;
+  fresh.reserve(kInputLogReserve);
   std::lock_guard lock(input_log_mutex_);
-  return std::exchange(input_log_, {});
+  std::swap(fresh, input_log_);
+  return fresh;
 }
 
 void RealtimeSimulation::log_input(SimulationInput input) {

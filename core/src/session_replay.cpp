@@ -63,7 +63,7 @@ void SessionReplay::restart() {
 }
 
 bool SessionReplay::advance_to(double servo_time_s, int max_cycles) {
-  if (servo_time_s < time_s_) restart();
+  if (servo_time_s < time_s_ && next_ > 0) restart();  // back in time: from rest again
   // Inputs come in groups: what the live loop took before a cycle, then the cycle. Whole groups
   // are taken.
   std::size_t end = next_;  // one past the last input to take

@@ -369,6 +369,9 @@ TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {
         sqlite3_exec(db, "UPDATE input_chunks SET data = X'4C534931FFFFFF00' WHERE first_input = 0",
                      nullptr, nullptr, nullptr),
         SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, "UPDATE session_replays SET integrator = 'leapfrog'", nullptr,
+                           nullptr, nullptr),
+              SQLITE_OK);
     sqlite3_close(db);
   }
   SqliteSessionStore damaged(file, SqliteSessionStore::Access::read_only);
@@ -379,6 +382,13 @@ TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {
     const std::string what = e.what();
     EXPECT_NE(what.find("session " + std::to_string(session)), std::string::npos) << what;
     EXPECT_NE(what.find("input chunk"), std::string::npos) << what;
+  }
+  // An integrator this version does not know (a newer file, or a damaged one): named.
+  try {
+    damaged.replay_setup(session);
+    ADD_FAILURE() << "an unknown integrator was read";
+  } catch (const StorageError& e) {
+    EXPECT_NE(std::string(e.what()).find("\"leapfrog\""), std::string::npos) << e.what();
   }
 }
 

@@ -40,6 +40,8 @@ class SessionReplay {
   // The servo time of the last cycle replayed (begin_s() before the first).
   double time_s() const { return time_s_; }
   bool at_end() const { return next_ == inputs_.size(); }
+  // Inputs taken since rest: it changes whenever the replayed state does.
+  std::size_t taken() const { return next_; }
 
   // Replays the inputs up to the last cycle at or before `servo_time_s`, taking at most
   // `max_cycles` cycles (a UI keeps its frames short this way); true when it got there. Going
