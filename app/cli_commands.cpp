@@ -1,5 +1,6 @@
 #include "cli_commands.h"
 
+#include "liversim/core/data_paths.h"
 #include "liversim/core/default_scene.h"
 #include "liversim/core/grab.h"
 #include "liversim/core/integrator.h"
@@ -15,6 +16,7 @@
 #include "render/liver_scene.h"
 #endif
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -260,7 +262,18 @@ int mesh_report(const MeshReportOptions& options) {
   });
 }
 
-int validate_scenarios(const std::vector<std::filesystem::path>& files) {
+int validate_scenarios(std::vector<std::filesystem::path> files) {
+  if (files.empty()) {
+    const std::filesystem::path folder = shipped_scenarios_folder();
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, error))
+      if (entry.path().extension() == ".json") files.push_back(entry.path());
+    if (error || files.empty())
+      return fail("no shipped scenarios in " + folder.string() +
+                  (error ? ": " + error.message() : std::string()));
+    std::sort(files.begin(), files.end());
+    std::cout << "shipped scenarios in " << folder.string() << ":\n";
+  }
   int invalid = 0;
   for (const auto& file : files) {
     const ScenarioReading reading = read_scenario_file(file);

@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
       "validate",
       "Check scenario files; print each error with the field's path, its value and what is "
       "expected (exit status 1 when any file is invalid)");
-  validate_cmd->add_option("files", scenario_files, "Scenario files (.json)")->required();
+  validate_cmd->add_option("files", scenario_files,
+                           "Scenario files (.json); none: the shipped scenarios");
 
   SimulateOptions sim;
   std::vector<double> force;

@@ -1,5 +1,6 @@
 // liversim: the workstation. Builds the default scene (or a scenario's) and opens the main window.
 #include "main_window.h"
+#include "translations.h"
 #include "vtk_viewport.h"
 
 #include "liversim/core/default_scene.h"
@@ -8,6 +9,7 @@
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QDir>
+#include <QIcon>
 #include <QMessageBox>
 #include <QStandardPaths>
 #include <QTimer>
@@ -31,13 +33,36 @@ struct Options {
   std::string scenario_file;
   std::string scenario_text;  // its exact content
   QString sessions_database;  // empty: sessions.sqlite in the user's data directory
+  QString language;           // empty: the setting, else the system's
 };
 
 // Parsed under a plain QCoreApplication, so --help, --version and bad options work without a
 // display. Exits the process for --help, --version and errors, as QCommandLineParser does.
+// --language X or --language=X, if given: the help is printed in it.
+QString language_argument(const QStringList& arguments) {
+  for (qsizetype i = 1; i < arguments.size(); ++i) {
+    if (arguments[i] == QLatin1String("--language") && i + 1 < arguments.size())
+      return arguments[i + 1];
+    if (arguments[i].startsWith(QLatin1String("--language=")))
+      return arguments[i].mid(QStringLiteral("--language=").size());
+  }
+  return {};
+}
+
+// The names QSettings and the data folders go by.
+void name_application() {
+  QCoreApplication::setApplicationName("LiverSim");
+  QCoreApplication::setOrganizationName("LiverSim");
+  QCoreApplication::setApplicationVersion(LIVERSIM_VERSION);
+}
+
 Options parse_options(int argc, char** argv) {
   QCoreApplication app(argc, argv);
-  QCoreApplication::setApplicationName("liversim");
+  name_application();
+  QString language = language_argument(QCoreApplication::arguments());
+  if (language.isEmpty()) language = liversim::languageSetting();
+  liversim::installTranslations(language);
+  QCoreApplication::setApplicationName("liversim");  // what --version prints
   QCoreApplication::setApplicationVersion(LIVERSIM_VERSION);
   QCommandLineParser parser;
   parser.setApplicationDescription(
@@ -71,7 +96,23 @@ Options parse_options(int argc, char** argv) {
                                   "in the user's data directory)."),
       "file");
   parser.addOption(database);
+  const QCommandLineOption language_option(
+      "language",
+      QCoreApplication::translate("main",
+                                  "Interface language: en or zh_CN (default: the one chosen in "
+                                  "Settings, else the system's)."),
+      "code");
+  parser.addOption(language_option);
+  parser.addPositionalArgument(
+      "scenario-file",
+      QCoreApplication::translate("main", "A scenario file to run, as with --scenario."),
+      "[scenario-file]");
   parser.process(app);
+  const QStringList positional = parser.positionalArguments();
+  if (positional.size() > 1 || (positional.size() == 1 && parser.isSet(scenario))) {
+    std::cerr << "liversim: give one scenario file, either with --scenario or alone\n";
+    std::exit(2);
+  }
 
   Options options;
   bool ok = false;
@@ -92,13 +133,14 @@ Options parse_options(int argc, char** argv) {
     }
     options.quit_after_s = seconds;
   }
-  if (parser.isSet(scenario)) {
+  if (parser.isSet(scenario) || !positional.isEmpty()) {
     if (parser.isSet(tets)) {
       std::cerr << "liversim: --tets and --scenario cannot go together: the scenario sets the "
                    "element count (organ.target_tet_count)\n";
       std::exit(2);
     }
-    options.scenario_file = parser.value(scenario).toStdString();
+    options.scenario_file =
+        (positional.isEmpty() ? parser.value(scenario) : positional.front()).toStdString();
     liversim::ScenarioReading reading = liversim::read_scenario_file(options.scenario_file);
     if (!reading.scenario) {
       std::cerr << "liversim: cannot open the scenario " << options.scenario_file << ":\n";
@@ -111,6 +153,15 @@ Options parse_options(int argc, char** argv) {
     options.scenario_text.assign(std::istreambuf_iterator<char>(in), {});
   }
   if (parser.isSet(database)) options.sessions_database = parser.value(database);
+  if (parser.isSet(language_option)) {
+    options.language = parser.value(language_option);
+    if (!liversim::availableLanguages().contains(options.language)) {
+      std::cerr << "liversim: --language must be one of "
+                << liversim::availableLanguages().join(", ").toStdString() << ", not '"
+                << options.language.toStdString() << "'\n";
+      std::exit(2);
+    }
+  }
   return options;
 }
 
@@ -152,9 +203,11 @@ int main(int argc, char** argv) {
   }
   liversim::VtkViewport::setDefaultSurfaceFormat();  // before QApplication, for every GL context
   QApplication app(argc, argv);
-  QApplication::setApplicationName("LiverSim");
-  QApplication::setOrganizationName("LiverSim");
-  QApplication::setApplicationVersion(LIVERSIM_VERSION);
+  name_application();
+  QApplication::setDesktopFileName("org.liversim.LiverSim");
+  QApplication::setWindowIcon(QIcon(":/icons/liversim.svg"));
+  liversim::installTranslations(options.language.isEmpty() ? liversim::languageSetting()
+                                                           : options.language);
   try {
     liversim::MainWindow window(std::move(*setup), std::move(opened));
     QString database = options.sessions_database;

@@ -11,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev python3 python3-jsonschema
   xvfb xauth
+  libqt6svg6 qt6-translations-l10n fonts-wqy-microhei desktop-file-utils appstream
 )
 
 missing=()

@@ -10,14 +10,22 @@
 #include <QVBoxLayout>
 
 namespace liversim {
-namespace {
-
-QString nameOf(IntegratorKind kind) {
+QString AccuracyPanel::integratorName(IntegratorKind kind) {
+  switch (kind) {
+    case IntegratorKind::central_difference:
+      return tr("Central difference");
+    case IntegratorKind::rk4:
+      return tr("Runge–Kutta 4");
+    case IntegratorKind::dopri5:
+      return tr("Dormand–Prince 5(4)");
+    case IntegratorKind::backward_euler:
+      return tr("Backward Euler");
+    case IntegratorKind::bdf2:
+      return tr("BDF2");
+  }
   const std::string_view name = integrator_name(kind);
   return QString::fromUtf8(name.data(), static_cast<qsizetype>(name.size()));
 }
-
-}  // namespace
 
 AccuracyPanel::AccuracyPanel(QWidget* parent) : QWidget(parent) {
   integrator_ = new QComboBox(this);
@@ -25,7 +33,7 @@ AccuracyPanel::AccuracyPanel(QWidget* parent) : QWidget(parent) {
   for (IntegratorKind kind : kAllIntegrators) {
     const QString kindText = is_explicit(kind) ? tr("explicit") : tr("implicit");
     integrator_->addItem(
-        tr("%1 (%2, order %3)").arg(nameOf(kind), kindText).arg(integrator_order(kind)),
+        tr("%1 (%2, order %3)").arg(integratorName(kind), kindText).arg(integrator_order(kind)),
         static_cast<int>(kind));
   }
 
@@ -134,9 +142,9 @@ QString AccuracyPanel::describe(const IntegratorSettings& settings) const {
                            : tr("largest stable step");
   if (settings.kind == IntegratorKind::dopri5)
     return tr("%1, first %2, tolerance %3 µm")
-        .arg(nameOf(settings.kind), step)
+        .arg(integratorName(settings.kind), step)
         .arg(settings.tolerance_m / kMetresPerUm, 0, 'g', 3);
-  return tr("%1, %2").arg(nameOf(settings.kind), step);
+  return tr("%1, %2").arg(integratorName(settings.kind), step);
 }
 
 }  // namespace liversim

@@ -33,6 +33,10 @@ class AccuracyPanel : public QWidget {
   void showError(const QString& message);
   QString errorText() const;
 
+  // The integrator's name as the interface shows it ("Central difference", "Runge–Kutta 4"...),
+  // translated; integrator_name() is the one of files and the command line.
+  static QString integratorName(IntegratorKind kind);
+
   // Unit conversions of the fields: the step in milliseconds, the tolerance in micrometres.
   static constexpr double kSecondsPerMs = 1e-3;
   static constexpr double kMetresPerUm = 1e-6;

@@ -9,6 +9,7 @@
 #include "scenario_editor.h"
 #include "scenario_panel.h"
 #include "tool_panel.h"
+#include "translations.h"
 #include "vtk_viewport.h"
 
 #include "liversim/core/cutting.h"
@@ -24,6 +25,7 @@
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
 #include <QAction>
+#include <QActionGroup>
 #include <QDateTime>
 #include <QDir>
 #include <QDockWidget>
@@ -48,10 +50,6 @@
 
 namespace liversim {
 namespace {
-
-QString fromView(std::string_view text) {
-  return QString::fromUtf8(text.data(), static_cast<qsizetype>(text.size()));
-}
 
 // A positive number with two or three significant digits and no exponent: 0.81, 2.6, 15, 480.
 QString formatAmount(double value) {
@@ -329,7 +327,7 @@ void MainWindow::refuseScenario(const QString& file, const QString& why) {
 
 void MainWindow::showScenarioDetails() {
   const QString name = scenario_ ? QString::fromStdString(scenario_->scenario.title)
-                                 : QString::fromStdString(setup_.description);
+                                 : tr("free practice, %1 elements").arg(setup_.mesh.tet_count());
   setWindowTitle(tr("LiverSim — %1").arg(name));
   scenarioPanel_->showScenario(scenario_ ? &scenario_->scenario : nullptr,
                                scenario_ ? scenario_->file : QString());
@@ -341,11 +339,9 @@ void MainWindow::buildMenus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
   file->setObjectName("fileMenu");
   QAction* open = file->addAction(tr("&Open Scenario…"), this, [this] {
-    const QStringList recent = recentScenarioFiles();
-    const QString folder =
-        recent.isEmpty() ? QDir::currentPath() : QFileInfo(recent.front()).absolutePath();
-    const QString chosen = QFileDialog::getOpenFileName(
-        this, tr("Open a scenario"), folder, tr("LiverSim scenarios (*.json);;All files (*)"));
+    const QString chosen =
+        QFileDialog::getOpenFileName(this, tr("Open a scenario"), scenarioFolderToOpen(),
+                                     tr("LiverSim scenarios (*.json);;All files (*)"));
     if (!chosen.isEmpty()) openScenarioFromMenu(chosen);
   });
   open->setObjectName("openScenarioAction");
@@ -378,6 +374,26 @@ void MainWindow::buildMenus() {
   mark->setToolTip(
       tr("Palpation: mark the point of the liver under the tool as where the lesion "
          "is (graded at the session's end)"));
+
+  QMenu* settings = menuBar()->addMenu(tr("Se&ttings"));
+  settings->setObjectName("settingsMenu");
+  QMenu* language = settings->addMenu(tr("&Language"));
+  language->setObjectName("languageMenu");
+  auto* languages = new QActionGroup(language);
+  const QString chosen = languageSetting();
+  const auto addLanguage = [&](const QString& code, const QString& name) {
+    QAction* action = language->addAction(name);
+    action->setObjectName("language_" + (code.isEmpty() ? QStringLiteral("system") : code));
+    action->setCheckable(true);
+    action->setChecked(code == chosen);
+    languages->addAction(action);
+    connect(action, &QAction::triggered, this, [this, code] {
+      setLanguageSetting(code);
+      statusBar()->showMessage(tr("LiverSim will use this language when it starts again."));
+    });
+  };
+  addLanguage({}, tr("The System's Language"));
+  for (const QString& code : availableLanguages()) addLanguage(code, languageName(code));
 }
 
 ScenarioEditor* MainWindow::openScenarioEditor() {
@@ -739,8 +755,9 @@ QString MainWindow::formatError(double error_m) {
 }
 
 QString MainWindow::accuracyStatus(const RealtimeStats& stats) const {
-  QString text =
-      tr("%1 · error %2").arg(fromView(stats.integrator_name), formatError(stats.error_estimate_m));
+  QString text = tr("%1 · error %2")
+                     .arg(AccuracyPanel::integratorName(stats.integrator),
+                          formatError(stats.error_estimate_m));
   if (stats.wall_s_per_simulated_s > 0.0) {
     // Both are per millisecond of simulated time: the scale of a step.
     text += tr(" · %1 ms wall per ms simulated · %2 force evaluations per ms simulated")

@@ -1,5 +1,8 @@
 #include "recent_scenarios.h"
 
+#include "liversim/core/data_paths.h"
+
+#include <QDir>
 #include <QFileInfo>
 #include <QSettings>
 
@@ -19,6 +22,13 @@ void rememberScenarioFile(const QString& file) {
   recent.prepend(absolute);
   while (recent.size() > kRecentScenarioCount) recent.removeLast();
   QSettings().setValue(kKey, recent);
+}
+
+QString scenarioFolderToOpen() {
+  const QStringList recent = recentScenarioFiles();
+  if (!recent.isEmpty()) return QFileInfo(recent.front()).absolutePath();
+  const QString shipped = QString::fromStdString(shipped_scenarios_folder().string());
+  return QFileInfo(shipped).isDir() ? shipped : QDir::currentPath();
 }
 
 }  // namespace liversim

@@ -192,11 +192,9 @@ void ScenarioEditor::buildActions() {
   });
   add(file, tr("&Open…"), "openScenarioAction", QKeySequence::Open, [this] {
     if (!maybeSave()) return;
-    const QStringList recent = recentScenarioFiles();
-    const QString folder =
-        recent.isEmpty() ? QDir::currentPath() : QFileInfo(recent.front()).absolutePath();
-    const QString chosen = QFileDialog::getOpenFileName(
-        this, tr("Open a scenario"), folder, tr("LiverSim scenarios (*.json);;All files (*)"));
+    const QString chosen =
+        QFileDialog::getOpenFileName(this, tr("Open a scenario"), scenarioFolderToOpen(),
+                                     tr("LiverSim scenarios (*.json);;All files (*)"));
     if (!chosen.isEmpty()) openFile(chosen);
   });
   recentMenu_ = file->addMenu(tr("Open &Recent"));

@@ -489,7 +489,7 @@ TEST_F(MainWindowTest, TheStatusBarReportsFrameRateAndSimulationSpeed) {
   }
   EXPECT_FALSE(status->text().contains("pulling")) << "nothing is grabbed";
   // The accuracy part: the scenario's integrator and its error estimate.
-  EXPECT_TRUE(status->text().contains(QStringLiteral("central-difference · error")))
+  EXPECT_TRUE(status->text().contains(QStringLiteral("Central difference · error")))
       << status->text().toStdString();
 }
 
@@ -592,7 +592,7 @@ TEST_F(MainWindowTest, AnInvalidAccuracySettingIsExplainedAndTheRunningOneStays)
   const std::uint64_t steps = window_->simulation().snapshot().step_count;
   ASSERT_TRUE(waitSimulated(0.05));
   EXPECT_GT(window_->simulation().snapshot().step_count, steps);
-  EXPECT_TRUE(QTest::qWaitFor([&] { return statusText().contains("central-difference"); }, 5'000))
+  EXPECT_TRUE(QTest::qWaitFor([&] { return statusText().contains("Central difference"); }, 5'000))
       << statusText().toStdString();
 
   // A valid setting afterwards is applied and clears the message.

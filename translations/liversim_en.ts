@@ -1,0 +1,31 @@
+<?xml version="1.0" encoding="utf-8"?>
+<!DOCTYPE TS>
+<TS version="2.1" language="en" sourcelanguage="en">
+<context>
+    <name>liversim::ScenarioEditor</name>
+    <message numerus="yes">
+        <source>%n ball(s)</source>
+        <translation>
+            <numerusform>%n ball</numerusform>
+            <numerusform>%n balls</numerusform>
+        </translation>
+    </message>
+</context>
+<context>
+    <name>liversim::ScenarioPanel</name>
+    <message numerus="yes">
+        <source>%n lesion(s)</source>
+        <translation>
+            <numerusform>%n lesion</numerusform>
+            <numerusform>%n lesions</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>, %n hidden</source>
+        <translation>
+            <numerusform>, %n hidden</numerusform>
+            <numerusform>, %n hidden</numerusform>
+        </translation>
+    </message>
+</context>
+</TS>

@@ -1,0 +1,1966 @@
+<?xml version="1.0" encoding="utf-8"?>
+<!DOCTYPE TS>
+<TS version="2.1" language="zh_CN" sourcelanguage="en">
+<context>
+    <name>ForceChart</name>
+    <message>
+        <source>Time (s)</source>
+        <translation>时间 (s)</translation>
+    </message>
+    <message>
+        <source>Force (N)</source>
+        <translation>力 (N)</translation>
+    </message>
+</context>
+<context>
+    <name>QObject</name>
+    <message>
+        <source>%1 could not be written: %2</source>
+        <translation>无法写入 %1：%2</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::AccuracyPanel</name>
+    <message>
+        <source>explicit</source>
+        <translation>显式</translation>
+    </message>
+    <message>
+        <source>implicit</source>
+        <translation>隐式</translation>
+    </message>
+    <message>
+        <source>%1 (%2, order %3)</source>
+        <translation>%1（%2，%3 阶）</translation>
+    </message>
+    <message>
+        <source> ms</source>
+        <translation> ms</translation>
+    </message>
+    <message>
+        <source>Step:</source>
+        <translation>步长：</translation>
+    </message>
+    <message>
+        <source> µm</source>
+        <translation> µm</translation>
+    </message>
+    <message>
+        <source>Error tolerance:</source>
+        <translation>误差容差：</translation>
+    </message>
+    <message>
+        <source>Local error allowed per step (node positions).</source>
+        <translation>每步允许的局部误差（节点位置）。</translation>
+    </message>
+    <message>
+        <source>Apply</source>
+        <translation>应用</translation>
+    </message>
+    <message>
+        <source>Rebuilds the model with this integrator and carries the liver&apos;s current motion over.</source>
+        <translation>使用此时间积分器重建模型，并沿用肝脏当前的运动状态。</translation>
+    </message>
+    <message>
+        <source>Integrator:</source>
+        <translation>时间积分器：</translation>
+    </message>
+    <message>
+        <source>In use: %1</source>
+        <translation>当前使用：%1</translation>
+    </message>
+    <message>
+        <source>Rebuilding the model…</source>
+        <translation>正在重建模型…</translation>
+    </message>
+    <message>
+        <source>Not applied: %1</source>
+        <translation>未应用：%1</translation>
+    </message>
+    <message>
+        <source>largest stable</source>
+        <translation>最大稳定步长</translation>
+    </message>
+    <message>
+        <source>First step:</source>
+        <translation>初始步长：</translation>
+    </message>
+    <message>
+        <source>step %1 ms</source>
+        <translation>步长 %1 ms</translation>
+    </message>
+    <message>
+        <source>largest stable step</source>
+        <translation>最大稳定步长</translation>
+    </message>
+    <message>
+        <source>%1, first %2, tolerance %3 µm</source>
+        <translation>%1，初始%2，容差 %3 µm</translation>
+    </message>
+    <message>
+        <source>%1, %2</source>
+        <translation>%1，%2</translation>
+    </message>
+    <message>
+        <source>Central difference</source>
+        <translation>中心差分</translation>
+    </message>
+    <message>
+        <source>Runge–Kutta 4</source>
+        <translation>四阶龙格-库塔 (RK4)</translation>
+    </message>
+    <message>
+        <source>Dormand–Prince 5(4)</source>
+        <translation>Dormand–Prince 5(4)</translation>
+    </message>
+    <message>
+        <source>Backward Euler</source>
+        <translation>后向欧拉</translation>
+    </message>
+    <message>
+        <source>BDF2</source>
+        <translation>BDF2</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::CalibrationDialog</name>
+    <message>
+        <source>Calibrate %1</source>
+        <translation>校准%1</translation>
+    </message>
+    <message>
+        <source>Device calibration:</source>
+        <translation>设备校准：</translation>
+    </message>
+    <message>
+        <source>Stylus at:</source>
+        <translation>触笔位置：</translation>
+    </message>
+    <message>
+        <source> ×</source>
+        <translation> ×</translation>
+    </message>
+    <message>
+        <source>Scene distance per device distance: above 1 the tool moves farther than the hand, and forces are felt weaker by the same factor</source>
+        <translation>场景移动距离与设备移动距离之比：大于 1 时器械的移动距离大于手的移动距离，感受到的力也按同一倍数减弱</translation>
+    </message>
+    <message>
+        <source>Motion scale:</source>
+        <translation>运动比例：</translation>
+    </message>
+    <message>
+        <source> mm</source>
+        <translation> mm</translation>
+    </message>
+    <message>
+        <source>Scene point of the device&apos;s origin (x, y, z):</source>
+        <translation>设备原点在场景中的位置 (x, y, z)：</translation>
+    </message>
+    <message>
+        <source>Device axes in the scene:</source>
+        <translation>设备坐标轴在场景中的方向：</translation>
+    </message>
+    <message>
+        <source>&amp;Align with the view</source>
+        <translation>与视图对齐(&amp;A)</translation>
+    </message>
+    <message>
+        <source>Turn the device&apos;s axes to the screen&apos;s: right, up and toward you</source>
+        <translation>将设备坐标轴转到与屏幕一致：向右、向上、朝向您</translation>
+    </message>
+    <message>
+        <source>&amp;Centre here</source>
+        <translation>在此居中(&amp;C)</translation>
+    </message>
+    <message>
+        <source>Hold the stylus in the middle of its workspace and press: the tool will be just in front of the liver there</source>
+        <translation>将触笔握持在其工作空间中央并按下此按钮：触笔在该处时器械将正好位于肝脏前方</translation>
+    </message>
+    <message>
+        <source>First button</source>
+        <translation>第一个按钮</translation>
+    </message>
+    <message>
+        <source>Second button</source>
+        <translation>第二个按钮</translation>
+    </message>
+    <message>
+        <source>Either button</source>
+        <translation>任一按钮</translation>
+    </message>
+    <message>
+        <source>Held, this button closes the forceps or lets the scalpel cut</source>
+        <translation>按住此按钮时抓钳闭合，或手术刀进行切割</translation>
+    </message>
+    <message>
+        <source>Grasp / cut button:</source>
+        <translation>抓取/切割按钮：</translation>
+    </message>
+    <message>
+        <source>The device has reported no position yet: is it connected?</source>
+        <translation>设备尚未报告位置：是否已连接？</translation>
+    </message>
+    <message>
+        <source>Centred: the stylus is now just in front of the liver.</source>
+        <translation>已居中：触笔当前位置对应肝脏正前方。</translation>
+    </message>
+    <message>
+        <source>%1, %2, %3 mm</source>
+        <translation>%1, %2, %3 mm</translation>
+    </message>
+    <message>
+        <source>no position yet</source>
+        <translation>尚无位置</translation>
+    </message>
+    <message>
+        <source>(%1, %2, %3)</source>
+        <translation>(%1, %2, %3)</translation>
+    </message>
+    <message>
+        <source>x → %1, y → %2, z → %3</source>
+        <translation>x → %1，y → %2，z → %3</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::DevicePanel</name>
+    <message>
+        <source>Mouse and keyboard</source>
+        <translation>鼠标和键盘</translation>
+    </message>
+    <message>
+        <source>Phantom Omni (OpenHaptics)</source>
+        <translation>Phantom Omni (OpenHaptics)</translation>
+    </message>
+    <message>
+        <source>Scripted trajectory…</source>
+        <translation>脚本轨迹…</translation>
+    </message>
+    <message>
+        <source>Replay of a session…</source>
+        <translation>回放训练记录…</translation>
+    </message>
+    <message>
+        <source>Move the tool with the mouse in the viewport</source>
+        <translation>在视口中用鼠标移动器械</translation>
+    </message>
+    <message>
+        <source>Play a trajectory file (time s, x y z mm, buttons per line) on the tool</source>
+        <translation>用轨迹文件驱动器械（每行：时间 s，x y z mm，按钮）</translation>
+    </message>
+    <message>
+        <source>&amp;Calibrate…</source>
+        <translation>校准(&amp;C)…</translation>
+    </message>
+    <message>
+        <source>The haptic servo loop: tick rate, tick periods (median and 99th percentile), late ticks, and the safety limits it applied</source>
+        <translation>力反馈伺服循环：节拍频率、节拍周期（中位数和第 99 百分位数）、超时节拍数，以及所施加的安全限制</translation>
+    </message>
+    <message>
+        <source>Phantom Omni (OpenHaptics): not found</source>
+        <translation>Phantom Omni (OpenHaptics)：未找到</translation>
+    </message>
+    <message>
+        <source>The Phantom Omni found through OpenHaptics</source>
+        <translation>通过 OpenHaptics 找到的 Phantom Omni</translation>
+    </message>
+    <message>
+        <source>Not available: %1. Choose it again to look again.</source>
+        <translation>不可用：%1。再次选择此项可重新查找。</translation>
+    </message>
+    <message>
+        <source>Map the device&apos;s workspace onto the scene and choose its buttons</source>
+        <translation>将设备的工作空间映射到场景中，并选择按钮功能</translation>
+    </message>
+    <message>
+        <source>Choose a device first: the mouse needs no calibration</source>
+        <translation>请先选择设备：鼠标无需校准</translation>
+    </message>
+    <message>
+        <source>Servo: starting</source>
+        <translation>伺服：正在启动</translation>
+    </message>
+    <message>
+        <source>Servo: %1 Hz · period %2 ms median, %3 ms p99 · %4 late · clamped: stiffness %5, force %6, rate %7 · watchdog %8 · device faults %9</source>
+        <translation>伺服：%1 Hz · 周期中位数 %2 ms，p99 %3 ms · 超时 %4 次 · 限幅：刚度 %5，力 %6，变化率 %7 · 看门狗 %8 · 设备故障 %9</translation>
+    </message>
+    <message>
+        <source>Servo: not running (the mouse moves the tool)</source>
+        <translation>伺服：未运行（由鼠标移动器械）</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::ForceTrace</name>
+    <message>
+        <source>Force on the tool over the last %1 s</source>
+        <translation>最近 %1 s 内器械受力</translation>
+    </message>
+    <message>
+        <source>%1 N</source>
+        <translation>%1 N</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::MainWindow</name>
+    <message>
+        <source>Scenario</source>
+        <translation>场景</translation>
+    </message>
+    <message>
+        <source>Accuracy</source>
+        <translation>精度</translation>
+    </message>
+    <message>
+        <source>Tool</source>
+        <translation>器械</translation>
+    </message>
+    <message>
+        <source>Device</source>
+        <translation>设备</translation>
+    </message>
+    <message>
+        <source>Trajectory to play</source>
+        <translation>要播放的轨迹</translation>
+    </message>
+    <message>
+        <source>Trajectories (*.txt *.trajectory);;All files (*)</source>
+        <translation>轨迹文件 (*.txt *.trajectory);;所有文件 (*)</translation>
+    </message>
+    <message>
+        <source>Drag the liver with the left mouse button; drag the background to turn the view, wheel to zoom.</source>
+        <translation>按住鼠标左键拖动肝脏；拖动背景可旋转视图，滚动滚轮可缩放。</translation>
+    </message>
+    <message>
+        <source>Building the scene of %1…</source>
+        <translation>正在构建 %1 的场景…</translation>
+    </message>
+    <message>
+        <source>Building the scene of %1: meshing the organ, attempt %2 of at most %3 (elements of %4 mm)…</source>
+        <translation>正在构建 %1 的场景：正在为器官划分网格，第 %2 次尝试（最多 %3 次，单元尺寸 %4 mm）…</translation>
+    </message>
+    <message>
+        <source>Building the scene of %1: attempt %2 made %3 elements…</source>
+        <translation>正在构建 %1 的场景：第 %2 次尝试生成了 %3 个单元…</translation>
+    </message>
+    <message>
+        <source>Opened %1.</source>
+        <translation>已打开 %1。</translation>
+    </message>
+    <message>
+        <source>“%1” (from the editor, not saved)</source>
+        <translation>“%1”（来自编辑器，未保存）</translation>
+    </message>
+    <message>
+        <source>Cannot open the scenario %1:
+%2
+The scene that was running goes on.</source>
+        <translation>无法打开场景 %1：
+%2
+原先运行的场景将继续运行。</translation>
+    </message>
+    <message>
+        <source>Cannot open the scenario %1.</source>
+        <translation>无法打开场景 %1。</translation>
+    </message>
+    <message>
+        <source>Cannot open the scenario</source>
+        <translation>无法打开场景</translation>
+    </message>
+    <message>
+        <source>LiverSim — %1</source>
+        <translation>LiverSim — %1</translation>
+    </message>
+    <message>
+        <source>&amp;File</source>
+        <translation>文件(&amp;F)</translation>
+    </message>
+    <message>
+        <source>&amp;Open Scenario…</source>
+        <translation>打开场景(&amp;O)…</translation>
+    </message>
+    <message>
+        <source>Open a scenario</source>
+        <translation>打开场景</translation>
+    </message>
+    <message>
+        <source>LiverSim scenarios (*.json);;All files (*)</source>
+        <translation>LiverSim 场景 (*.json);;所有文件 (*)</translation>
+    </message>
+    <message>
+        <source>Open &amp;Recent</source>
+        <translation>最近打开(&amp;R)</translation>
+    </message>
+    <message>
+        <source>Scenario &amp;Editor…</source>
+        <translation>场景编辑器(&amp;E)…</translation>
+    </message>
+    <message>
+        <source>Instructors: author the scenario shown, or a new one</source>
+        <translation>供教员使用：编辑当前显示的场景，或新建场景</translation>
+    </message>
+    <message>
+        <source>&amp;Quit</source>
+        <translation>退出(&amp;Q)</translation>
+    </message>
+    <message>
+        <source>&amp;Session</source>
+        <translation>训练(&amp;S)</translation>
+    </message>
+    <message>
+        <source>&amp;Mark the Lesion Here</source>
+        <translation>在此标记病灶(&amp;M)</translation>
+    </message>
+    <message>
+        <source>&amp;Review Sessions…</source>
+        <translation>审阅训练记录(&amp;R)…</translation>
+    </message>
+    <message>
+        <source>My &amp;Sessions…</source>
+        <translation>我的训练记录(&amp;S)…</translation>
+    </message>
+    <message>
+        <source>Palpation: mark the point of the liver under the tool as where the lesion is (graded at the session&apos;s end)</source>
+        <translation>触诊：将器械下方的肝脏位置标记为病灶所在处（训练结束时评分）</translation>
+    </message>
+    <message>
+        <source>A scene is still being built; try the scenario after it.</source>
+        <translation>仍在构建场景；请在构建完成后再试运行该场景。</translation>
+    </message>
+    <message>
+        <source>A scene is still being built; open the scenario after it.</source>
+        <translation>仍在构建场景；请在构建完成后再打开该场景。</translation>
+    </message>
+    <message>
+        <source>The liver was cut while the integrator changed; apply it again.</source>
+        <translation>更换时间积分器期间肝脏被切割；请重新应用。</translation>
+    </message>
+    <message>
+        <source>%1 fps | %2 steps/s | real-time factor %3 | step %4 ms</source>
+        <translation>%1 帧/秒 | %2 步/秒 | 实时因子 %3 | 步长 %4 ms</translation>
+    </message>
+    <message>
+        <source> | slower than real time</source>
+        <translation> | 慢于实时</translation>
+    </message>
+    <message>
+        <source> | </source>
+        <translation> | </translation>
+    </message>
+    <message>
+        <source>Simulation halted: %1; every retry with shorter steps failed. Apply a setting in the Accuracy panel (another integrator or a shorter step) to go on from the last good state. | </source>
+        <translation>仿真已停止：%1；以更短步长进行的所有重试均失败。请在“精度”面板中应用新设置（更换时间积分器或缩短步长），以从最后一个正常状态继续。 | </translation>
+    </message>
+    <message>
+        <source> | recovered %1 times, refused %2 inputs (last: %3)</source>
+        <translation> | 已恢复 %1 次，拒绝输入 %2 次（最近一次：%3）</translation>
+    </message>
+    <message>
+        <source> | energy books: the scheme is creating energy (choose a shorter step or an implicit scheme)</source>
+        <translation> | 能量核算：积分格式正在凭空产生能量（请选用更短的步长或隐式格式）</translation>
+    </message>
+    <message>
+        <source> | pulling %1 N</source>
+        <translation> | 拉力 %1 N</translation>
+    </message>
+    <message>
+        <source> | resected %1 mL</source>
+        <translation> | 已切除 %1 mL</translation>
+    </message>
+    <message>
+        <source>no problem</source>
+        <translation>无问题</translation>
+    </message>
+    <message>
+        <source>a tool input was not a number</source>
+        <translation>器械输入不是有效数值</translation>
+    </message>
+    <message>
+        <source>a node position became not a number</source>
+        <translation>某节点位置变为非数值</translation>
+    </message>
+    <message>
+        <source>a node velocity became not a number</source>
+        <translation>某节点速度变为非数值</translation>
+    </message>
+    <message>
+        <source>a node moved implausibly fast</source>
+        <translation>某节点移动速度异常过快</translation>
+    </message>
+    <message>
+        <source>a node gained more energy than the tools put in</source>
+        <translation>某节点获得的能量超过器械输入的能量</translation>
+    </message>
+    <message>
+        <source>an implicit step did not converge</source>
+        <translation>隐式步未收敛</translation>
+    </message>
+    <message>
+        <source>unknown problem</source>
+        <translation>未知问题</translation>
+    </message>
+    <message>
+        <source>n/a</source>
+        <translation>无</translation>
+    </message>
+    <message>
+        <source>&lt; 1 pm</source>
+        <translation>&lt; 1 pm</translation>
+    </message>
+    <message>
+        <source>≈ %1 pm</source>
+        <translation>≈ %1 pm</translation>
+    </message>
+    <message>
+        <source>≈ %1 nm</source>
+        <translation>≈ %1 nm</translation>
+    </message>
+    <message>
+        <source>≈ %1 µm</source>
+        <translation>≈ %1 µm</translation>
+    </message>
+    <message>
+        <source>≈ %1 mm</source>
+        <translation>≈ %1 mm</translation>
+    </message>
+    <message>
+        <source>%1 · error %2</source>
+        <translation>%1 · 误差 %2</translation>
+    </message>
+    <message>
+        <source> · %1 ms wall per ms simulated · %2 force evaluations per ms simulated</source>
+        <translation> · 每仿真 1 ms 耗时 %1 ms · 每仿真 1 ms 计算力 %2 次</translation>
+    </message>
+    <message>
+        <source> · stability-limited</source>
+        <translation> · 受稳定性限制</translation>
+    </message>
+    <message>
+        <source>Sessions are not recorded: %1</source>
+        <translation>无法记录训练：%1</translation>
+    </message>
+    <message>
+        <source>There is no sessions database.</source>
+        <translation>没有训练记录数据库。</translation>
+    </message>
+    <message>
+        <source>Cannot replay session %1: %2</source>
+        <translation>无法回放训练记录 %1：%2</translation>
+    </message>
+    <message>
+        <source>Session %1 has no device input to replay.</source>
+        <translation>训练记录 %1 没有可回放的设备输入。</translation>
+    </message>
+    <message>
+        <source>Replay of session %1</source>
+        <translation>回放训练记录 %1</translation>
+    </message>
+    <message>
+        <source>%1: %2, %3, %4 (%5)</source>
+        <translation>%1: %2，%3，%4（%5）</translation>
+    </message>
+    <message>
+        <source>No recorded session has device input to replay.</source>
+        <translation>没有包含可回放设备输入的训练记录。</translation>
+    </message>
+    <message>
+        <source>Replay a session</source>
+        <translation>回放训练记录</translation>
+    </message>
+    <message>
+        <source>Session:</source>
+        <translation>训练记录：</translation>
+    </message>
+    <message>
+        <source>Free practice</source>
+        <translation>自由练习</translation>
+    </message>
+    <message>
+        <source>Trainee</source>
+        <translation>学员</translation>
+    </message>
+    <message>
+        <source>Last session: peak force %1 N (free practice: no rubric).</source>
+        <translation>上次训练：峰值力 %1 N（自由练习：无评分标准）。</translation>
+    </message>
+    <message>
+        <source>Last session stored (no rubric).</source>
+        <translation>上次训练已保存（无评分标准）。</translation>
+    </message>
+    <message>
+        <source>was %1</source>
+        <translation>实际为 %1</translation>
+    </message>
+    <message>
+        <source>not done</source>
+        <translation>未完成</translation>
+    </message>
+    <message>
+        <source>Last session: score %1 %</source>
+        <translation>上次训练：得分 %1%</translation>
+    </message>
+    <message>
+        <source>, every criterion passed.</source>
+        <translation>，所有标准均已通过。</translation>
+    </message>
+    <message>
+        <source>. Not passed: %1.</source>
+        <translation>。未通过：%1。</translation>
+    </message>
+    <message>
+        <source>Marks are kept with a recorded session: put a tool on the liver first.</source>
+        <translation>标记随训练记录保存：请先将器械放到肝脏上。</translation>
+    </message>
+    <message>
+        <source>Marks are kept with a recorded session, and there is no sessions database.</source>
+        <translation>标记随训练记录保存，但没有训练记录数据库。</translation>
+    </message>
+    <message>
+        <source>Hold a tool over the place to mark.</source>
+        <translation>请将器械停在要标记的位置上。</translation>
+    </message>
+    <message>
+        <source>Marked the lesion at (%1, %2, %3) mm.</source>
+        <translation>已在 (%1, %2, %3) mm 处标记病灶。</translation>
+    </message>
+    <message>
+        <source>The session was not saved whole: %1</source>
+        <translation>训练记录未完整保存：%1</translation>
+    </message>
+    <message>
+        <source>The session&apos;s metrics were not stored: %1</source>
+        <translation>训练记录的指标未保存：%1</translation>
+    </message>
+    <message>
+        <source>The Phantom Omni is not available: %1</source>
+        <translation>Phantom Omni 不可用：%1</translation>
+    </message>
+    <message>
+        <source>Choose a recorded session to replay.</source>
+        <translation>请选择要回放的训练记录。</translation>
+    </message>
+    <message>
+        <source>Choose a trajectory file to play.</source>
+        <translation>请选择要播放的轨迹文件。</translation>
+    </message>
+    <message>
+        <source>Scripted: %1</source>
+        <translation>脚本：%1</translation>
+    </message>
+    <message>
+        <source>Cannot play the trajectory: %1</source>
+        <translation>无法播放轨迹：%1</translation>
+    </message>
+    <message>
+        <source>Cannot run the device: %1</source>
+        <translation>无法运行设备：%1</translation>
+    </message>
+    <message>
+        <source>The mouse moves the tool: press on the liver to put the tool chosen in the Tool panel there.</source>
+        <translation>由鼠标移动器械：在肝脏上按下鼠标，即可将“器械”面板中所选的器械放到该处。</translation>
+    </message>
+    <message>
+        <source>%1 moves the tool chosen in the Tool panel.</source>
+        <translation>由 %1 移动“器械”面板中所选的器械。</translation>
+    </message>
+    <message>
+        <source>The device</source>
+        <translation>设备</translation>
+    </message>
+    <message>
+        <source>%1 stopped: %2. The mouse moves the tool now; choose the device again once it is back.</source>
+        <translation>%1已停止：%2。现在由鼠标移动器械；设备恢复后请重新选择它。</translation>
+    </message>
+    <message>
+        <source>the scripted device</source>
+        <translation>脚本设备</translation>
+    </message>
+    <message>
+        <source>the device</source>
+        <translation>设备</translation>
+    </message>
+    <message>
+        <source>calibrated</source>
+        <translation>已校准</translation>
+    </message>
+    <message>
+        <source>not calibrated: put the stylus in its inkwell (or move it through its whole range), then open this dialog again</source>
+        <translation>未校准：请将触笔放入笔座（或在其整个活动范围内移动一遍），然后重新打开此对话框</translation>
+    </message>
+    <message>
+        <source>Se&amp;ttings</source>
+        <translation>设置(&amp;T)</translation>
+    </message>
+    <message>
+        <source>&amp;Language</source>
+        <translation>语言(&amp;L)</translation>
+    </message>
+    <message>
+        <source>LiverSim will use this language when it starts again.</source>
+        <translation>LiverSim 将在下次启动时使用此语言。</translation>
+    </message>
+    <message>
+        <source>The System&apos;s Language</source>
+        <translation>跟随系统语言</translation>
+    </message>
+    <message>
+        <source>free practice, %1 elements</source>
+        <translation>自由练习，%1 个单元</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::ScenarioDocument</name>
+    <message>
+        <source>New scenario</source>
+        <translation>新场景</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::ScenarioEditor</name>
+    <message>
+        <source>Lesions</source>
+        <translation>病灶</translation>
+    </message>
+    <message>
+        <source>Task</source>
+        <translation>任务</translation>
+    </message>
+    <message>
+        <source>Tissue and effects</source>
+        <translation>组织与效应</translation>
+    </message>
+    <message>
+        <source>Organ and accuracy</source>
+        <translation>器官与精度</translation>
+    </message>
+    <message>
+        <source>Grading</source>
+        <translation>评分</translation>
+    </message>
+    <message>
+        <source>&amp;File</source>
+        <translation>文件(&amp;F)</translation>
+    </message>
+    <message>
+        <source>Editor</source>
+        <translation>编辑器</translation>
+    </message>
+    <message>
+        <source>&amp;New Scenario</source>
+        <translation>新建场景(&amp;N)</translation>
+    </message>
+    <message>
+        <source>&amp;Open…</source>
+        <translation>打开(&amp;O)…</translation>
+    </message>
+    <message>
+        <source>Open a scenario</source>
+        <translation>打开场景</translation>
+    </message>
+    <message>
+        <source>LiverSim scenarios (*.json);;All files (*)</source>
+        <translation>LiverSim 场景 (*.json);;所有文件 (*)</translation>
+    </message>
+    <message>
+        <source>Open &amp;Recent</source>
+        <translation>最近打开(&amp;R)</translation>
+    </message>
+    <message>
+        <source>&amp;Save</source>
+        <translation>保存(&amp;S)</translation>
+    </message>
+    <message>
+        <source>Save &amp;As…</source>
+        <translation>另存为(&amp;A)…</translation>
+    </message>
+    <message>
+        <source>Save the scenario</source>
+        <translation>保存场景</translation>
+    </message>
+    <message>
+        <source>LiverSim scenarios (*.json)</source>
+        <translation>LiverSim 场景 (*.json)</translation>
+    </message>
+    <message>
+        <source>&amp;Close</source>
+        <translation>关闭(&amp;C)</translation>
+    </message>
+    <message>
+        <source>&amp;Edit</source>
+        <translation>编辑(&amp;E)</translation>
+    </message>
+    <message>
+        <source>&amp;Undo</source>
+        <translation>撤销(&amp;U)</translation>
+    </message>
+    <message>
+        <source>&amp;Redo</source>
+        <translation>重做(&amp;R)</translation>
+    </message>
+    <message>
+        <source>Undo</source>
+        <translation>撤销</translation>
+    </message>
+    <message>
+        <source>Redo</source>
+        <translation>重做</translation>
+    </message>
+    <message>
+        <source>Turn</source>
+        <translation>旋转</translation>
+    </message>
+    <message>
+        <source>Drag to turn the view; drag a lesion to move it (Shift: resize it)</source>
+        <translation>拖动以旋转视图；拖动病灶可移动它（按住 Shift：调整其大小）</translation>
+    </message>
+    <message>
+        <source>Place lesion</source>
+        <translation>放置病灶</translation>
+    </message>
+    <message>
+        <source>Click on the organ to put a lesion under its surface there</source>
+        <translation>单击器官，在该处表面下方放置一个病灶</translation>
+    </message>
+    <message>
+        <source>Draw plane</source>
+        <translation>绘制平面</translation>
+    </message>
+    <message>
+        <source>Drag across the organ: the planned resection plane runs along the line, straight away from you (resection tasks)</source>
+        <translation>在器官上拖出一条线：计划切除平面沿此线并垂直于屏幕向内延伸（切除任务）</translation>
+    </message>
+    <message>
+        <source>Paint fixed</source>
+        <translation>涂刷固定区</translation>
+    </message>
+    <message>
+        <source>Drag over the surface to hold it fixed there (ligament attachments)</source>
+        <translation>在表面上拖动，将所经之处固定（韧带附着处）</translation>
+    </message>
+    <message>
+        <source>Try it</source>
+        <translation>试运行</translation>
+    </message>
+    <message>
+        <source>Run the scenario as it is now in the workstation</source>
+        <translation>在工作站中按当前状态运行该场景</translation>
+    </message>
+    <message>
+        <source>Add</source>
+        <translation>添加</translation>
+    </message>
+    <message>
+        <source>A new lesion at the organ&apos;s centre (or use Place lesion)</source>
+        <translation>在器官中心新建一个病灶（或使用“放置病灶”）</translation>
+    </message>
+    <message>
+        <source>Remove</source>
+        <translation>移除</translation>
+    </message>
+    <message>
+        <source>Add a lesion</source>
+        <translation>添加病灶</translation>
+    </message>
+    <message>
+        <source>Remove the lesion</source>
+        <translation>移除病灶</translation>
+    </message>
+    <message>
+        <source>The lesion&apos;s name, which the task refers to</source>
+        <translation>病灶名称，供任务引用</translation>
+    </message>
+    <message>
+        <source>Name</source>
+        <translation>名称</translation>
+    </message>
+    <message>
+        <source>Rename the lesion</source>
+        <translation>重命名病灶</translation>
+    </message>
+    <message>
+        <source>The lesion&apos;s centre along the scene&apos;s %1 axis</source>
+        <translation>病灶中心在场景 %1 轴上的坐标</translation>
+    </message>
+    <message>
+        <source>The lesion&apos;s semi-axis along the scene&apos;s %1 axis (Shift-drag the lesion in the view to resize it)</source>
+        <translation>病灶沿场景 %1 轴的半轴长（在视图中按住 Shift 拖动病灶可调整其大小）</translation>
+    </message>
+    <message>
+        <source>Move the lesion</source>
+        <translation>移动病灶</translation>
+    </message>
+    <message>
+        <source>Resize the lesion</source>
+        <translation>调整病灶大小</translation>
+    </message>
+    <message>
+        <source>Centre (x, y, z)</source>
+        <translation>中心 (x, y, z)</translation>
+    </message>
+    <message>
+        <source>Semi-axes</source>
+        <translation>半轴</translation>
+    </message>
+    <message>
+        <source>Young&apos;s modulus of the lesion (instantaneous, with viscoelasticity): %1 to %2 times the parenchyma&apos;s. %3</source>
+        <translation>病灶的杨氏模量（启用粘弹性时为瞬时模量）：为实质的 %1 至 %2 倍。%3</translation>
+    </message>
+    <message>
+        <source>Stiffness E</source>
+        <translation>刚度 E</translation>
+    </message>
+    <message>
+        <source>Change the lesion&apos;s stiffness</source>
+        <translation>更改病灶刚度</translation>
+    </message>
+    <message>
+        <source>Yield limit</source>
+        <translation>屈服极限</translation>
+    </message>
+    <message>
+        <source>Change the lesion&apos;s yield limit</source>
+        <translation>更改病灶屈服极限</translation>
+    </message>
+    <message>
+        <source>Viscosity η1</source>
+        <translation>粘度 η1</translation>
+    </message>
+    <message>
+        <source>Change the lesion&apos;s viscosity</source>
+        <translation>更改病灶粘度</translation>
+    </message>
+    <message>
+        <source>Hidden from the trainee</source>
+        <translation>对学员隐藏</translation>
+    </message>
+    <message>
+        <source>Not drawn in the workstation (palpation tasks)</source>
+        <translation>不在工作站中显示（触诊任务）</translation>
+    </message>
+    <message>
+        <source>Hide the lesion</source>
+        <translation>隐藏病灶</translation>
+    </message>
+    <message>
+        <source>Show the lesion</source>
+        <translation>显示病灶</translation>
+    </message>
+    <message>
+        <source>Title</source>
+        <translation>标题</translation>
+    </message>
+    <message>
+        <source>Change the title</source>
+        <translation>更改标题</translation>
+    </message>
+    <message>
+        <source>Description</source>
+        <translation>描述</translation>
+    </message>
+    <message>
+        <source>Change the description</source>
+        <translation>更改描述</translation>
+    </message>
+    <message>
+        <source>Palpate a hidden lesion</source>
+        <translation>触诊隐藏病灶</translation>
+    </message>
+    <message>
+        <source>Retract a lobe</source>
+        <translation>牵拉肝叶</translation>
+    </message>
+    <message>
+        <source>Resect a lesion</source>
+        <translation>切除病灶</translation>
+    </message>
+    <message>
+        <source>Change the task</source>
+        <translation>更改任务</translation>
+    </message>
+    <message>
+        <source>Shown to the trainee</source>
+        <translation>向学员显示</translation>
+    </message>
+    <message>
+        <source>Instructions</source>
+        <translation>任务说明</translation>
+    </message>
+    <message>
+        <source>Change the instructions</source>
+        <translation>更改任务说明</translation>
+    </message>
+    <message>
+        <source>The time the trainee has: 10 s to 2 h</source>
+        <translation>学员可用的时间：10 s 至 2 h</translation>
+    </message>
+    <message>
+        <source>Time limit</source>
+        <translation>时限</translation>
+    </message>
+    <message>
+        <source>Change the time limit</source>
+        <translation>更改时限</translation>
+    </message>
+    <message>
+        <source>The lesion to find or to resect</source>
+        <translation>要查找或切除的病灶</translation>
+    </message>
+    <message>
+        <source>Lesion</source>
+        <translation>病灶</translation>
+    </message>
+    <message>
+        <source>Choose the task&apos;s lesion</source>
+        <translation>选择任务的病灶</translation>
+    </message>
+    <message>
+        <source>Resection: the least distance from the cut to the lesion</source>
+        <translation>切除：切口与病灶之间的最小距离</translation>
+    </message>
+    <message>
+        <source>Margin</source>
+        <translation>切缘</translation>
+    </message>
+    <message>
+        <source>Change the margin</source>
+        <translation>更改切缘</translation>
+    </message>
+    <message>
+        <source>Clear</source>
+        <translation>清除</translation>
+    </message>
+    <message>
+        <source>Clear the planned plane</source>
+        <translation>清除计划平面</translation>
+    </message>
+    <message>
+        <source>Planned plane</source>
+        <translation>计划平面</translation>
+    </message>
+    <message>
+        <source>Allow a tool</source>
+        <translation>允许使用器械</translation>
+    </message>
+    <message>
+        <source>Withdraw a tool</source>
+        <translation>禁用器械</translation>
+    </message>
+    <message>
+        <source>Tools</source>
+        <translation>器械</translation>
+    </message>
+    <message>
+        <source>A force on the tissue above this is excessive (graded)</source>
+        <translation>作用于组织的力超过此值即为过大（计入评分）</translation>
+    </message>
+    <message>
+        <source>Safe force</source>
+        <translation>安全力</translation>
+    </message>
+    <message>
+        <source>Change the safe force</source>
+        <translation>更改安全力</translation>
+    </message>
+    <message>
+        <source>Parenchyma E</source>
+        <translation>实质 E</translation>
+    </message>
+    <message>
+        <source>Change the parenchyma&apos;s stiffness</source>
+        <translation>更改实质刚度</translation>
+    </message>
+    <message>
+        <source>Poisson&apos;s ratio ν</source>
+        <translation>泊松比 ν</translation>
+    </message>
+    <message>
+        <source>Change Poisson&apos;s ratio</source>
+        <translation>更改泊松比</translation>
+    </message>
+    <message>
+        <source>Effects simulated (an effect off costs nothing)</source>
+        <translation>仿真的效应（关闭的效应不产生计算开销）</translation>
+    </message>
+    <message>
+        <source>Near-incompressibility (averaged pressure)</source>
+        <translation>近不可压缩性（平均压力）</translation>
+    </message>
+    <message>
+        <source>Viscoelasticity (relaxation, creep)</source>
+        <translation>粘弹性（松弛、蠕变）</translation>
+    </message>
+    <message>
+        <source>Viscoplasticity above the yield limit</source>
+        <translation>超过屈服极限后的粘塑性</translation>
+    </message>
+    <message>
+        <source>Fibre anisotropy (HGO)</source>
+        <translation>纤维各向异性 (HGO)</translation>
+    </message>
+    <message>
+        <source>Switch an effect on</source>
+        <translation>开启效应</translation>
+    </message>
+    <message>
+        <source>Switch an effect off</source>
+        <translation>关闭效应</translation>
+    </message>
+    <message>
+        <source>Steps per second of this scenario on this machine, measured now: its model stepped for half a second under a 0.5 N pull</source>
+        <translation>此场景在本机上每秒的步数，即时测量：模型在 0.5 N 拉力下推进半秒</translation>
+    </message>
+    <message>
+        <source>Laws of the effects</source>
+        <translation>效应的本构参数</translation>
+    </message>
+    <message>
+        <source>Change %1</source>
+        <translation>更改%1</translation>
+    </message>
+    <message>
+        <source>Maxwell arm E1</source>
+        <translation>Maxwell 支路 E1</translation>
+    </message>
+    <message>
+        <source> E2 = E − E1 follows, so that E stays the parenchyma&apos;s.</source>
+        <translation> E2 = E − E1 随之确定，使 E 保持为实质的值。</translation>
+    </message>
+    <message>
+        <source>Maxwell arm η1</source>
+        <translation>Maxwell 支路 η1</translation>
+    </message>
+    <message>
+        <source>Yield limit σs</source>
+        <translation>屈服极限 σs</translation>
+    </message>
+    <message>
+        <source>Viscoplastic η2</source>
+        <translation>粘塑性 η2</translation>
+    </message>
+    <message>
+        <source>Creep index n</source>
+        <translation>蠕变指数 n</translation>
+    </message>
+    <message>
+        <source>Fibre k1</source>
+        <translation>纤维 k1</translation>
+    </message>
+    <message>
+        <source>Fibre k2</source>
+        <translation>纤维 k2</translation>
+    </message>
+    <message>
+        <source>Fibre direction</source>
+        <translation>纤维方向</translation>
+    </message>
+    <message>
+        <source>The fibres&apos; reference direction (normalised on saving)</source>
+        <translation>纤维的参考方向（保存时归一化）</translation>
+    </message>
+    <message>
+        <source>Change the fibre direction</source>
+        <translation>更改纤维方向</translation>
+    </message>
+    <message>
+        <source>Across the view</source>
+        <translation>沿视图横向</translation>
+    </message>
+    <message>
+        <source>Fibres along the screen&apos;s horizontal, as the organ is seen now</source>
+        <translation>按器官当前的视角，使纤维沿屏幕水平方向</translation>
+    </message>
+    <message>
+        <source>Set the fibre direction</source>
+        <translation>设置纤维方向</translation>
+    </message>
+    <message>
+        <source>Fixed regions</source>
+        <translation>固定区域</translation>
+    </message>
+    <message>
+        <source>Radius of the painting brush (Paint fixed)</source>
+        <translation>涂刷画笔的半径（涂刷固定区）</translation>
+    </message>
+    <message>
+        <source>Brush</source>
+        <translation>画笔</translation>
+    </message>
+    <message>
+        <source>Clear painted</source>
+        <translation>清除涂刷</translation>
+    </message>
+    <message>
+        <source>Clear the painted fixed regions</source>
+        <translation>清除涂刷的固定区域</translation>
+    </message>
+    <message>
+        <source>Painted</source>
+        <translation>已涂刷</translation>
+    </message>
+    <message>
+        <source>Coronary ligament (built-in liver)</source>
+        <translation>冠状韧带（内置肝脏）</translation>
+    </message>
+    <message>
+        <source>Change the ligament</source>
+        <translation>更改韧带</translation>
+    </message>
+    <message>
+        <source>Built-in liver</source>
+        <translation>内置肝脏</translation>
+    </message>
+    <message>
+        <source>Surface model (OBJ, STL, PLY, glTF, FBX, 3DS)</source>
+        <translation>表面模型 (OBJ, STL, PLY, glTF, FBX, 3DS)</translation>
+    </message>
+    <message>
+        <source>Tetrahedral mesh (.inp, .msh)</source>
+        <translation>四面体网格 (.inp, .msh)</translation>
+    </message>
+    <message>
+        <source>Organ</source>
+        <translation>器官</translation>
+    </message>
+    <message>
+        <source>Change the organ</source>
+        <translation>更改器官</translation>
+    </message>
+    <message>
+        <source>The organ&apos;s file: relative to the scenario&apos;s folder, or absolute</source>
+        <translation>器官文件：相对于场景所在文件夹的路径，或绝对路径</translation>
+    </message>
+    <message>
+        <source>Choose…</source>
+        <translation>选择…</translation>
+    </message>
+    <message>
+        <source>File</source>
+        <translation>文件</translation>
+    </message>
+    <message>
+        <source>Choose the organ&apos;s file</source>
+        <translation>选择器官文件</translation>
+    </message>
+    <message>
+        <source>The organ&apos;s file</source>
+        <translation>器官文件</translation>
+    </message>
+    <message>
+        <source>Organ files (%1);;All files (*)</source>
+        <translation>器官文件 (%1);;所有文件 (*)</translation>
+    </message>
+    <message>
+        <source>The unit of the surface model&apos;s lengths (never guessed)</source>
+        <translation>表面模型的长度单位（不会自动推测）</translation>
+    </message>
+    <message>
+        <source>Length unit</source>
+        <translation>长度单位</translation>
+    </message>
+    <message>
+        <source>Change the organ&apos;s unit</source>
+        <translation>更改器官单位</translation>
+    </message>
+    <message>
+        <source>Elements of the organ&apos;s mesh: 1000 to 50000 (more is more accurate and slower: see the cost in Tissue and effects)</source>
+        <translation>器官网格的单元数：1000 至 50000（越多越精确，也越慢：计算开销见“组织与效应”）</translation>
+    </message>
+    <message>
+        <source>Elements</source>
+        <translation>单元数</translation>
+    </message>
+    <message>
+        <source>Change the element count</source>
+        <translation>更改单元数</translation>
+    </message>
+    <message>
+        <source>A node set of the mesh file held fixed (empty: none)</source>
+        <translation>网格文件中保持固定的节点集（留空：无）</translation>
+    </message>
+    <message>
+        <source>Fixed node set</source>
+        <translation>固定节点集</translation>
+    </message>
+    <message>
+        <source>Change the fixed node set</source>
+        <translation>更改固定节点集</translation>
+    </message>
+    <message>
+        <source>Change the integrator</source>
+        <translation>更改时间积分器</translation>
+    </message>
+    <message>
+        <source>Metric</source>
+        <translation>指标</translation>
+    </message>
+    <message>
+        <source>Weight</source>
+        <translation>权重</translation>
+    </message>
+    <message>
+        <source>Pass if</source>
+        <translation>通过条件</translation>
+    </message>
+    <message>
+        <source>Threshold</source>
+        <translation>阈值</translation>
+    </message>
+    <message>
+        <source>The rubric: each criterion passes when its metric is at most or at least the threshold; the score is the passed criteria&apos;s share of the weights</source>
+        <translation>评分标准：每项标准在其指标不超过或不低于阈值时通过；得分为已通过标准的权重占总权重的比例</translation>
+    </message>
+    <message>
+        <source>Add criterion</source>
+        <translation>添加标准</translation>
+    </message>
+    <message>
+        <source>Add a criterion</source>
+        <translation>添加标准</translation>
+    </message>
+    <message>
+        <source>Remove a criterion</source>
+        <translation>移除标准</translation>
+    </message>
+    <message>
+        <source>Tissue stretched past 1 + this is damaged (graded): 0.05 to 2</source>
+        <translation>组织拉伸超过 1 + 此值即视为损伤（计入评分）：0.05 至 2</translation>
+    </message>
+    <message>
+        <source>Damage in tension</source>
+        <translation>拉伸损伤</translation>
+    </message>
+    <message>
+        <source>Change the damage strain</source>
+        <translation>更改损伤应变</translation>
+    </message>
+    <message>
+        <source>Tissue squeezed below 1 − this is damaged (graded): 0.05 to 0.95</source>
+        <translation>组织压缩至 1 − 此值以下即视为损伤（计入评分）：0.05 至 0.95</translation>
+    </message>
+    <message>
+        <source>Damage in compression</source>
+        <translation>压缩损伤</translation>
+    </message>
+    <message>
+        <source>Pick on the organ</source>
+        <translation>在器官上选取</translation>
+    </message>
+    <message>
+        <source>Retraction: click where the lobe is to be grasped</source>
+        <translation>牵拉：单击肝叶上要抓取的位置</translation>
+    </message>
+    <message>
+        <source>Grasp point</source>
+        <translation>抓取点</translation>
+    </message>
+    <message>
+        <source>Retraction: how far to lift: 5 to 100 mm</source>
+        <translation>牵拉：提起的高度，5 至 100 mm</translation>
+    </message>
+    <message>
+        <source>Lift</source>
+        <translation>提起高度</translation>
+    </message>
+    <message>
+        <source>Change the lift</source>
+        <translation>更改提起高度</translation>
+    </message>
+    <message>
+        <source>The criterion&apos;s weight in the score</source>
+        <translation>该标准在得分中的权重</translation>
+    </message>
+    <message>
+        <source>at most</source>
+        <translation>不超过</translation>
+    </message>
+    <message>
+        <source>at least</source>
+        <translation>不低于</translation>
+    </message>
+    <message>
+        <source>The threshold, in the metric&apos;s unit</source>
+        <translation>阈值，单位与指标相同</translation>
+    </message>
+    <message>
+        <source>Change a criterion&apos;s metric</source>
+        <translation>更改标准的指标</translation>
+    </message>
+    <message>
+        <source>Change a criterion&apos;s weight</source>
+        <translation>更改标准的权重</translation>
+    </message>
+    <message>
+        <source>Change a criterion&apos;s rule</source>
+        <translation>更改标准的规则</translation>
+    </message>
+    <message>
+        <source>Change a criterion&apos;s threshold</source>
+        <translation>更改标准的阈值</translation>
+    </message>
+    <message>
+        <source>The organ cannot be built: %1</source>
+        <translation>无法构建器官：%1</translation>
+    </message>
+    <message>
+        <source> (the organ shown is the one before)</source>
+        <translation> （显示的是之前的器官）</translation>
+    </message>
+    <message>
+        <source>Organ: %1</source>
+        <translation>器官：%1</translation>
+    </message>
+    <message>
+        <source>through (%1, %2, %3) mm, normal (%4, %5, %6)</source>
+        <translation>经过 (%1, %2, %3) mm，法向 (%4, %5, %6)</translation>
+    </message>
+    <message>
+        <source>none: draw it across the organ (Draw plane)</source>
+        <translation>无：请在器官上绘制（“绘制平面”）</translation>
+    </message>
+    <message>
+        <source>resection tasks only</source>
+        <translation>仅用于切除任务</translation>
+    </message>
+    <message numerus="yes">
+        <source>%n ball(s)</source>
+        <translation>
+            <numerusform>%n 个球形区域</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>(%1, %2, %3) mm</source>
+        <translation>(%1, %2, %3) mm</translation>
+    </message>
+    <message>
+        <source>retraction tasks only</source>
+        <translation>仅用于牵拉任务</translation>
+    </message>
+    <message>
+        <source>untitled</source>
+        <translation>未命名</translation>
+    </message>
+    <message>
+        <source>Scenario editor — %1%2</source>
+        <translation>场景编辑器 — %1%2</translation>
+    </message>
+    <message>
+        <source>Click where the lobe is to be grasped.</source>
+        <translation>请单击肝叶上要抓取的位置。</translation>
+    </message>
+    <message>
+        <source>the parenchyma&apos;s</source>
+        <translation>同实质</translation>
+    </message>
+    <message>
+        <source>Place a lesion</source>
+        <translation>放置病灶</translation>
+    </message>
+    <message>
+        <source>Set the grasp point</source>
+        <translation>设置抓取点</translation>
+    </message>
+    <message>
+        <source>The grasp point is set.</source>
+        <translation>已设置抓取点。</translation>
+    </message>
+    <message>
+        <source>Paint a fixed region</source>
+        <translation>涂刷固定区域</translation>
+    </message>
+    <message>
+        <source>Draw the planned plane</source>
+        <translation>绘制计划平面</translation>
+    </message>
+    <message>
+        <source>Cannot open the scenario %1</source>
+        <translation>无法打开场景 %1</translation>
+    </message>
+    <message>
+        <source>Opened %1.</source>
+        <translation>已打开 %1。</translation>
+    </message>
+    <message>
+        <source>The scenario is not saved: fix these first</source>
+        <translation>场景未保存：请先修正以下问题</translation>
+    </message>
+    <message>
+        <source>Saved %1.</source>
+        <translation>已保存 %1。</translation>
+    </message>
+    <message>
+        <source>Unsaved changes</source>
+        <translation>未保存的更改</translation>
+    </message>
+    <message>
+        <source>The scenario has changes that are not saved. Save them?</source>
+        <translation>场景有未保存的更改。是否保存？</translation>
+    </message>
+    <message>
+        <source>The scenario cannot run: fix these first</source>
+        <translation>场景无法运行：请先修正以下问题</translation>
+    </message>
+    <message>
+        <source>Running the scenario in the workstation.</source>
+        <translation>正在工作站中运行该场景。</translation>
+    </message>
+    <message>
+        <source>%1 steps/s — measuring again…</source>
+        <translation>%1 步/秒 — 正在重新测量…</translation>
+    </message>
+    <message>
+        <source>Measuring the cost…</source>
+        <translation>正在测量计算开销…</translation>
+    </message>
+    <message>
+        <source>%1 steps/s, %2× real time (%3 elements)</source>
+        <translation>%1 步/秒，%2 倍实时（%3 个单元）</translation>
+    </message>
+    <message>
+        <source>; before the last change %1 steps/s</source>
+        <translation>；上次更改前为 %1 步/秒</translation>
+    </message>
+    <message>
+        <source>Not measured: %1</source>
+        <translation>未测量：%1</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::ScenarioPanel</name>
+    <message>
+        <source>probe</source>
+        <translation>探针</translation>
+    </message>
+    <message>
+        <source>forceps</source>
+        <translation>抓钳</translation>
+    </message>
+    <message>
+        <source>scalpel</source>
+        <translation>手术刀</translation>
+    </message>
+    <message>
+        <source>Palpate the liver and locate the lesion.</source>
+        <translation>触诊肝脏并定位病灶。</translation>
+    </message>
+    <message>
+        <source>Grasp the lobe and lift it by %1 mm.</source>
+        <translation>抓住肝叶并将其提起 %1 mm。</translation>
+    </message>
+    <message>
+        <source>Resect the lesion with a margin of at least %1 mm.</source>
+        <translation>切除病灶，切缘至少 %1 mm。</translation>
+    </message>
+    <message>
+        <source>%1
+Time limit: %2:%3.</source>
+        <translation>%1
+时限：%2:%3。</translation>
+    </message>
+    <message>
+        <source>Free practice</source>
+        <translation>自由练习</translation>
+    </message>
+    <message>
+        <source>The built-in liver, no task. File ▸ Open Scenario… loads one.</source>
+        <translation>内置肝脏，无任务。可通过“文件 ▸ 打开场景…”加载场景。</translation>
+    </message>
+    <message>
+        <source>near-incompressibility</source>
+        <translation>近不可压缩性</translation>
+    </message>
+    <message>
+        <source>viscoelasticity</source>
+        <translation>粘弹性</translation>
+    </message>
+    <message>
+        <source>viscoplasticity</source>
+        <translation>粘塑性</translation>
+    </message>
+    <message>
+        <source>fibres</source>
+        <translation>纤维</translation>
+    </message>
+    <message>
+        <source>elasticity only</source>
+        <translation>仅弹性</translation>
+    </message>
+    <message numerus="yes">
+        <source>%n lesion(s)</source>
+        <translation>
+            <numerusform>%n 个病灶</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>, %n hidden</source>
+        <translation>
+            <numerusform>，其中 %n 个隐藏</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>Tools: %1.
+Simulated: %2.
+%3.</source>
+        <translation>器械：%1。
+仿真效应：%2。
+%3。</translation>
+    </message>
+    <message>
+        <source>File: %1</source>
+        <translation>文件：%1</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::SessionReplayWindow</name>
+    <message>
+        <source>Replay of session %1</source>
+        <translation>回放训练记录 %1</translation>
+    </message>
+    <message>
+        <source>Recorded force on the tissue (N)</source>
+        <translation>记录的组织受力 (N)</translation>
+    </message>
+    <message>
+        <source>Replayed force on the tool (N)</source>
+        <translation>回放的器械受力 (N)</translation>
+    </message>
+    <message>
+        <source>Replayed time</source>
+        <translation>回放时间</translation>
+    </message>
+    <message>
+        <source>The replay ends at %1 s, where the integrator was changed (to %2): what followed was not logged for replay.</source>
+        <translation>回放在 %1 s 处结束，此时时间积分器被更换（更换为 %2）：之后的过程未记录，无法回放。</translation>
+    </message>
+    <message>
+        <source>Session %1 cannot be read: %2</source>
+        <translation>无法读取训练记录 %1：%2</translation>
+    </message>
+    <message>
+        <source>Session %1 was recorded without its simulation input (by a version before replays, or as a replay itself): it cannot be replayed in the viewport.</source>
+        <translation>训练记录 %1 录制时未保存仿真输入（由支持回放之前的版本录制，或其本身就是一次回放）：无法在视口中回放。</translation>
+    </message>
+    <message>
+        <source>Session %1 has no simulation input stored (it ended before its first cycle was saved).</source>
+        <translation>训练记录 %1 没有保存仿真输入（在第一个周期保存之前就已结束）。</translation>
+    </message>
+    <message>
+        <source>Building the session&apos;s scene…</source>
+        <translation>正在构建训练记录的场景…</translation>
+    </message>
+    <message>
+        <source>Session %1 cannot be replayed: %2</source>
+        <translation>无法回放训练记录 %1：%2</translation>
+    </message>
+    <message>
+        <source>Pause</source>
+        <translation>暂停</translation>
+    </message>
+    <message>
+        <source>Play</source>
+        <translation>播放</translation>
+    </message>
+    <message>
+        <source>%1 / %2 s</source>
+        <translation>%1 / %2 s</translation>
+    </message>
+    <message>
+        <source>Seeking to %1 s…</source>
+        <translation>正在跳转到 %1 s…</translation>
+    </message>
+    <message>
+        <source>Playing.</source>
+        <translation>正在播放。</translation>
+    </message>
+    <message>
+        <source>Paused.</source>
+        <translation>已暂停。</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::SessionReviewWindow</name>
+    <message>
+        <source>Sessions of %1</source>
+        <translation>%1 的训练记录</translation>
+    </message>
+    <message>
+        <source>Sessions — %1</source>
+        <translation>训练记录 — %1</translation>
+    </message>
+    <message>
+        <source>Filter by trainee or scenario</source>
+        <translation>按学员或场景筛选</translation>
+    </message>
+    <message>
+        <source>Session</source>
+        <translation>训练记录</translation>
+    </message>
+    <message>
+        <source>Trainee</source>
+        <translation>学员</translation>
+    </message>
+    <message>
+        <source>Scenario</source>
+        <translation>场景</translation>
+    </message>
+    <message>
+        <source>Started</source>
+        <translation>开始时间</translation>
+    </message>
+    <message>
+        <source>Status</source>
+        <translation>状态</translation>
+    </message>
+    <message>
+        <source>Score</source>
+        <translation>得分</translation>
+    </message>
+    <message>
+        <source>Open a session to see it against its rubric.</source>
+        <translation>打开一条训练记录，查看其对照评分标准的结果。</translation>
+    </message>
+    <message>
+        <source>Metric</source>
+        <translation>指标</translation>
+    </message>
+    <message>
+        <source>Value</source>
+        <translation>值</translation>
+    </message>
+    <message>
+        <source>Criterion (weight)</source>
+        <translation>标准（权重）</translation>
+    </message>
+    <message>
+        <source>Passed</source>
+        <translation>通过</translation>
+    </message>
+    <message>
+        <source>Force on the device (N)</source>
+        <translation>设备输出力 (N)</translation>
+    </message>
+    <message>
+        <source>Events</source>
+        <translation>事件</translation>
+    </message>
+    <message>
+        <source>e.g. pass, fail, B+</source>
+        <translation>例如：通过、不通过、B+</translation>
+    </message>
+    <message>
+        <source>Save Grade</source>
+        <translation>保存评分</translation>
+    </message>
+    <message>
+        <source>Export CSV…</source>
+        <translation>导出 CSV…</translation>
+    </message>
+    <message>
+        <source>Export the session to</source>
+        <translation>将训练记录导出到</translation>
+    </message>
+    <message>
+        <source>Save Report as PDF…</source>
+        <translation>将报告另存为 PDF…</translation>
+    </message>
+    <message>
+        <source>Save the report</source>
+        <translation>保存报告</translation>
+    </message>
+    <message>
+        <source>PDF documents (*.pdf)</source>
+        <translation>PDF 文档 (*.pdf)</translation>
+    </message>
+    <message>
+        <source>Instructor:</source>
+        <translation>教员：</translation>
+    </message>
+    <message>
+        <source>Grade:</source>
+        <translation>评分：</translation>
+    </message>
+    <message>
+        <source>Comment:</source>
+        <translation>评语：</translation>
+    </message>
+    <message>
+        <source>Saved grades:</source>
+        <translation>已保存的评分：</translation>
+    </message>
+    <message>
+        <source>Replay in the Viewport…</source>
+        <translation>在视口中回放…</translation>
+    </message>
+    <message>
+        <source>Play the session back in a viewport from its recorded input, with its force plotted in step</source>
+        <translation>根据记录的输入在视口中回放该训练记录，并同步绘制其力曲线</translation>
+    </message>
+    <message>
+        <source>Export:</source>
+        <translation>导出：</translation>
+    </message>
+    <message>
+        <source>The sessions cannot be read: %1</source>
+        <translation>无法读取训练记录：%1</translation>
+    </message>
+    <message>
+        <source>not measured</source>
+        <translation>未测量</translation>
+    </message>
+    <message>
+        <source>yes</source>
+        <translation>是</translation>
+    </message>
+    <message>
+        <source>no</source>
+        <translation>否</translation>
+    </message>
+    <message>
+        <source>not graded</source>
+        <translation>未评分</translation>
+    </message>
+    <message>
+        <source>Force on the tissue (N)</source>
+        <translation>组织受力 (N)</translation>
+    </message>
+    <message>
+        <source>at (%1, %2, %3) mm</source>
+        <translation>位于 (%1, %2, %3) mm</translation>
+    </message>
+    <message>
+        <source>%1, %2: %3%4 — %5</source>
+        <translation>%1，%2：%3%4 — %5</translation>
+    </message>
+    <message>
+        <source> (score %1 %)</source>
+        <translation> （得分 %1%）</translation>
+    </message>
+    <message>
+        <source>none yet</source>
+        <translation>暂无</translation>
+    </message>
+    <message>
+        <source>Session %1 cannot be read: %2</source>
+        <translation>无法读取训练记录 %1：%2</translation>
+    </message>
+    <message>
+        <source>Session %1: its scenario has no rubric.</source>
+        <translation>训练记录 %1：其场景没有评分标准。</translation>
+    </message>
+    <message>
+        <source>Session %1: score %2 % (%3 of %4 criteria passed)</source>
+        <translation>训练记录 %1：得分 %2%（%4 项标准中通过 %3 项）</translation>
+    </message>
+    <message>
+        <source>Trainees cannot grade sessions.</source>
+        <translation>学员不能为训练记录评分。</translation>
+    </message>
+    <message>
+        <source>A grade needs the instructor&apos;s name and the grade.</source>
+        <translation>评分需要填写教员姓名和评分。</translation>
+    </message>
+    <message>
+        <source>The grade was not saved: %1</source>
+        <translation>评分未保存：%1</translation>
+    </message>
+    <message>
+        <source>LiverSim session %1</source>
+        <translation>LiverSim 训练记录 %1</translation>
+    </message>
+    <message>
+        <source>Trainee: %1</source>
+        <translation>学员：%1</translation>
+    </message>
+    <message>
+        <source>Scenario: %1</source>
+        <translation>场景：%1</translation>
+    </message>
+    <message>
+        <source>Started: %1</source>
+        <translation>开始时间：%1</translation>
+    </message>
+    <message>
+        <source>Force on the device</source>
+        <translation>设备输出力</translation>
+    </message>
+    <message>
+        <source>Grades</source>
+        <translation>评分</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::ToolPanel</name>
+    <message>
+        <source>&amp;Hand</source>
+        <translation>手(&amp;H)</translation>
+    </message>
+    <message>
+        <source>Drag the liver with the left mouse button: the tissue under it follows the pointer</source>
+        <translation>按住鼠标左键拖动肝脏：指针下方的组织会跟随指针移动</translation>
+    </message>
+    <message>
+        <source>&amp;Probe</source>
+        <translation>探针(&amp;P)</translation>
+    </message>
+    <message>
+        <source>Press the left mouse button on the liver to put the probe&apos;s ball on it, drag to push; Shift+wheel pushes it in or draws it back</source>
+        <translation>在肝脏上按下鼠标左键，将探针的球头放到该处，拖动以按压；Shift+滚轮可将其推入或退回</translation>
+    </message>
+    <message>
+        <source>&amp;Forceps</source>
+        <translation>抓钳(&amp;F)</translation>
+    </message>
+    <message>
+        <source>Press the left mouse button on the liver to close the jaws on it, drag to pull, release to let go</source>
+        <translation>在肝脏上按下鼠标左键使钳口夹住组织，拖动以牵拉，松开按键即释放</translation>
+    </message>
+    <message>
+        <source>&amp;Scalpel</source>
+        <translation>手术刀(&amp;S)</translation>
+    </message>
+    <message>
+        <source>Press the left mouse button on the liver to put the blade on it and drag: it breaks in where the tissue is stressed past its cutting threshold and cuts along its path</source>
+        <translation>在肝脏上按下鼠标左键放下刀片并拖动：刀片在组织应力超过切割阈值处切入，并沿拖动路径切割</translation>
+    </message>
+    <message>
+        <source>Force on the tool: %1 N (holding tissue)</source>
+        <translation>器械受力：%1 N（正在夹持组织）</translation>
+    </message>
+    <message>
+        <source>Force on the tool: %1 N</source>
+        <translation>器械受力：%1 N</translation>
+    </message>
+</context>
+<context>
+    <name>main</name>
+    <message>
+        <source>LiverSim: real-time finite-element liver surgery training workstation</source>
+        <translation>LiverSim：实时有限元肝脏手术训练工作站</translation>
+    </message>
+    <message>
+        <source>Element count of the liver (100 to 2000000).</source>
+        <translation>肝脏的单元数（100 至 2000000）。</translation>
+    </message>
+    <message>
+        <source>Close the application this many seconds after the main window is shown (for unattended runs).</source>
+        <translation>主窗口显示后经过指定秒数即关闭应用程序（用于无人值守运行）。</translation>
+    </message>
+    <message>
+        <source>Run this scenario file (JSON, docs/scenario-format.md) instead of free practice on the built-in liver.</source>
+        <translation>运行此场景文件（JSON，见 docs/scenario-format.md），而不是在内置肝脏上自由练习。</translation>
+    </message>
+    <message>
+        <source>Record sessions to this SQLite file (default: sessions.sqlite in the user&apos;s data directory).</source>
+        <translation>将训练记录保存到此 SQLite 文件（默认：用户数据目录中的 sessions.sqlite）。</translation>
+    </message>
+    <message>
+        <source>LiverSim cannot start</source>
+        <translation>LiverSim 无法启动</translation>
+    </message>
+    <message>
+        <source>Interface language: en or zh_CN (default: the one chosen in Settings, else the system&apos;s).</source>
+        <translation>界面语言：en 或 zh_CN（默认：“设置”中所选语言，否则跟随系统）。</translation>
+    </message>
+    <message>
+        <source>A scenario file to run, as with --scenario.</source>
+        <translation>要运行的场景文件，与 --scenario 相同。</translation>
+    </message>
+</context>
+</TS>
