@@ -705,6 +705,22 @@ The scene that was running goes on.</source>
         <source>free practice, %1 elements</source>
         <translation>自由练习，%1 个单元</translation>
     </message>
+    <message>
+        <source>The tool models could not be read, so the tools are drawn as simple shapes: %1</source>
+        <translation>无法读取器械模型，器械将以简单形状显示：%1</translation>
+    </message>
+    <message>
+        <source>&amp;View</source>
+        <translation>视图(&amp;V)</translation>
+    </message>
+    <message>
+        <source>&amp;See-through Liver</source>
+        <translation>透视肝脏(&amp;S)</translation>
+    </message>
+    <message>
+        <source>Show the liver translucent, with the lesions inside it</source>
+        <translation>以半透明方式显示肝脏及其内部病灶</translation>
+    </message>
 </context>
 <context>
     <name>liversim::ScenarioDocument</name>

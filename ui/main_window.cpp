@@ -60,7 +60,7 @@ QString formatAmount(double value) {
 }  // namespace
 
 MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario, QWidget* parent)
-    : QMainWindow(parent), scenario_(std::move(scenario)) {
+    : QMainWindow(parent), toolModels_(load_tool_models()), scenario_(std::move(scenario)) {
   auto model = std::make_shared<const SimModel>(build_model(setup.mesh, setup.model_options));
   installScene(std::move(setup), std::move(model));
 
@@ -129,13 +129,19 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   if (scenario_) rememberScenarioFile(scenario_->file);
   buildMenus();
   showScenarioDetails();
+  setSeeThrough(QSettings().value("view/see_through", false).toBool());
 
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("simulationStatus");
   statusBar()->addPermanentWidget(statusLabel_, 1);
-  statusBar()->showMessage(
-      tr("Drag the liver with the left mouse button; drag the background to "
-         "turn the view, wheel to zoom."));
+  if (toolModels_.problem.empty())
+    statusBar()->showMessage(
+        tr("Drag the liver with the left mouse button; drag the background to "
+           "turn the view, wheel to zoom."));
+  else
+    statusBar()->showMessage(tr("The tool models could not be read, so the tools are drawn as "
+                                "simple shapes: %1")
+                                 .arg(QString::fromStdString(toolModels_.problem)));
   resize(1200, 800);
 
   frameTimer_.setTimerType(Qt::PreciseTimer);
@@ -170,6 +176,8 @@ void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> 
   // The visual surface's triangles are the physics boundary's (its vertex i is node nodes[i]).
   auto simulation = make_scene_simulation(model, setup.visual.surface);
   auto scene = std::make_unique<LiverScene>(setup.mesh, setup.visual);
+  scene->set_tool_models(toolModels_);
+  scene->set_opacity(seeThrough_ ? kSeeThroughOpacity : 1.0);
   if (simulation_) {
     // The hand and the mouse's tool let go of the old liver; a device stays attached.
     if (grab_) endGrab();
@@ -329,6 +337,8 @@ void MainWindow::showScenarioDetails() {
   const QString name = scenario_ ? QString::fromStdString(scenario_->scenario.title)
                                  : tr("free practice, %1 elements").arg(setup_.mesh.tet_count());
   setWindowTitle(tr("LiverSim — %1").arg(name));
+  scene_->show_lesions(scenario_ ? visible_lesions(scenario_->scenario)
+                                 : std::vector<LesionShape>{});
   scenarioPanel_->showScenario(scenario_ ? &scenario_->scenario : nullptr,
                                scenario_ ? scenario_->file : QString());
   // Free practice offers what a scenario does by default: every tool.
@@ -358,6 +368,15 @@ void MainWindow::buildMenus() {
   QAction* quit = file->addAction(tr("&Quit"), this, &QWidget::close);
   quit->setObjectName("quitAction");
   quit->setShortcut(QKeySequence::Quit);
+
+  QMenu* view = menuBar()->addMenu(tr("&View"));
+  view->setObjectName("viewMenu");
+  seeThroughAction_ = view->addAction(tr("&See-through Liver"), this,
+                                      [this](bool checked) { setSeeThrough(checked); });
+  seeThroughAction_->setObjectName("seeThroughAction");
+  seeThroughAction_->setCheckable(true);
+  seeThroughAction_->setShortcut(QKeySequence(Qt::Key_T));
+  seeThroughAction_->setToolTip(tr("Show the liver translucent, with the lesions inside it"));
 
   QMenu* session = menuBar()->addMenu(tr("&Session"));
   session->setObjectName("sessionMenu");
@@ -394,6 +413,14 @@ void MainWindow::buildMenus() {
   };
   addLanguage({}, tr("The System's Language"));
   for (const QString& code : availableLanguages()) addLanguage(code, languageName(code));
+}
+
+void MainWindow::setSeeThrough(bool on) {
+  seeThrough_ = on;
+  scene_->set_opacity(on ? kSeeThroughOpacity : 1.0);
+  if (seeThroughAction_ != nullptr) seeThroughAction_->setChecked(on);
+  QSettings().setValue("view/see_through", on);
+  viewport_->update();
 }
 
 ScenarioEditor* MainWindow::openScenarioEditor() {

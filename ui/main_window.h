@@ -4,6 +4,7 @@
 // status bar. The simulation runs on its own thread; the viewport renders from its newest snapshot.
 
 #include "haptic_preferences.h"
+#include "render/liver_scene.h"
 
 #include "liversim/core/default_scene.h"
 #include "liversim/core/emulated_devices.h"
@@ -68,6 +69,9 @@ class MainWindow : public QMainWindow {
   RealtimeSimulation& simulation() { return *simulation_; }
   const Grab* activeGrab() const { return grab_ ? &*grab_ : nullptr; }
   AccuracyPanel* accuracyPanel() const { return accuracyPanel_; }
+  // See-through: the liver translucent, its visible lesions inside it (View menu, T; remembered).
+  void setSeeThrough(bool on);
+  bool seeThrough() const { return seeThrough_; }
   ToolPanel* toolPanel() const { return toolPanel_; }
   // The tool the mouse holds in the scene, if any (tools other than the hand).
   const std::optional<Tool>& heldTool() const { return tool_; }
@@ -139,6 +143,8 @@ class MainWindow : public QMainWindow {
   // Spring stiffness of a mouse grab and the radius of tissue it holds.
   static constexpr double kGrabStiffnessNPerM = 300.0;
   static constexpr double kGrabRadiusM = 0.02;
+  // The liver's opacity in the see-through view.
+  static constexpr double kSeeThroughOpacity = 0.35;
 
  signals:
   // A recorded session's metrics were computed and stored (or not: stored false, the reason in
@@ -197,6 +203,9 @@ class MainWindow : public QMainWindow {
   static QString formatError(double error_m);
 
   SceneSetup setup_;
+  ToolModels toolModels_;  // read once; every scene draws its tools with them
+  bool seeThrough_ = false;
+  QAction* seeThroughAction_ = nullptr;
   std::shared_ptr<const SimModel> sceneModel_;  // setup_'s model, uncut, with the integrator in use
   std::unique_ptr<RealtimeSimulation> simulation_;
   std::unique_ptr<LiverScene> scene_;

@@ -152,6 +152,7 @@ void SessionReplayWindow::finishBuilding(std::shared_ptr<SessionReplay> replay,
   }
   replay_ = std::move(replay);  // the worker is done with it
   scene_ = std::make_unique<LiverScene>(replay_->scene().mesh, replay_->scene().visual);
+  scene_->set_tool_models(load_tool_models());
   viewport_->renderWindow()->AddRenderer(scene_->renderer());
   scene_->reset_camera(viewport_->height() > 0
                            ? static_cast<double>(viewport_->width()) / viewport_->height()

@@ -109,6 +109,21 @@ VisualSurface visual_surface_on_nodes(const TetMesh& mesh) {
   return visual;
 }
 
+namespace {
+
+// Barycentric weights of rest point p in element e (negative outside it).
+std::array<double, 4> barycentric_weights(const TetMesh& mesh, std::size_t e,
+                                          const Eigen::Vector3d& p) {
+  const auto t = mesh.tet(e);
+  const Eigen::Vector3d x0 = mesh.rest_position_m.at(t[0]);
+  Eigen::Matrix3d edges;
+  for (int c = 1; c < 4; ++c) edges.col(c - 1) = mesh.rest_position_m.at(t[c]) - x0;
+  const Eigen::Vector3d local = edges.inverse() * (p - x0);
+  return {1.0 - local.sum(), local[0], local[1], local[2]};
+}
+
+}  // namespace
+
 VisualSurface embed_visual_surface(const TetMesh& mesh, const BoundarySurface& surface,
                                    const std::vector<Eigen::Vector3d>& vertex_rest_m) {
   if (vertex_rest_m.size() != surface.nodes.size())
@@ -125,16 +140,11 @@ VisualSurface embed_visual_surface(const TetMesh& mesh, const BoundarySurface& s
     std::array<NodeIndex, 4> best_nodes{};
     std::array<double, 4> best_weights{};
     for (TetIndex e : incident[surface.nodes[v]]) {
-      const auto t = mesh.tet(e);
-      const Eigen::Vector3d x0 = mesh.rest_position_m.at(t[0]);
-      Eigen::Matrix3d edges;
-      for (int c = 1; c < 4; ++c) edges.col(c - 1) = mesh.rest_position_m.at(t[c]) - x0;
-      const Eigen::Vector3d local = edges.inverse() * (p - x0);
-      const std::array<double, 4> w{1.0 - local.sum(), local[0], local[1], local[2]};
+      const std::array<double, 4> w = barycentric_weights(mesh, e, p);
       const double min_weight = *std::min_element(w.begin(), w.end());
       if (min_weight > best_min_weight) {
         best_min_weight = min_weight;
-        best_nodes = t;
+        best_nodes = mesh.tet(e);
         best_weights = w;
       }
     }
@@ -146,19 +156,57 @@ VisualSurface embed_visual_surface(const TetMesh& mesh, const BoundarySurface& s
 
 void map_visual_positions(const VisualSurface& visual, const NodeArray& position,
                           std::vector<double>& vertex_xyz) {
-  vertex_xyz.resize(3 * visual.vertex_count());
-  for (std::size_t v = 0; v < visual.vertex_count(); ++v) {
+  map_embedded_positions(visual.host_nodes, visual.weights, position, vertex_xyz);
+}
+
+EmbeddedPoints embed_points(const TetMesh& mesh, const std::vector<Eigen::Vector3d>& points_m) {
+  // Each element's rest bounding box, grown by the reach, so that only the few elements whose
+  // box holds a point are solved for its weights.
+  const std::size_t elements = mesh.tet_count();
+  std::vector<Eigen::AlignedBox3d> box(elements);
+  for (std::size_t e = 0; e < elements; ++e) {
+    for (auto n : mesh.tet(e)) box[e].extend(mesh.rest_position_m.at(n));
+    const Eigen::Vector3d margin = -kEmbeddingReach * (box[e].max() - box[e].min());
+    box[e].extend(box[e].min() - margin);
+    box[e].extend(box[e].max() + margin);
+  }
+  EmbeddedPoints embedded;
+  embedded.host_nodes.resize(points_m.size(), {0, 0, 0, 0});
+  embedded.weights.resize(points_m.size(), {0.0, 0.0, 0.0, 0.0});
+  embedded.held.resize(points_m.size(), 0);
+  for (std::size_t i = 0; i < points_m.size(); ++i) {
+    double best_min_weight = kEmbeddingReach;
+    for (std::size_t e = 0; e < elements; ++e) {
+      if (!box[e].contains(points_m[i])) continue;
+      const std::array<double, 4> w = barycentric_weights(mesh, e, points_m[i]);
+      const double min_weight = *std::min_element(w.begin(), w.end());
+      if (min_weight < best_min_weight) continue;
+      best_min_weight = min_weight;
+      embedded.host_nodes[i] = mesh.tet(e);
+      embedded.weights[i] = w;
+      embedded.held[i] = 1;
+      if (min_weight >= 0.0) break;  // inside: no element holds it better
+    }
+  }
+  return embedded;
+}
+
+void map_embedded_positions(const std::vector<std::array<NodeIndex, 4>>& host_nodes,
+                            const std::vector<std::array<double, 4>>& weights,
+                            const NodeArray& position, std::vector<double>& xyz) {
+  xyz.resize(3 * host_nodes.size());
+  for (std::size_t v = 0; v < host_nodes.size(); ++v) {
     double x = 0.0, y = 0.0, z = 0.0;
     for (int c = 0; c < 4; ++c) {
-      const auto n = visual.host_nodes[v][c];
-      const double w = visual.weights[v][c];
+      const auto n = host_nodes[v][c];
+      const double w = weights[v][c];
       x += w * position.x[n];
       y += w * position.y[n];
       z += w * position.z[n];
     }
-    vertex_xyz[3 * v] = x;
-    vertex_xyz[3 * v + 1] = y;
-    vertex_xyz[3 * v + 2] = z;
+    xyz[3 * v] = x;
+    xyz[3 * v + 1] = y;
+    xyz[3 * v + 2] = z;
   }
 }
 

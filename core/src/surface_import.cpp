@@ -6,6 +6,8 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <gmsh.h>
+#include "assimp_reading.h"
+
 #include <assimp/Importer.hpp>
 
 #include <algorithm>
@@ -193,19 +195,12 @@ bool is_surface_file(const std::filesystem::path& file) {
 
 TriangleSurface read_surface_file(const std::filesystem::path& file, double metres_per_unit) {
   const std::string name = file.string();
-  if (!(metres_per_unit > 0.0) || !std::isfinite(metres_per_unit))
-    throw SurfaceImportError(name + ": the length unit must be a positive number of metres");
-  if (!std::filesystem::exists(file)) throw SurfaceImportError(name + ": no such file");
   Assimp::Importer importer;
-  // Points and lines are no surface: dropped.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(
-      name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                aiProcess_PreTransformVertices | aiProcess_SortByPType | aiProcess_FindDegenerates);
-  if (scene == nullptr)
-    throw SurfaceImportError(name +
-                             ": cannot read it as a surface model: " + importer.GetErrorString());
+  const aiScene* scene = detail::read_assimp_scene(
+      importer, file, metres_per_unit,
+      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
+          aiProcess_SortByPType | aiProcess_FindDegenerates,
+      "a surface model");
   TriangleSurface surface;
   // The same point in two meshes (or twice in one) is one vertex.
   std::map<std::array<double, 3>, std::int32_t> vertex_at;

@@ -17,6 +17,8 @@
 #include <vtkPNGWriter.h>
 #include <vtkSmartPointer.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -25,7 +27,11 @@
 #include <optional>
 #include <string>
 
+#include "liversim/core/cutting.h"
+#include "liversim/core/data_paths.h"
 #include "liversim/core/default_scene.h"
+#include "liversim/core/scenario.h"
+#include "liversim/core/state.h"
 #include "liversim/core/surface.h"
 #include "render/liver_scene.h"
 
@@ -162,9 +168,38 @@ class RenderBaselineTest : public ::testing::Test {
     const SceneSetup setup = default_scene();
     LiverScene scene(setup.mesh, setup.visual);
     if (position) scene.update_positions(*position);
+    return screenshot(scene, name);
+  }
+
+  static fs::path screenshot(LiverScene& scene, const std::string& name) {
     const fs::path file = kOutputDir / (name + ".png");
     write_screenshot_png(scene, file, kWidth, kHeight);
     return file;
+  }
+
+  // The picture `output` against tests/baselines/NAME.png; on failure the rendered picture and
+  // the difference stay in the output folder, named in the message. On success `output` is
+  // removed.
+  void expectMatchesBaseline(const fs::path& output, const std::string& name) {
+    const fs::path baseline = fs::path(LIVERSIM_BASELINE_DIR) / (name + ".png");
+    ASSERT_TRUE(fs::exists(baseline))
+        << "the baseline " << baseline << " is missing. The picture rendered now is\n  " << output
+        << "\nlook at it and, if it is right, copy it there:\n  cp " << output << ' ' << baseline;
+    const auto comparison = compare(output, baseline);
+    ASSERT_TRUE(comparison);
+    const PixelDifference pixels = differingPixels(readPng(output), readPng(baseline));
+    std::cout << name << " against the baseline: " << report(*comparison) << "; " << pixels.count
+              << " pixels differ, by at most " << pixels.largest << " of 255\n";
+    if (comparison->thresholded_error > kMaxThresholdedError) {
+      const fs::path diff = kOutputDir / (name + "_diff.png");
+      writePng(comparison->difference, diff);
+      ADD_FAILURE() << name << " no longer looks like the baseline: " << report(*comparison)
+                    << "\n  rendered now: " << output << "\n  baseline:     " << baseline
+                    << "\n  difference:   " << diff
+                    << "\nif the change is intended, copy the rendered picture over the baseline.";
+      return;
+    }
+    fs::remove(output);  // passed: nothing to inspect
   }
 
   static std::string report(const ImageComparison& c) {
@@ -175,26 +210,7 @@ class RenderBaselineTest : public ::testing::Test {
 };
 
 TEST_F(RenderBaselineTest, DefaultSceneMatchesTheBaseline) {
-  const fs::path output = render("default_scene");
-  ASSERT_TRUE(fs::exists(kBaseline))
-      << "the baseline " << kBaseline << " is missing. The picture rendered now is\n  " << output
-      << "\nlook at it and, if it is right, copy it there:\n  cp " << output << ' ' << kBaseline;
-
-  const auto comparison = compare(output, kBaseline);
-  ASSERT_TRUE(comparison);
-  const PixelDifference pixels = differingPixels(readPng(output), readPng(kBaseline));
-  std::cout << "default scene against the baseline: " << report(*comparison) << "; " << pixels.count
-            << " pixels differ, by at most " << pixels.largest << " of 255\n";
-  if (comparison->thresholded_error > kMaxThresholdedError) {
-    const fs::path diff = kOutputDir / "default_scene_diff.png";
-    writePng(comparison->difference, diff);
-    ADD_FAILURE() << "the default scene no longer looks like the baseline: " << report(*comparison)
-                  << "\n  rendered now: " << output << "\n  baseline:     " << kBaseline
-                  << "\n  difference:   " << diff
-                  << "\nif the change is intended, copy the rendered picture over the baseline.";
-    return;
-  }
-  fs::remove(output);  // passed: nothing to inspect
+  expectMatchesBaseline(render("default_scene"), "default_scene");
 }
 
 TEST_F(RenderBaselineTest, RenderingIsRepeatable) {
@@ -234,6 +250,121 @@ TEST_F(RenderBaselineTest, DeformedLiverDiffersFromTheBaseline) {
   EXPECT_GT(comparison->thresholded_error, kMaxThresholdedError)
       << "the comparison does not notice a deformed liver; see " << output;
   if (!HasFailure()) fs::remove(output);
+}
+
+// Pixels that differ between two pictures of the same scene.
+long changedPixels(const fs::path& a, const fs::path& b) {
+  return differingPixels(readPng(a), readPng(b)).count;
+}
+
+// The shipped wedge resection: a peripheral tumour in the left lobe, visible to the trainee.
+SceneSetup wedgeResectionScene(Scenario& scenario) {
+  const fs::path file = shipped_scenarios_folder() / "wedge-resection-peripheral-tumour.json";
+  ScenarioReading reading = read_scenario_file(file);
+  if (!reading.scenario) throw std::runtime_error("cannot read " + file.string());
+  scenario = *reading.scenario;
+  return build_scene(scenario, file.parent_path());
+}
+
+TEST_F(RenderBaselineTest, SeeThroughShowsTheLesionInsideTheLiver) {
+  Scenario scenario;
+  const SceneSetup setup = wedgeResectionScene(scenario);
+  const std::vector<LesionShape> lesions = visible_lesions(scenario);
+  ASSERT_EQ(lesions.size(), 1u);
+  LiverScene scene(setup.mesh, setup.visual);
+  scene.set_opacity(0.35);
+  const fs::path without = screenshot(scene, "see_through_without_lesion");
+  scene.show_lesions(lesions);
+  // Every triangle of the lesion's sphere (24 × 16 facets) lies inside the liver: all held.
+  EXPECT_EQ(scene.shown_lesion_triangle_count(), 2u * 24u * 15u);
+  const fs::path with = screenshot(scene, "see_through_lesion");
+  // The lesion (radius 8 mm) shows through in its own colour: pale yellow, which neither the
+  // liver (red) nor the background (grey-blue) has.
+  const auto yellowPixels = [](const fs::path& file) {
+    const auto image = readPng(file);
+    const auto* p = static_cast<const unsigned char*>(image->GetScalarPointer());
+    long count = 0;
+    for (vtkIdType i = 0; i < image->GetNumberOfPoints(); ++i, p += 3)
+      count += p[0] > 120 && p[1] > 90 && p[2] < 0.8 * p[1] && p[1] > 0.6 * p[0];
+    return count;
+  };
+  EXPECT_EQ(yellowPixels(without), 0);
+  // Its disc seen through the liver: the liver, ~280 mm across, spans about 480 px, so the
+  // lesion's 16 mm are about 27 px across; at least half its disc's area.
+  EXPECT_GT(yellowPixels(with), 250);
+  EXPECT_GT(changedPixels(without, with), 200);
+  fs::remove(without);
+  expectMatchesBaseline(with, "see_through_lesion");
+}
+
+TEST_F(RenderBaselineTest, ACutShowsItsFacesAndTheScalpel) {
+  const SceneSetup setup = default_scene();
+  const SimModel model = build_model(setup.mesh, setup.model_options);
+  // The left lobe's tip cut off by an oblique plane: the blade, upright across the liver's
+  // depth and leaning toward the tip at the back, is drawn from below the liver to above it.
+  Eigen::AlignedBox3d box;
+  for (std::size_t i = 0; i < model.node_count; ++i) box.extend(model.rest_position_m.at(i));
+  BladeStroke stroke;
+  for (double y = box.min().y() - 0.01; y <= box.max().y() + 0.01; y += 0.002)
+    stroke.add({Eigen::Vector3d(0.085, y, box.max().z() + 0.01),
+                Eigen::Vector3d(0.115, y, box.min().z() - 0.01)});
+  CuttingSettings anything;
+  anything.cutting_stress_pa = 0.0;
+  const CutResult cut = cut_tissue(model, make_rest_state(model), stroke, anything);
+  ASSERT_TRUE(cut.cut());
+  EXPECT_GT(cut.report.removed_elements, 0u) << "the tip did not come free";
+
+  LiverScene scene(setup.mesh, setup.visual);
+  const fs::path uncut = screenshot(scene, "before_cut");
+  scene.set_tool_models(load_tool_models());
+  scene.show_cut_model(*cut.model, cut.state.position_m);
+  Tool scalpel;
+  scalpel.kind = ToolKind::scalpel;
+  scalpel.pose.origin_m = Eigen::Vector3d(0.10, box.max().y() + 0.012, box.center().z());
+  scalpel.pose.orientation = Eigen::AngleAxisd(-0.6, Eigen::Vector3d::UnitX());
+  scene.show_tool(scalpel);
+  const fs::path after = screenshot(scene, "after_cut");
+  EXPECT_GT(changedPixels(uncut, after), 2000) << "the cut changed little of the picture";
+  fs::remove(uncut);
+  expectMatchesBaseline(after, "after_cut");
+}
+
+TEST_F(RenderBaselineTest, ToolModelsAreReadAndDrawnWhereTheirCapsulesAre) {
+  const ToolModels models = load_tool_models();
+  ASSERT_TRUE(models.problem.empty()) << models.problem;
+  const SceneSetup setup = default_scene();
+  LiverScene scene(setup.mesh, setup.visual);
+  scene.set_tool_models(models);
+  // The forceps half open in front of the liver, the shaft toward the viewer and up.
+  Tool forceps;
+  forceps.kind = ToolKind::forceps;
+  forceps.jaw_opening = 0.6;
+  forceps.pose.origin_m = Eigen::Vector3d(-0.02, 0.0, 0.08);
+  forceps.pose.orientation = Eigen::AngleAxisd(-0.5, Eigen::Vector3d::UnitX());
+  scene.show_tool(forceps);
+  const fs::path modelled = screenshot(scene, "forceps_model");
+  // The jaws' tips (tools.cpp) must fall on the model's steel, not on the liver behind.
+  std::array<Capsule, 3> parts;
+  ASSERT_EQ(tool_capsules(forceps, parts), 3);
+  scene.set_tool_models({});  // no models: the capsules
+  scene.show_tool(forceps);
+  const fs::path capsules = screenshot(scene, "forceps_capsules");
+  const auto a = readPng(modelled);
+  const auto b = readPng(capsules);
+  for (int jaw = 1; jaw <= 2; ++jaw) {
+    // Two thirds along each jaw, where both drawings have steel.
+    const Eigen::Vector3d point = parts[jaw].a_m + (2.0 / 3.0) * (parts[jaw].b_m - parts[jaw].a_m);
+    const Eigen::Vector2d pixel = scene.world_to_display(point);
+    for (const auto& image : {a, b}) {
+      const auto* p =
+          static_cast<unsigned char*>(image->GetScalarPointer(int(pixel.x()), int(pixel.y()), 0));
+      // Steel is grey (red ≈ green ≈ blue); the liver is red.
+      EXPECT_LT(std::abs(p[0] - p[2]), 40) << "jaw " << jaw << " is not drawn at its capsule";
+    }
+  }
+  EXPECT_GT(changedPixels(modelled, capsules), 100) << "the model looks like the capsules";
+  fs::remove(capsules);
+  expectMatchesBaseline(modelled, "forceps_model");
 }
 
 }  // namespace

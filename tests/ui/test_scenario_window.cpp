@@ -4,6 +4,7 @@
 // scene that was running goes on.
 #include <gtest/gtest.h>
 
+#include <QAction>
 #include <QApplication>
 #include <QFile>
 #include <QFileInfo>
@@ -235,6 +236,36 @@ TEST_F(ScenarioWindowTest, AScenarioWhoseMeshCannotBeBuiltIsRefusedAndTheSceneGo
   auto* apply = window_->accuracyPanel()->findChild<QPushButton*>("applyAccuracy");
   ASSERT_NE(apply, nullptr);
   EXPECT_TRUE(apply->isEnabled());
+}
+
+}  // namespace
+}  // namespace liversim
+
+namespace liversim {
+namespace {
+
+TEST_F(ScenarioWindowTest, SeeThroughShowsTheScenariosLesionAndIsRemembered) {
+  ASSERT_EQ(open(kSmallScenario), true) << window_->scenarioPanel()->problemText().toStdString();
+  // Solid: the lesion is drawn but hidden inside the liver.
+  EXPECT_FALSE(window_->seeThrough());
+  EXPECT_DOUBLE_EQ(window_->scene().opacity(), 1.0);
+  EXPECT_GT(window_->scene().shown_lesion_triangle_count(), 0u);
+
+  auto* action = window_->findChild<QAction*>("seeThroughAction");
+  ASSERT_NE(action, nullptr);
+  action->trigger();
+  EXPECT_TRUE(window_->seeThrough());
+  EXPECT_DOUBLE_EQ(window_->scene().opacity(), MainWindow::kSeeThroughOpacity);
+
+  // The next window starts see-through.
+  window_.reset();
+  window_ = std::make_unique<MainWindow>(default_scene(1000));
+  EXPECT_TRUE(window_->seeThrough());
+  EXPECT_DOUBLE_EQ(window_->scene().opacity(), MainWindow::kSeeThroughOpacity);
+  // Free practice has no lesions.
+  EXPECT_EQ(window_->scene().shown_lesion_triangle_count(), 0u);
+  window_->setSeeThrough(false);
+  EXPECT_DOUBLE_EQ(window_->scene().opacity(), 1.0);
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include "render/offscreen_png.h"
 
 #include "liversim/core/cutting.h"
+#include "liversim/core/data_paths.h"
+#include "liversim/core/surface_import.h"
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
@@ -12,6 +14,7 @@
 #include <vtkFloatArray.h>
 #include <vtkLight.h>
 #include <vtkLineSource.h>
+#include <vtkMatrix4x4.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -24,6 +27,7 @@
 #include <vtkUnsignedCharArray.h>
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace liversim {
@@ -36,10 +40,106 @@ constexpr double kCutColour[3] = {0.70, 0.24, 0.20};
 constexpr double kBackgroundTop[3] = {0.16, 0.18, 0.22};
 constexpr double kSteel[3] = {0.7, 0.72, 0.75};
 constexpr double kBackgroundBottom[3] = {0.05, 0.05, 0.07};
+// A tumour: pale yellow-white, firmer-looking than the parenchyma.
+constexpr double kLesionColour[3] = {0.91, 0.80, 0.48};
+// The tool models' files in resources/tools, in millimetres.
+constexpr double kToolModelMetresPerUnit = 1e-3;
+
+vtkSmartPointer<vtkActor> model_actor(const VisualMesh& mesh) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToFloat();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.position_m.size()));
+  vtkNew<vtkFloatArray> normals;
+  normals->SetNumberOfComponents(3);
+  normals->SetNumberOfTuples(static_cast<vtkIdType>(mesh.normal.size()));
+  for (std::size_t v = 0; v < mesh.position_m.size(); ++v) {
+    points->SetPoint(static_cast<vtkIdType>(v), mesh.position_m[v].data());
+    normals->SetTypedTuple(static_cast<vtkIdType>(v), mesh.normal[v].data());
+  }
+  vtkNew<vtkCellArray> triangles;
+  for (const auto& t : mesh.triangles) {
+    const vtkIdType ids[3] = {t[0], t[1], t[2]};
+    triangles->InsertNextCell(3, ids);
+  }
+  vtkNew<vtkPolyData> polydata;
+  polydata->SetPoints(points);
+  polydata->GetPointData()->SetNormals(normals);
+  polydata->SetPolys(triangles);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(polydata);
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  vtkProperty* property = actor->GetProperty();
+  property->SetColor(mesh.diffuse_colour[0], mesh.diffuse_colour[1], mesh.diffuse_colour[2]);
+  property->SetInterpolationToPhong();
+  property->SetSpecular(mesh.specular);
+  property->SetSpecularPower(mesh.shininess);
+  actor->VisibilityOff();
+  actor->PickableOff();  // picks hit the liver through the tool
+  return actor;
+}
 
 }  // namespace
 
-LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual) : uncut_visual_(visual) {
+std::vector<LesionShape> visible_lesions(const Scenario& scenario) {
+  std::vector<LesionShape> shapes;
+  for (const LesionSpec& lesion : scenario.lesions)
+    if (!lesion.hidden) shapes.push_back({to_metres(lesion.centre_mm), to_metres(lesion.radii_mm)});
+  return shapes;
+}
+
+ToolModels load_tool_models(const std::filesystem::path& folder) {
+  ToolModels models;
+  const auto read = [&](const char* file, std::optional<VisualModel>& model) {
+    try {
+      model = read_visual_model(folder / file, kToolModelMetresPerUnit);
+    } catch (const std::exception& e) {
+      models.problem += (models.problem.empty() ? "" : "; ") + std::string(e.what());
+    }
+  };
+  read("probe.obj", models.probe);
+  read("forceps-body.obj", models.forceps_body);
+  read("forceps-jaw.obj", models.forceps_jaw);
+  read("scalpel.obj", models.scalpel);
+  return models;
+}
+
+ToolModels load_tool_models() {
+  return load_tool_models(shipped_resources_folder() / "tools");
+}
+
+void LiverScene::ModelActors::show(bool shown) {
+  for (auto& actor : actors) actor->SetVisibility(shown);
+}
+
+void LiverScene::ModelActors::place(const Eigen::Affine3d& pose) {
+  vtkNew<vtkMatrix4x4> matrix;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) matrix->SetElement(r, c, pose.matrix()(r, c));
+  for (auto& actor : actors) actor->SetUserMatrix(matrix);
+}
+
+void LiverScene::set_tool_models(const ToolModels& models) {
+  const auto make = [&](const std::optional<VisualModel>& model, ModelActors& into) {
+    for (auto& actor : into.actors) renderer_->RemoveActor(actor);
+    into.actors.clear();
+    if (!model) return;
+    for (const VisualMesh& mesh : *model) {
+      into.actors.push_back(model_actor(mesh));
+      renderer_->AddActor(into.actors.back());
+    }
+  };
+  make(models.probe, tool_models_[static_cast<int>(ToolKind::probe)]);
+  make(models.scalpel, tool_models_[static_cast<int>(ToolKind::scalpel)]);
+  // The forceps are drawn from a model only with their jaws.
+  const bool forceps = models.forceps_body && models.forceps_jaw;
+  make(forceps ? models.forceps_body : std::nullopt,
+       tool_models_[static_cast<int>(ToolKind::forceps)]);
+  for (ModelActors& jaw : forceps_jaws_) make(forceps ? models.forceps_jaw : std::nullopt, jaw);
+}
+
+LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual)
+    : uncut_visual_(visual), uncut_mesh_(mesh) {
   std::vector<double> smooth_xyz;
   map_visual_positions(visual, mesh.rest_position_m, smooth_xyz);
   for (std::size_t v = 0; v < visual.vertex_count(); ++v) {
@@ -112,6 +212,21 @@ LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual) : uncut_visual
     }
   }
 
+  lesion_points_->SetDataTypeToDouble();
+  lesion_normals_->SetNumberOfComponents(3);
+  lesion_polydata_->SetPoints(lesion_points_);
+  lesion_polydata_->GetPointData()->SetNormals(lesion_normals_);
+  vtkNew<vtkPolyDataMapper> lesion_mapper;
+  lesion_mapper->SetInputData(lesion_polydata_);
+  lesion_actor_->SetMapper(lesion_mapper);
+  lesion_actor_->GetProperty()->SetColor(kLesionColour[0], kLesionColour[1], kLesionColour[2]);
+  lesion_actor_->GetProperty()->SetInterpolationToPhong();
+  lesion_actor_->GetProperty()->SetSpecular(0.2);
+  lesion_actor_->GetProperty()->SetSpecularPower(12.0);
+  lesion_actor_->PickableOff();
+  lesion_actor_->VisibilityOff();
+  renderer_->AddActor(lesion_actor_);
+
   renderer_->GradientBackgroundOn();
   renderer_->SetBackground(kBackgroundBottom[0], kBackgroundBottom[1], kBackgroundBottom[2]);
   renderer_->SetBackground2(kBackgroundTop[0], kBackgroundTop[1], kBackgroundTop[2]);
@@ -164,6 +279,27 @@ void LiverScene::set_surface(VisualSurface visual, const std::vector<std::uint8_
 }
 
 void LiverScene::show_tool(const std::optional<Tool>& tool) {
+  for (ModelActors& model : tool_models_) model.show(false);
+  for (ModelActors& jaw : forceps_jaws_) jaw.show(false);
+  // The models are made at the default sizes: another tool geometry is drawn as its capsules.
+  if (tool && has_model(tool->kind) && tool->geometry == ToolGeometry{}) {
+    show_tool(std::span<const Capsule>());
+    const Eigen::Affine3d pose = Eigen::Translation3d(tool->pose.origin_m) * tool->pose.orientation;
+    ModelActors& model = tool_models_[static_cast<int>(tool->kind)];
+    model.place(pose);
+    model.show(true);
+    if (tool->kind == ToolKind::forceps) {
+      // Each jaw turns about the hinge's y axis (tools.cpp, jaw_tip_local_m); the second is the
+      // first turned half a turn about the shaft.
+      const double angle =
+          std::clamp(tool->jaw_opening, 0.0, 1.0) * tool->geometry.max_jaw_angle_rad;
+      forceps_jaws_[0].place(pose * Eigen::AngleAxisd(-angle, Eigen::Vector3d::UnitY()));
+      forceps_jaws_[1].place(pose * Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()) *
+                             Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitZ()));
+      for (ModelActors& jaw : forceps_jaws_) jaw.show(true);
+    }
+    return;
+  }
   std::array<Capsule, 3> parts;
   const int count = tool ? tool_capsules(*tool, parts) : 0;
   show_tool(std::span<const Capsule>(parts.data(), static_cast<std::size_t>(count)));
@@ -181,10 +317,90 @@ void LiverScene::show_cut_model(const SimModel& model, const NodeArray& position
   VisualSurface visual = embed_visual_surface(mesh, surface, vertex_rest);
   const auto cut_faces = cut_face_flags(model, visual.surface);
   set_surface(std::move(visual), cut_faces, position_m);
+  if (!lesion_rest_m_.empty()) {
+    show_lesion_embedding(embed_points(mesh, lesion_rest_m_));
+    update_lesion_positions(position_m);
+  }
 }
 
 void LiverScene::show_uncut(const NodeArray& position_m) {
   set_surface(uncut_visual_, {}, position_m);
+  if (!lesion_rest_m_.empty()) {
+    show_lesion_embedding(uncut_lesion_embedding_);
+    update_lesion_positions(position_m);
+  }
+}
+
+void LiverScene::show_lesions(const std::vector<LesionShape>& lesions) {
+  lesion_rest_m_.clear();
+  lesion_triangles_.clear();
+  // A unit sphere of 24 × 16 facets, stretched to each lesion's radii.
+  constexpr int kAround = 24, kAlong = 16;
+  for (const LesionShape& lesion : lesions) {
+    const auto first = static_cast<std::int32_t>(lesion_rest_m_.size());
+    const auto vertex = [&](int i, int j) {  // i along (pole to pole), j around
+      if (i == 0) return first;
+      if (i == kAlong) return first + 1 + (kAlong - 1) * kAround;
+      return first + 1 + (i - 1) * kAround + j % kAround;
+    };
+    for (int i = 0; i <= kAlong; ++i) {
+      const double polar = std::numbers::pi * i / kAlong;
+      for (int j = 0; j < ((i == 0 || i == kAlong) ? 1 : kAround); ++j) {
+        const double azimuth = 2.0 * std::numbers::pi * j / kAround;
+        const Eigen::Vector3d unit(std::sin(polar) * std::cos(azimuth),
+                                   std::sin(polar) * std::sin(azimuth), std::cos(polar));
+        lesion_rest_m_.push_back(lesion.centre_m + lesion.radii_m.cwiseProduct(unit));
+      }
+    }
+    for (int i = 0; i < kAlong; ++i)
+      for (int j = 0; j < kAround; ++j) {
+        const std::int32_t a = vertex(i, j), b = vertex(i, j + 1), c = vertex(i + 1, j),
+                           d = vertex(i + 1, j + 1);
+        // Counter-clockwise seen from outside (the sphere's z axis points to its first pole).
+        if (i > 0) lesion_triangles_.push_back({a, c, b});
+        if (i < kAlong - 1) lesion_triangles_.push_back({b, c, d});
+      }
+  }
+  uncut_lesion_embedding_ = embed_points(uncut_mesh_, lesion_rest_m_);
+  show_lesion_embedding(uncut_lesion_embedding_);
+  update_lesion_positions(uncut_mesh_.rest_position_m);
+}
+
+std::size_t LiverScene::shown_lesion_triangle_count() const {
+  return lesion_actor_->GetVisibility()
+             ? static_cast<std::size_t>(lesion_polydata_->GetNumberOfCells())
+             : 0;
+}
+
+void LiverScene::show_lesion_embedding(EmbeddedPoints embedding) {
+  lesion_embedding_ = std::move(embedding);
+  vtkNew<vtkCellArray> triangles;
+  for (const auto& t : lesion_triangles_) {
+    if (!lesion_embedding_.held[t[0]] || !lesion_embedding_.held[t[1]] ||
+        !lesion_embedding_.held[t[2]])
+      continue;  // in a piece a cut removed
+    const vtkIdType ids[3] = {t[0], t[1], t[2]};
+    triangles->InsertNextCell(3, ids);
+  }
+  lesion_polydata_->SetPolys(triangles);
+  lesion_actor_->SetVisibility(triangles->GetNumberOfCells() > 0);
+}
+
+void LiverScene::update_lesion_positions(const NodeArray& position_m) {
+  if (lesion_rest_m_.empty()) return;
+  map_embedded_positions(lesion_embedding_.host_nodes, lesion_embedding_.weights, position_m,
+                         lesion_xyz_);
+  lesion_points_->SetNumberOfPoints(static_cast<vtkIdType>(lesion_rest_m_.size()));
+  for (std::size_t i = 0; i < lesion_rest_m_.size(); ++i)
+    lesion_points_->SetPoint(static_cast<vtkIdType>(i), lesion_xyz_[3 * i], lesion_xyz_[3 * i + 1],
+                             lesion_xyz_[3 * i + 2]);
+  compute_vertex_normals(lesion_triangles_, lesion_xyz_, lesion_normal_scratch_);
+  lesion_normals_->SetNumberOfTuples(static_cast<vtkIdType>(lesion_rest_m_.size()));
+  std::copy(lesion_normal_scratch_.begin(), lesion_normal_scratch_.end(),
+            lesion_normals_->GetPointer(0));
+  lesion_points_->Modified();
+  lesion_normals_->Modified();
+  lesion_polydata_->Modified();
 }
 
 void LiverScene::update_positions(const NodeArray& position_m) {
@@ -197,6 +413,7 @@ void LiverScene::update_positions(const NodeArray& position_m) {
   points_->Modified();
   normals_->Modified();
   polydata_->Modified();
+  update_lesion_positions(position_m);
 }
 
 void LiverScene::reset_camera(double aspect) {

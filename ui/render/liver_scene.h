@@ -4,9 +4,11 @@
 // the rendering tests share it.
 
 #include "liversim/core/model.h"
+#include "liversim/core/scenario.h"
 #include "liversim/core/surface.h"
 #include "liversim/core/tet_mesh.h"
 #include "liversim/core/tools.h"
+#include "liversim/core/visual_model.h"
 
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
@@ -17,6 +19,7 @@
 #include <map>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 class vtkActor;
@@ -31,6 +34,25 @@ class vtkTubeFilter;
 class vtkUnsignedCharArray;
 
 namespace liversim {
+
+// A lesion as the see-through view draws it: an ellipsoid at rest, carried by the organ.
+struct LesionShape {
+  Eigen::Vector3d centre_m;
+  Eigen::Vector3d radii_m;  // along the scene's axes
+};
+
+// The scenario's lesions a trainee may see (not the hidden ones of a palpation task).
+std::vector<LesionShape> visible_lesions(const Scenario& scenario);
+
+// The tools' models (resources/tools, read through assimp), or why they could not be read: the
+// scene then draws each tool as its capsules.
+struct ToolModels {
+  std::optional<VisualModel> probe, forceps_body, forceps_jaw, scalpel;
+  std::string problem;  // empty when all were read
+};
+// Reads them from `folder` (default: the shipped resources' tools folder, data_paths.h).
+ToolModels load_tool_models(const std::filesystem::path& folder);
+ToolModels load_tool_models();
 
 struct ScenePick {
   Eigen::Vector3d point_m;  // where the ray hit the liver surface
@@ -58,6 +80,11 @@ class LiverScene {
   void show_cut_model(const SimModel& model, const NodeArray& position_m);
   // Shows the organ's first surface again (the scene restarted from rest).
   void show_uncut(const NodeArray& position_m);
+  // Lesions inside the organ (seen in the see-through view, or where a cut opens them), carried
+  // by the elements that hold them at rest, and by the cut model's after a cut; the part of a
+  // lesion in a piece a cut removed goes with it. None: no lesions.
+  void show_lesions(const std::vector<LesionShape>& lesions);
+  std::size_t shown_lesion_triangle_count() const;
   // Moves the surface to these node positions (all mesh nodes). Allocates nothing after the first.
   void update_positions(const NodeArray& position_m);
   // Anterior view of the whole organ, in a view `aspect` (width / height) wide: a view narrower
@@ -71,7 +98,10 @@ class LiverScene {
   void show_grab_marker(const std::optional<Eigen::Vector3d>& point_m);
   // The tool's parts (tools.h: tool_capsules) as steel-grey rods with rounded ends; none hides it.
   void show_tool(std::span<const Capsule> parts);
-  void show_tool(const std::optional<Tool>& tool);  // its parts (tool_capsules), or none
+  // The tool as its model when there is one (set_tool_models), else as its capsules; none hides
+  // it.
+  void show_tool(const std::optional<Tool>& tool);
+  void set_tool_models(const ToolModels& models);
 
   // Display coordinates are VTK's: pixels from the bottom-left corner of the render window.
   std::optional<ScenePick> pick(int display_x, int display_y) const;
@@ -101,6 +131,31 @@ class LiverScene {
     std::array<vtkSmartPointer<vtkActor>, 3> actors;  // tube, two ends
   };
   std::array<ToolPart, 3> tool_parts_;
+  // Tool models: one actor per model mesh, placed by the tool's pose (the forceps' jaw twice).
+  struct ModelActors {
+    std::vector<vtkSmartPointer<vtkActor>> actors;
+    void show(bool shown);
+    void place(const Eigen::Affine3d& pose);
+  };
+  std::array<ModelActors, 3> tool_models_;  // by ToolKind: probe, forceps (body), scalpel
+  std::array<ModelActors, 2> forceps_jaws_;
+  bool has_model(ToolKind kind) const {
+    return !tool_models_[static_cast<int>(kind)].actors.empty();
+  }
+
+  // Lesions: their rest vertices and triangles, embedded in the uncut mesh and in the model shown.
+  TetMesh uncut_mesh_;
+  std::vector<Eigen::Vector3d> lesion_rest_m_;
+  std::vector<std::array<std::int32_t, 3>> lesion_triangles_;
+  EmbeddedPoints uncut_lesion_embedding_, lesion_embedding_;
+  vtkNew<vtkPoints> lesion_points_;
+  vtkNew<vtkFloatArray> lesion_normals_;
+  vtkNew<vtkPolyData> lesion_polydata_;
+  vtkNew<vtkActor> lesion_actor_;
+  std::vector<double> lesion_xyz_;
+  std::vector<float> lesion_normal_scratch_;
+  void show_lesion_embedding(EmbeddedPoints embedding);  // its held triangles
+  void update_lesion_positions(const NodeArray& position_m);
   std::vector<double> vertex_xyz_;
   std::vector<float> normal_scratch_;
 };

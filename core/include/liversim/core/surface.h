@@ -48,4 +48,21 @@ VisualSurface embed_visual_surface(const TetMesh& mesh, const BoundarySurface& s
 void map_visual_positions(const VisualSurface& visual, const NodeArray& position,
                           std::vector<double>& vertex_xyz);
 
+// Points inside the organ (the lesions drawn in the see-through view), each carried by the
+// element that holds it at rest, with host nodes and barycentric weights as VisualSurface's. A
+// point is held by the element it lies in, or, just outside the organ, by the nearest element
+// whose smallest weight is at least kEmbeddingReach; a point farther out (or in a piece a cut
+// removed) is not held, and its weights are zero.
+struct EmbeddedPoints {
+  std::vector<std::array<NodeIndex, 4>> host_nodes;
+  std::vector<std::array<double, 4>> weights;
+  std::vector<std::uint8_t> held;
+};
+inline constexpr double kEmbeddingReach = -0.25;
+EmbeddedPoints embed_points(const TetMesh& mesh, const std::vector<Eigen::Vector3d>& points_m);
+// Positions of embedded points (as map_visual_positions).
+void map_embedded_positions(const std::vector<std::array<NodeIndex, 4>>& host_nodes,
+                            const std::vector<std::array<double, 4>>& weights,
+                            const NodeArray& position, std::vector<double>& xyz);
+
 }  // namespace liversim

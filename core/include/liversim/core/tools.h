@@ -44,6 +44,7 @@ struct ToolGeometry {
   double max_jaw_angle_rad = 0.35;  // each jaw off the axis when fully open (20°)
   double blade_length_m = 0.02;
   double blade_half_thickness_m = 0.0005;
+  bool operator==(const ToolGeometry&) const = default;
 };
 
 struct ToolPose {
