@@ -143,8 +143,6 @@ class MainWindow : public QMainWindow {
   // Spring stiffness of a mouse grab and the radius of tissue it holds.
   static constexpr double kGrabStiffnessNPerM = 300.0;
   static constexpr double kGrabRadiusM = 0.02;
-  // The liver's opacity in the see-through view.
-  static constexpr double kSeeThroughOpacity = 0.35;
 
  signals:
   // A recorded session's metrics were computed and stored (or not: stored false, the reason in

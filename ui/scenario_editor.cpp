@@ -945,7 +945,7 @@ void ScenarioEditor::rebuildOrgan() {
     organCentre_m_ += Eigen::Vector3d(p.x[i], p.y[i], p.z[i]);
   if (p.size() > 0) organCentre_m_ /= double(p.size());
   scene_ = std::make_unique<LiverScene>(organ_->mesh, organ_->visual);
-  scene_->set_opacity(0.35);
+  scene_->set_opacity(kSeeThroughOpacity);
   overlay_ = std::make_unique<ScenarioOverlay>(scene_->renderer());
   viewport_->renderWindow()->AddRenderer(scene_->renderer());
   fitCamera();

@@ -272,7 +272,7 @@ TEST_F(RenderBaselineTest, SeeThroughShowsTheLesionInsideTheLiver) {
   const std::vector<LesionShape> lesions = visible_lesions(scenario);
   ASSERT_EQ(lesions.size(), 1u);
   LiverScene scene(setup.mesh, setup.visual);
-  scene.set_opacity(0.35);
+  scene.set_opacity(kSeeThroughOpacity);
   const fs::path without = screenshot(scene, "see_through_without_lesion");
   scene.show_lesions(lesions);
   // Every triangle of the lesion's sphere (24 × 16 facets) lies inside the liver: all held.
@@ -329,6 +329,15 @@ TEST_F(RenderBaselineTest, ACutShowsItsFacesAndTheScalpel) {
   expectMatchesBaseline(after, "after_cut");
 }
 
+TEST(ToolModelsLoading, AMissingFolderNamesEachFileAndLeavesTheCapsules) {
+  const ToolModels models = load_tool_models("/nonexistent/tools");
+  EXPECT_FALSE(models.probe || models.forceps_body || models.forceps_jaw || models.scalpel);
+  for (const char* file : {"probe.obj", "forceps-body.obj", "forceps-jaw.obj", "scalpel.obj"})
+    EXPECT_NE(models.problem.find(std::string("/nonexistent/tools/") + file + ": no such file"),
+              std::string::npos)
+        << models.problem;
+}
+
 TEST_F(RenderBaselineTest, ToolModelsAreReadAndDrawnWhereTheirCapsulesAre) {
   const ToolModels models = load_tool_models();
   ASSERT_TRUE(models.problem.empty()) << models.problem;
@@ -364,6 +373,13 @@ TEST_F(RenderBaselineTest, ToolModelsAreReadAndDrawnWhereTheirCapsulesAre) {
   }
   EXPECT_GT(changedPixels(modelled, capsules), 100) << "the model looks like the capsules";
   fs::remove(capsules);
+  // The model follows the tool when it moves again.
+  scene.set_tool_models(models);
+  forceps.pose.origin_m.x() += 0.03;
+  scene.show_tool(forceps);
+  const fs::path moved = screenshot(scene, "forceps_moved");
+  EXPECT_GT(changedPixels(modelled, moved), 100) << "the model did not follow the tool";
+  fs::remove(moved);
   expectMatchesBaseline(modelled, "forceps_model");
 }
 

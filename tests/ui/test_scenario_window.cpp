@@ -255,13 +255,13 @@ TEST_F(ScenarioWindowTest, SeeThroughShowsTheScenariosLesionAndIsRemembered) {
   ASSERT_NE(action, nullptr);
   action->trigger();
   EXPECT_TRUE(window_->seeThrough());
-  EXPECT_DOUBLE_EQ(window_->scene().opacity(), MainWindow::kSeeThroughOpacity);
+  EXPECT_DOUBLE_EQ(window_->scene().opacity(), kSeeThroughOpacity);
 
   // The next window starts see-through.
   window_.reset();
   window_ = std::make_unique<MainWindow>(default_scene(1000));
   EXPECT_TRUE(window_->seeThrough());
-  EXPECT_DOUBLE_EQ(window_->scene().opacity(), MainWindow::kSeeThroughOpacity);
+  EXPECT_DOUBLE_EQ(window_->scene().opacity(), kSeeThroughOpacity);
   // Free practice has no lesions.
   EXPECT_EQ(window_->scene().shown_lesion_triangle_count(), 0u);
   window_->setSeeThrough(false);

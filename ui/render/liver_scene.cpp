@@ -1,6 +1,7 @@
 #include "render/liver_scene.h"
 
 #include "render/offscreen_png.h"
+#include "render/scenario_overlay.h"
 
 #include "liversim/core/cutting.h"
 #include "liversim/core/data_paths.h"
@@ -40,8 +41,6 @@ constexpr double kCutColour[3] = {0.70, 0.24, 0.20};
 constexpr double kBackgroundTop[3] = {0.16, 0.18, 0.22};
 constexpr double kSteel[3] = {0.7, 0.72, 0.75};
 constexpr double kBackgroundBottom[3] = {0.05, 0.05, 0.07};
-// A tumour: pale yellow-white, firmer-looking than the parenchyma.
-constexpr double kLesionColour[3] = {0.91, 0.80, 0.48};
 // The tool models' files in resources/tools, in millimetres.
 constexpr double kToolModelMetresPerUnit = 1e-3;
 
@@ -112,11 +111,9 @@ void LiverScene::ModelActors::show(bool shown) {
   for (auto& actor : actors) actor->SetVisibility(shown);
 }
 
-void LiverScene::ModelActors::place(const Eigen::Affine3d& pose) {
-  vtkNew<vtkMatrix4x4> matrix;
+void LiverScene::ModelActors::place(const Eigen::Affine3d& tool_pose) {
   for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) matrix->SetElement(r, c, pose.matrix()(r, c));
-  for (auto& actor : actors) actor->SetUserMatrix(matrix);
+    for (int c = 0; c < 4; ++c) pose->SetElement(r, c, tool_pose.matrix()(r, c));
 }
 
 void LiverScene::set_tool_models(const ToolModels& models) {
@@ -126,6 +123,7 @@ void LiverScene::set_tool_models(const ToolModels& models) {
     if (!model) return;
     for (const VisualMesh& mesh : *model) {
       into.actors.push_back(model_actor(mesh));
+      into.actors.back()->SetUserMatrix(into.pose);
       renderer_->AddActor(into.actors.back());
     }
   };

@@ -23,6 +23,7 @@
 #include <vector>
 
 class vtkActor;
+class vtkMatrix4x4;
 class vtkCellPicker;
 class vtkFloatArray;
 class vtkPoints;
@@ -34,6 +35,9 @@ class vtkTubeFilter;
 class vtkUnsignedCharArray;
 
 namespace liversim {
+
+// The organ's opacity in the see-through view.
+inline constexpr double kSeeThroughOpacity = 0.35;
 
 // A lesion as the see-through view draws it: an ellipsoid at rest, carried by the organ.
 struct LesionShape {
@@ -90,8 +94,9 @@ class LiverScene {
   // Anterior view of the whole organ, in a view `aspect` (width / height) wide: a view narrower
   // than tall backs off so that the organ fits across it too.
   void reset_camera(double aspect = 1.0);
-  // See-through: the organ at `opacity` (< 1), front faces only, so what lies inside it (lesions:
-  // scenario_overlay.h) shows through one clean layer; 1 is solid.
+  // See-through: the organ at `opacity` (< 1; kSeeThroughOpacity in the workstation and the
+  // editor), front faces only, so what lies inside it (lesions) shows through one clean layer; 1
+  // is solid.
   void set_opacity(double opacity);
   double opacity() const;
   // A small sphere at the grabbed point, or none.
@@ -134,6 +139,7 @@ class LiverScene {
   // Tool models: one actor per model mesh, placed by the tool's pose (the forceps' jaw twice).
   struct ModelActors {
     std::vector<vtkSmartPointer<vtkActor>> actors;
+    vtkNew<vtkMatrix4x4> pose;  // every actor's user matrix, updated in place
     void show(bool shown);
     void place(const Eigen::Affine3d& pose);
   };

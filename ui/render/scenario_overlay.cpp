@@ -15,8 +15,7 @@
 namespace liversim {
 namespace {
 
-// A tumour: pale yellow-white, as it looks against parenchyma; the selected one brighter.
-constexpr double kLesionColour[3] = {0.93, 0.86, 0.62};
+// The lesion being edited: brighter than the others (kLesionColour).
 constexpr double kSelectedLesionColour[3] = {1.0, 0.95, 0.35};
 constexpr double kFixedColour[3] = {0.25, 0.5, 0.95};
 constexpr double kPlaneColour[3] = {0.2, 0.85, 0.4};

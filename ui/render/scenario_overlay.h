@@ -1,7 +1,8 @@
 #pragma once
-// What a scenario adds to the liver's picture, for the instructor's editor and for the
-// workstation's see-through mode: its lesions (ellipsoids), its fixed regions (painted balls), the
-// planned resection plane and the fibre direction. VTK only (no Qt), in metres like the scene.
+// What a scenario adds to the liver's picture in the instructor's editor: its lesions (ellipsoids
+// at rest), its fixed regions (painted balls), the planned resection plane and the fibre
+// direction. VTK only (no Qt), in metres like the scene. (The workstation's see-through view
+// draws lesions that move with the tissue: LiverScene::show_lesions.)
 
 #include <vtkSmartPointer.h>
 #include <Eigen/Core>
@@ -17,6 +18,9 @@ class vtkPolyDataMapper;
 class vtkRenderer;
 
 namespace liversim {
+
+// A tumour: pale yellow-white against the parenchyma, in the editor and the see-through view.
+inline constexpr double kLesionColour[3] = {0.91, 0.80, 0.48};
 
 struct LesionMarker {
   Eigen::Vector3d centre_m;
