@@ -123,7 +123,6 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   model.tet_count = mesh.tet_count();
   model.corner = mesh.corner;
   model.rest_position_m = mesh.rest_position_m;
-  model.regions = options.regions;
   model.mass_damping_per_s = options.mass_damping_per_s;
   model.stable_step_safety = options.stable_step_safety;
   model.integrator = options.integrator;
@@ -131,10 +130,7 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   const std::size_t tets = model.tet_count;
   for (auto& entry : model.dm_inverse) entry.resize(tets);
   model.rest_volume_m3.resize(tets);
-  model.shear_modulus_pa.resize(tets);
-  model.lame_lambda_pa.resize(tets);
   model.region.assign(tets, 0);
-  model.lumped_mass_kg.assign(model.node_count, 0.0);
 
   for (std::size_t e = 0; e < tets; ++e) {
     const auto region = e < mesh.region.size() ? mesh.region[e] : 0;
@@ -143,9 +139,6 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
                                   std::to_string(region) + ", which has no material (" +
                                   std::to_string(options.regions.size()) + " regions given)");
     model.region[e] = region;
-    const TissueMaterial& tissue = options.regions[region].tissue;
-    model.shear_modulus_pa[e] = (1.0 - tissue.mooney_rivlin_fraction) * tissue.shear_modulus_pa();
-    model.lame_lambda_pa[e] = tissue.lame_lambda_pa();
 
     const auto nodes = mesh.tet(e);
     for (auto n : nodes) {
@@ -165,45 +158,18 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
     const Eigen::Matrix3d inv = dm.inverse();
     for (int k = 0; k < 9; ++k) model.dm_inverse[k][e] = inv(k / 3, k % 3);
     model.rest_volume_m3[e] = volume;
-    const double corner_mass = tissue.density_kg_per_m3 * volume / 4.0;
-    for (auto n : nodes) model.lumped_mass_kg[n] += corner_mass;
   }
 
+  bool fibres = false;
   for (const auto& region : options.regions)
-    model.effects.fibres |= region.fibres.has_value() && region.fibres->k1_pa > 0.0;
-  if (model.effects.fibres) {
+    fibres |= region.fibres.has_value() && region.fibres->k1_pa > 0.0;
+  if (fibres) {
     if (options.fibre_field.first_family.empty())
       throw std::invalid_argument("a region has fibres but the fibre field gives no direction");
     model.fibre_direction[0] = fibre_directions(options.fibre_field.first_family, tets, "first");
     model.fibre_direction[1] = fibre_directions(options.fibre_field.second_family, tets, "second");
-    model.fibre_parameters.resize(tets);
-    for (std::size_t e = 0; e < tets; ++e)
-      model.fibre_parameters[e] =
-          options.regions[model.region[e]].fibres.value_or(FibreParameters{});
   }
-
   model.effects.average_nodal_pressure = options.average_nodal_pressure;
-  for (const auto& region : options.regions)
-    model.effects.mooney_rivlin |= region.tissue.mooney_rivlin_fraction > 0.0;
-  if (model.effects.mooney_rivlin) {
-    model.mooney_rivlin_c2_pa.resize(tets);
-    for (std::size_t e = 0; e < tets; ++e) {
-      const TissueMaterial& tissue = options.regions[model.region[e]].tissue;
-      model.mooney_rivlin_c2_pa[e] =
-          0.5 * tissue.mooney_rivlin_fraction * tissue.shear_modulus_pa();
-      // The I2 term adds 4 c2 to the small-strain λ; take it off so E and ν mean what they say.
-      model.lame_lambda_pa[e] -= 4.0 * model.mooney_rivlin_c2_pa[e];
-    }
-  }
-  for (const auto& region : options.regions)
-    model.effects.viscous |= region.viscoelastic.has_value();
-  if (model.effects.viscous)
-    for (const auto& region : options.regions)
-      model.viscous_parameters.push_back(
-          region.viscoelastic
-              ? std::optional<ViscousTissueParameters>(ViscousTissueParameters{
-                    *region.viscoelastic, region.tissue.poisson_ratio, region.viscoplastic})
-              : std::nullopt);
 
   model.is_fixed.assign(model.node_count, 0);
   for (auto n : options.fixed_nodes) {
@@ -212,18 +178,89 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
                                   std::to_string(model.node_count) + " nodes)");
     model.is_fixed[n] = 1;
   }
+  model.min_element_height_m = assess_quality(mesh).min_height_m;
+  build_node_incidence(model);
+  set_region_materials(model, options.regions);
+  return model;
+}
+
+void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& regions) {
+  validate_regions(regions);
+  const std::size_t tets = model.tet_count;
+  for (std::size_t e = 0; e < tets; ++e)
+    if (model.region[e] < 0 || static_cast<std::size_t>(model.region[e]) >= regions.size())
+      throw std::invalid_argument("element " + std::to_string(e) + " is in region " +
+                                  std::to_string(model.region[e]) + ", which has no material (" +
+                                  std::to_string(regions.size()) + " regions given)");
+  bool fibres = false;
+  for (const auto& region : regions)
+    fibres |= region.fibres.has_value() && region.fibres->k1_pa > 0.0;
+  if (fibres && model.fibre_direction[0].size() != tets)
+    throw std::invalid_argument("a region has fibres but the model has no fibre directions");
+
+  // A cut model keeps each element's mass through the cut (not density times rest volume): a new
+  // density scales it.
+  if (!model.element_mass_kg.empty())
+    for (std::size_t e = 0; e < tets; ++e)
+      model.element_mass_kg[e] *= regions[model.region[e]].tissue.density_kg_per_m3 /
+                                  model.regions[model.region[e]].tissue.density_kg_per_m3;
+  model.regions = regions;
+
+  model.shear_modulus_pa.resize(tets);
+  model.lame_lambda_pa.resize(tets);
+  model.lumped_mass_kg.assign(model.node_count, 0.0);
+  for (std::size_t e = 0; e < tets; ++e) {
+    const TissueMaterial& tissue = regions[model.region[e]].tissue;
+    model.shear_modulus_pa[e] = (1.0 - tissue.mooney_rivlin_fraction) * tissue.shear_modulus_pa();
+    model.lame_lambda_pa[e] = tissue.lame_lambda_pa();
+    const double corner_mass =
+        (model.element_mass_kg.empty() ? tissue.density_kg_per_m3 * model.rest_volume_m3[e]
+                                       : model.element_mass_kg[e]) /
+        4.0;
+    for (int c = 0; c < 4; ++c) model.lumped_mass_kg[model.corner[c][e]] += corner_mass;
+  }
+
+  model.effects.fibres = fibres;
+  model.fibre_parameters.clear();
+  if (fibres) {
+    model.fibre_parameters.resize(tets);
+    for (std::size_t e = 0; e < tets; ++e)
+      model.fibre_parameters[e] = regions[model.region[e]].fibres.value_or(FibreParameters{});
+  }
+
+  model.effects.mooney_rivlin = false;
+  for (const auto& region : regions)
+    model.effects.mooney_rivlin |= region.tissue.mooney_rivlin_fraction > 0.0;
+  model.mooney_rivlin_c2_pa.clear();
+  if (model.effects.mooney_rivlin) {
+    model.mooney_rivlin_c2_pa.resize(tets);
+    for (std::size_t e = 0; e < tets; ++e) {
+      const TissueMaterial& tissue = regions[model.region[e]].tissue;
+      model.mooney_rivlin_c2_pa[e] =
+          0.5 * tissue.mooney_rivlin_fraction * tissue.shear_modulus_pa();
+      // The I2 term adds 4 c2 to the small-strain λ; take it off so E and ν mean what they say.
+      model.lame_lambda_pa[e] -= 4.0 * model.mooney_rivlin_c2_pa[e];
+    }
+  }
+  model.effects.viscous = false;
+  for (const auto& region : regions) model.effects.viscous |= region.viscoelastic.has_value();
+  model.viscous_parameters.clear();
+  if (model.effects.viscous)
+    for (const auto& region : regions)
+      model.viscous_parameters.push_back(
+          region.viscoelastic
+              ? std::optional<ViscousTissueParameters>(ViscousTissueParameters{
+                    *region.viscoelastic, region.tissue.poisson_ratio, region.viscoplastic})
+              : std::nullopt);
+
   model.inverse_mass_per_kg.resize(model.node_count);
   for (std::size_t n = 0; n < model.node_count; ++n) {
     // A node no element touches has no mass; keep it still rather than divide by zero.
     const bool free = !model.is_fixed[n] && model.lumped_mass_kg[n] > 0.0;
     model.inverse_mass_per_kg[n] = free ? 1.0 / model.lumped_mass_kg[n] : 0.0;
   }
-
-  model.min_element_height_m = assess_quality(mesh).min_height_m;
-  build_node_incidence(model);
   model.max_frequency_rad_per_s = estimate_max_frequency_rad_per_s(model, model.rest_position_m);
   model.stable_time_step_s = stable_time_step_s(model, StepInputs{});
-  return model;
 }
 
 }  // namespace liversim

@@ -960,6 +960,40 @@ void write_scenario_file(const Scenario& scenario, const std::filesystem::path& 
   }
 }
 
+std::vector<RegionMaterial> region_materials(const Scenario& s) {
+  // Region 0: the parenchyma, with the laws of the effects that are on.
+  const TissueSpec& t = s.parenchyma;
+  RegionMaterial parenchyma;
+  parenchyma.tissue = t.elastic;
+  if (s.effects.viscoelastic) parenchyma.viscoelastic = t.viscoelastic;
+  if (s.effects.viscoplastic) parenchyma.viscoplastic = t.viscoplastic;
+  if (s.effects.fibres) parenchyma.fibres = FibreParameters{t.fibres->k1_pa, t.fibres->k2};
+  std::vector<RegionMaterial> regions{parenchyma};
+  // Lesions: isotropic (a tumour has no fibre architecture), the parenchyma's laws scaled to the
+  // lesion's stiffness.
+  for (const LesionSpec& lesion : s.lesions) {
+    RegionMaterial material;
+    material.tissue = t.elastic;
+    material.tissue.youngs_modulus_pa = lesion.youngs_modulus_pa;
+    const double ratio = lesion.youngs_modulus_pa / t.elastic.youngs_modulus_pa;
+    if (parenchyma.viscoelastic) {
+      ViscoelasticParameters law = *parenchyma.viscoelastic;
+      law.e1_pa *= ratio;
+      law.e2_pa *= ratio;
+      // Without a viscosity of its own the lesion relaxes with the parenchyma's time τ = η1/E1.
+      law.eta1_pa_s = lesion.viscosity_pa_s.value_or(law.eta1_pa_s * ratio);
+      material.viscoelastic = law;
+    }
+    if (parenchyma.viscoplastic) {
+      ViscoplasticParameters law = *parenchyma.viscoplastic;
+      law.yield_limit_pa = lesion.yield_limit_pa.value_or(law.yield_limit_pa);
+      material.viscoplastic = law;
+    }
+    regions.push_back(material);
+  }
+  return regions;
+}
+
 SceneSetup build_scene(const Scenario& s, const std::filesystem::path& scenario_folder,
                        const MeshingProgressCallback& meshing_progress) {
   if (const auto errors = validate(s); !errors.empty())
@@ -997,45 +1031,19 @@ SceneSetup build_scene(const Scenario& s, const std::filesystem::path& scenario_
       if (fixed[n]) options.fixed_nodes.push_back(static_cast<NodeIndex>(n));
   }
 
-  // Region 0: the parenchyma, with the laws of the effects that are on.
-  const TissueSpec& t = s.parenchyma;
-  RegionMaterial parenchyma;
-  parenchyma.tissue = t.elastic;
-  if (s.effects.viscoelastic) parenchyma.viscoelastic = t.viscoelastic;
-  if (s.effects.viscoplastic) parenchyma.viscoplastic = t.viscoplastic;
+  options.regions = region_materials(s);
   if (s.effects.fibres) {
-    parenchyma.fibres = FibreParameters{t.fibres->k1_pa, t.fibres->k2};
-    const auto& d = t.fibres->direction;
+    const auto& d = s.parenchyma.fibres->direction;
     options.fibre_field.first_family = {Eigen::Vector3d(d[0], d[1], d[2])};
   }
-  options.regions = {parenchyma};
   options.average_nodal_pressure = s.effects.near_incompressibility;
   options.integrator = s.integrator;
 
-  // Lesions: regions 1, 2, ... over the elements whose centroid lies in the ellipsoid; isotropic
-  // (a tumour has no fibre architecture), the parenchyma's laws scaled to the lesion's stiffness.
+  // Lesions: regions 1, 2, ... over the elements whose centroid lies in the ellipsoid.
   if (mesh.region.size() < mesh.tet_count()) mesh.region.resize(mesh.tet_count(), 0);
   for (std::size_t i = 0; i < s.lesions.size(); ++i) {
     const LesionSpec& lesion = s.lesions[i];
-    RegionMaterial material;
-    material.tissue = t.elastic;
-    material.tissue.youngs_modulus_pa = lesion.youngs_modulus_pa;
-    const double ratio = lesion.youngs_modulus_pa / t.elastic.youngs_modulus_pa;
-    if (parenchyma.viscoelastic) {
-      ViscoelasticParameters law = *parenchyma.viscoelastic;
-      law.e1_pa *= ratio;
-      law.e2_pa *= ratio;
-      // Without a viscosity of its own the lesion relaxes with the parenchyma's time τ = η1/E1.
-      law.eta1_pa_s = lesion.viscosity_pa_s.value_or(law.eta1_pa_s * ratio);
-      material.viscoelastic = law;
-    }
-    if (parenchyma.viscoplastic) {
-      ViscoplasticParameters law = *parenchyma.viscoplastic;
-      law.yield_limit_pa = lesion.yield_limit_pa.value_or(law.yield_limit_pa);
-      material.viscoplastic = law;
-    }
-    const auto region = static_cast<std::int32_t>(options.regions.size());
-    options.regions.push_back(material);
+    const auto region = static_cast<std::int32_t>(i + 1);
     std::size_t taken = 0;
     for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
       Eigen::Vector3d centroid = Eigen::Vector3d::Zero();

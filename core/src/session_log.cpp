@@ -9,11 +9,17 @@ namespace liversim {
 
 namespace {
 
-constexpr std::array<std::string_view, 10> kEventNames = {"grasp",         "release",
-                                                          "cut",           "excessive_force",
-                                                          "lesion_breach", "simulation_recovery",
-                                                          "device_fault",  "tool_selected",
-                                                          "lesion_marked", "integrator_changed"};
+constexpr std::array<std::string_view, 11> kEventNames = {"grasp",
+                                                          "release",
+                                                          "cut",
+                                                          "excessive_force",
+                                                          "lesion_breach",
+                                                          "simulation_recovery",
+                                                          "device_fault",
+                                                          "tool_selected",
+                                                          "lesion_marked",
+                                                          "integrator_changed",
+                                                          "material_changed"};
 
 // Layout 1: "LSF1", the frame count (u32), then one column per quantity, frame by frame: time,
 // position x, y, z, velocity x, y, z, force x, y, z (IEEE doubles), buttons (u32). Columns keep

@@ -226,6 +226,33 @@ TEST(Cutting, CuttingAPieceFreeTakesItOutAndMeasuresTheResectedVolume) {
   EXPECT_TRUE(elements_are_sound(after, cut.state));
 }
 
+TEST(Cutting, ANewDensityScalesTheMassesACutModelKept) {
+  const SimModel model = block_model();
+  const SimState state = make_rest_state(model);
+  const double z = 0.032;
+  const CutResult cut =
+      cut_tissue(model, state, sweep_of({-0.01, -0.01, z}, {-0.01, 0.06, z}, {0.08, 0.0, 0.0}),
+                 cut_anything());
+  ASSERT_TRUE(cut.cut());
+  // The same material again first: the cut's own frequency is a local estimate, this one the
+  // whole model's power iteration.
+  SimModel same = *cut.model;
+  ASSERT_FALSE(same.element_mass_kg.empty());
+  set_region_materials(same, same.regions);
+  const double mass_kg = total_mass_kg(same);
+  EXPECT_NEAR(mass_kg, total_mass_kg(*cut.model), 1e-12 * mass_kg);
+  SimModel after = same;
+  RegionMaterial denser = after.regions[0];
+  denser.tissue.density_kg_per_m3 *= 2.0;
+  set_region_materials(after, {denser});
+  EXPECT_NEAR(total_mass_kg(after), 2.0 * mass_kg, 1e-12 * mass_kg);
+  // Twice the mass at the same stiffness (exactly, in binary): ω_max falls by √2, the stable
+  // step grows.
+  EXPECT_NEAR(after.max_frequency_rad_per_s, same.max_frequency_rad_per_s / std::sqrt(2.0),
+              1e-9 * same.max_frequency_rad_per_s);
+  EXPECT_GT(after.stable_time_step_s, same.stable_time_step_s);
+}
+
 TEST(Cutting, ABladeBelowTheCuttingStressOnlyDeforms) {
   const SimModel model = block_model();
   const SimState state = make_rest_state(model);

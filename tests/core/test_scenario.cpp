@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -351,6 +353,76 @@ TEST(ScenarioScene, AnEffectThatIsOffIsNotInTheModelButItsParametersAreKept) {
   EXPECT_TRUE(model.viscous_parameters.empty());
   EXPECT_TRUE(model.fibre_parameters.empty());
   EXPECT_TRUE(round_trip(s).parenchyma.viscoelastic.has_value());
+}
+
+TEST(ScenarioScene, ALiveTissueChangeGivesTheModelABuildWouldGive) {
+  const Scenario before = every_field_set();
+  const SceneSetup scene = build_scene(before, ".");
+  Scenario after = before;
+  TissueSpec& t = after.parenchyma;
+  t.elastic = TissueMaterial{8000.0, 0.45, 1100.0, 0.0};
+  t.viscoelastic = ViscoelasticParameters{5000.0, 3000.0, 4000.0};
+  t.viscoplastic = ViscoplasticParameters{90.0, 4000.0, 0.8};
+  t.fibres->k1_pa = 2000.0;
+  ASSERT_TRUE(validate(after).empty());
+  ModelOptions options = scene.model_options;
+  options.regions = region_materials(after);
+  const SimModel built = build_model(scene.mesh, options);
+
+  SimModel changed = build_model(scene.mesh, scene.model_options);
+  set_region_materials(changed, region_materials(after));
+  // The same arithmetic in the same order: equal to the last bit.
+  EXPECT_EQ(changed.shear_modulus_pa, built.shear_modulus_pa);
+  EXPECT_EQ(changed.lame_lambda_pa, built.lame_lambda_pa);
+  EXPECT_EQ(changed.lumped_mass_kg, built.lumped_mass_kg);
+  EXPECT_EQ(changed.inverse_mass_per_kg, built.inverse_mass_per_kg);
+  ASSERT_EQ(changed.fibre_parameters.size(), built.fibre_parameters.size());
+  for (std::size_t e = 0; e < built.tet_count; ++e)
+    ASSERT_EQ(changed.fibre_parameters[e].k1_pa, built.fibre_parameters[e].k1_pa) << e;
+  ASSERT_EQ(changed.viscous_parameters.size(), 2u);  // the parenchyma and the lesion
+  for (std::size_t r = 0; r < 2; ++r) {
+    const auto& a = *changed.viscous_parameters[r];
+    const auto& b = *built.viscous_parameters[r];
+    EXPECT_EQ(a.viscoelastic.e1_pa, b.viscoelastic.e1_pa);
+    EXPECT_EQ(a.viscoelastic.eta1_pa_s, b.viscoelastic.eta1_pa_s);
+    EXPECT_EQ(a.viscoplastic->yield_limit_pa, b.viscoplastic->yield_limit_pa);
+    EXPECT_EQ(a.poisson_ratio, 0.45);
+  }
+  EXPECT_EQ(changed.stable_time_step_s, built.stable_time_step_s);
+
+  // Every modulus doubled (exactly, in binary): K doubles, so the highest frequency of M⁻¹K
+  // rises by √2 and the stable step shrinks.
+  const SimModel original = build_model(scene.mesh, scene.model_options);
+  Scenario stiffer = before;
+  stiffer.parenchyma.elastic.youngs_modulus_pa *= 2.0;
+  stiffer.parenchyma.viscoelastic->e1_pa *= 2.0;
+  stiffer.parenchyma.viscoelastic->e2_pa *= 2.0;
+  stiffer.parenchyma.fibres->k1_pa *= 2.0;
+  stiffer.lesions[0].youngs_modulus_pa *= 2.0;
+  SimModel doubled = original;
+  set_region_materials(doubled, region_materials(stiffer));
+  EXPECT_NEAR(doubled.max_frequency_rad_per_s, std::sqrt(2.0) * original.max_frequency_rad_per_s,
+              1e-9 * original.max_frequency_rad_per_s);
+  EXPECT_LT(doubled.stable_time_step_s, original.stable_time_step_s);
+}
+
+TEST(ScenarioScene, ALiveTissueChangeIsRefusedWholeWhenAParameterIsBad) {
+  const Scenario s = every_field_set();
+  const SceneSetup scene = build_scene(s, ".");
+  SimModel model = build_model(scene.mesh, scene.model_options);
+  Scenario bad = s;
+  bad.parenchyma.elastic.poisson_ratio = std::numeric_limits<double>::quiet_NaN();
+  const double step = model.stable_time_step_s;
+  try {
+    set_region_materials(model, region_materials(bad));
+    FAIL() << "a NaN Poisson's ratio was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("region 0 (parenchyma)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("Poisson"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(model.stable_time_step_s, step);
+  // The lesion's region needs a material too.
+  EXPECT_THROW(set_region_materials(model, {region_materials(s)[0]}), std::invalid_argument);
 }
 
 TEST(ScenarioScene, PaintedBallsHoldTheSurfaceInsideThem) {

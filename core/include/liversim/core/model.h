@@ -140,6 +140,14 @@ struct SimModel {
 // of range.
 SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
 
+// Gives the model's regions these materials (a live change of the tissue, also of a cut model):
+// every per-element modulus, fibre and viscous parameter, the masses (a cut model's element masses
+// scale with the density), the effects they switch on and the stable step follow, as build_model
+// would make them. A region with fibres needs the model to have fibre directions already. Throws
+// std::invalid_argument as build_model does for the materials; the model is then unchanged only
+// if the throw came from validation (callers change a copy).
+void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& regions);
+
 // Throws std::invalid_argument naming the first integrator setting out of range.
 void validate_integrator(const IntegratorSettings& settings);
 

@@ -190,6 +190,11 @@ void write_scenario_file(const Scenario& scenario, const std::filesystem::path& 
 SceneSetup build_scene(const Scenario& scenario, const std::filesystem::path& scenario_folder,
                        const MeshingProgressCallback& meshing_progress = {});
 
+// The materials of its scene's regions (ModelOptions::regions): the parenchyma (region 0) with the
+// laws of the effects that are on, then each lesion's, the parenchyma's laws scaled to its
+// stiffness. build_scene uses them; a live change of the tissue recomputes them.
+std::vector<RegionMaterial> region_materials(const Scenario& scenario);
+
 std::string_view task_name(TaskKind kind);
 
 }  // namespace liversim

@@ -39,6 +39,9 @@ enum class SessionEventKind {
   // The Accuracy panel changed the integrator (detail: its name and step); a replay of the
   // session's input stops there.
   integrator_changed,
+  // The Material panel changed the tissue (detail: the parenchyma's new parameters); a replay of
+  // the session's input stops there too.
+  material_changed,
 };
 std::string_view session_event_name(SessionEventKind kind);
 std::optional<SessionEventKind> session_event_kind(std::string_view name);
