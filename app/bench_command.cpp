@@ -334,16 +334,6 @@ int evaluate_effect_off_case(const BenchOptions& o) {
   return 0;
 }
 
-// The processor as /proc/cpuinfo names it ("unknown processor" elsewhere).
-std::string processor_name() {
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(cpuinfo, line))
-    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos)
-      return line.substr(line.find(':') + 2);
-  return "unknown processor";
-}
-
 std::string shell_quoted(const std::string& text) {
   std::string quoted = "'";
   for (char ch : text) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);

@@ -11,6 +11,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace liversim::cli {
 
@@ -102,6 +103,10 @@ std::string number(double value);
 std::string format(double value, int precision = 3);
 // Today's date (UTC) as YYYY-MM-DD, for the header of a written report.
 std::string today_utc();
+// The value below which a fraction `p` (0 to 1) of `values` lie, the nearest of them; 0 for none.
+double percentile(std::vector<double> values, double p);
+// The processor as /proc/cpuinfo names it ("unknown processor" elsewhere), for a report's header.
+std::string processor_name();
 // Writes a report file and says so on stdout; 0, or fail()'s exit code naming the file.
 int write_report(const std::filesystem::path& file, const std::string& text);
 

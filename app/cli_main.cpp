@@ -3,6 +3,7 @@
 #include "cli_commands.h"
 #include "cut_bench_command.h"
 #include "experiment_commands.h"
+#include "render_bench_command.h"
 #include "servo_bench_command.h"
 #include "sessions_command.h"
 #include "study_command.h"
@@ -163,6 +164,7 @@ int main(int argc, char** argv) {
   const auto run_bench = add_bench_command(app);
   const auto run_cut_bench = add_cut_bench_command(app);
   const auto run_servo_bench = add_servo_bench_command(app);
+  const auto run_render_bench = add_render_bench_command(app);
   const auto run_sessions = add_sessions_command(app);
 
   try {
@@ -177,6 +179,7 @@ int main(int argc, char** argv) {
   if (auto exit_code = run_bench()) return *exit_code;
   if (auto exit_code = run_cut_bench()) return *exit_code;
   if (auto exit_code = run_servo_bench()) return *exit_code;
+  if (auto exit_code = run_render_bench()) return *exit_code;
   if (auto exit_code = run_sessions()) return *exit_code;
   if (report->parsed()) return mesh_report(report_options);
   if (simulate_cmd->parsed()) return simulate(sim);

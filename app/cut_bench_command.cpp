@@ -1,5 +1,7 @@
 #include "cut_bench_command.h"
 
+#include "cli_commands.h"
+
 #include "liversim/core/cutting.h"
 #include "liversim/core/default_scene.h"
 #include "liversim/core/surface_bvh.h"
@@ -28,13 +30,6 @@ struct CutBenchOptions {
   int threads = 2;
   int repeats = 5;
 };
-
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const auto at = static_cast<std::size_t>(p * static_cast<double>(values.size() - 1) + 0.5);
-  return values[std::min(at, values.size() - 1)];
-}
 
 int run(const CutBenchOptions& o) {
   using clock = std::chrono::steady_clock;

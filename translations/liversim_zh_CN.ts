@@ -721,6 +721,181 @@ The scene that was running goes on.</source>
         <source>Show the liver translucent, with the lesions inside it</source>
         <translation>以半透明方式显示肝脏及其内部病灶</translation>
     </message>
+    <message>
+        <source>a scene or an integrator change is being built; enter the value again after it.</source>
+        <translation>正在构建场景或更换积分器；请在其完成后重新输入该值。</translation>
+    </message>
+    <message>
+        <source>Material</source>
+        <translation>材料</translation>
+    </message>
+    <message>
+        <source>Cancel</source>
+        <translation>取消</translation>
+    </message>
+    <message>
+        <source>Stop building the scene; the scene that is running goes on</source>
+        <translation>停止构建场景；正在运行的场景继续运行</translation>
+    </message>
+    <message>
+        <source>Opening %1 was cancelled; the scene that was running goes on.</source>
+        <translation>已取消打开 %1；原来运行的场景继续运行。</translation>
+    </message>
+    <message>
+        <source>Cancelling…</source>
+        <translation>正在取消…</translation>
+    </message>
+    <message>
+        <source>&amp;Ambient Occlusion</source>
+        <translation>环境光遮蔽(&amp;A)</translation>
+    </message>
+    <message>
+        <source>Darken creases and cut edges by their ambient occlusion (costs frame rate: docs/rendering-performance.md)</source>
+        <translation>按环境光遮蔽加深褶皱和切口边缘（会降低帧率：docs/rendering-performance.md）</translation>
+    </message>
+    <message>
+        <source>&amp;Panels</source>
+        <translation>面板(&amp;P)</translation>
+    </message>
+    <message>
+        <source>Instructors: review and grade every trainee&apos;s sessions</source>
+        <translation>教师：查看并评分所有学员的训练记录</translation>
+    </message>
+    <message>
+        <source>&amp;Instructor Mode</source>
+        <translation>教师模式(&amp;I)</translation>
+    </message>
+    <message>
+        <source>Instructor mode: change the tissue, author scenarios, review every trainee&apos;s sessions</source>
+        <translation>教师模式：修改组织参数、编写场景、查看所有学员的训练记录</translation>
+    </message>
+    <message>
+        <source>Main Toolbar</source>
+        <translation>主工具栏</translation>
+    </message>
+    <message>
+        <source>%1 (%2)</source>
+        <translation>%1（%2）</translation>
+    </message>
+    <message>
+        <source>The liver was cut while the tissue changed; enter it again.</source>
+        <translation>修改组织参数期间肝脏被切开；请重新输入。</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::MaterialPanel</name>
+    <message>
+        <source> kPa</source>
+        <translation> kPa</translation>
+    </message>
+    <message>
+        <source>Young&apos;s modulus E</source>
+        <translation>杨氏模量 E</translation>
+    </message>
+    <message>
+        <source>Poisson&apos;s ratio ν</source>
+        <translation>泊松比 ν</translation>
+    </message>
+    <message>
+        <source> kg/m³</source>
+        <translation> kg/m³</translation>
+    </message>
+    <message>
+        <source>Density ρ</source>
+        <translation>密度 ρ</translation>
+    </message>
+    <message>
+        <source> Pa</source>
+        <translation> Pa</translation>
+    </message>
+    <message>
+        <source>Maxwell arm E1</source>
+        <translation>Maxwell 支路 E1</translation>
+    </message>
+    <message>
+        <source> Pa·s</source>
+        <translation> Pa·s</translation>
+    </message>
+    <message>
+        <source>Maxwell arm η1</source>
+        <translation>Maxwell 支路 η1</translation>
+    </message>
+    <message>
+        <source>Yield limit σs</source>
+        <translation>屈服极限 σs</translation>
+    </message>
+    <message>
+        <source> Pa·sⁿ</source>
+        <translation> Pa·sⁿ</translation>
+    </message>
+    <message>
+        <source>Viscoplastic η2</source>
+        <translation>粘塑性 η2</translation>
+    </message>
+    <message>
+        <source>Creep index n</source>
+        <translation>蠕变指数 n</translation>
+    </message>
+    <message>
+        <source>Fibre k1</source>
+        <translation>纤维 k1</translation>
+    </message>
+    <message>
+        <source>Fibre k2</source>
+        <translation>纤维 k2</translation>
+    </message>
+    <message>
+        <source>Trainee mode: the tissue is the scenario&apos;s. An instructor can change it in instructor mode (Settings menu).</source>
+        <translation>学员模式：组织参数由场景决定。教师可在教师模式（设置菜单）中修改。</translation>
+    </message>
+    <message>
+        <source>A value entered is applied to the running liver at once; it goes on from where it is. The laws of effects the scene leaves off are not simulated and not shown.</source>
+        <translation>输入的值立即作用于正在运行的肝脏，并从当前状态继续。场景未启用的效应既不模拟也不显示。</translation>
+    </message>
+    <message>
+        <source>In use. Effects left off (not simulated): %1.</source>
+        <translation>正在使用。未启用（不模拟）的效应：%1。</translation>
+    </message>
+    <message>
+        <source>viscoelasticity</source>
+        <translation>粘弹性</translation>
+    </message>
+    <message>
+        <source>viscoplasticity</source>
+        <translation>粘塑性</translation>
+    </message>
+    <message>
+        <source>fibres</source>
+        <translation>纤维</translation>
+    </message>
+    <message>
+        <source>none</source>
+        <translation>无</translation>
+    </message>
+    <message>
+        <source>, </source>
+        <translation>、</translation>
+    </message>
+    <message>
+        <source>E2 = E − E1 = %1 Pa; relaxation time τ = η1/E1 = %2 s</source>
+        <translation>E2 = E − E1 = %1 Pa；松弛时间 τ = η1/E1 = %2 s</translation>
+    </message>
+    <message>
+        <source>Applying the new tissue to the running liver…</source>
+        <translation>正在将新的组织参数应用到运行中的肝脏…</translation>
+    </message>
+    <message>
+        <source>Not applied: %1</source>
+        <translation>未应用：%1</translation>
+    </message>
+    <message>
+        <source>%1: %2 to %3%4</source>
+        <translation>%1：%2 至 %3%4</translation>
+    </message>
+    <message>
+        <source>. E2 = E − E1 follows.</source>
+        <translation>。E2 = E − E1 随之确定。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::ScenarioDocument</name>
@@ -1688,6 +1863,14 @@ Simulated: %2.
     <message>
         <source>Paused.</source>
         <translation>已暂停。</translation>
+    </message>
+    <message>
+        <source>See-through</source>
+        <translation>透视</translation>
+    </message>
+    <message>
+        <source>Show the liver semi-transparent, with the scenario&apos;s lesions inside</source>
+        <translation>以半透明显示肝脏及其内部的场景病灶</translation>
     </message>
 </context>
 <context>

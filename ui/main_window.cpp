@@ -3,6 +3,7 @@
 #include "accuracy_panel.h"
 #include "calibration_dialog.h"
 #include "device_panel.h"
+#include "material_panel.h"
 #include "recent_scenarios.h"
 #include "render/liver_scene.h"
 #include "scenario_document.h"
@@ -26,6 +27,7 @@
 #include <vtkRenderer.h>
 #include <QAction>
 #include <QActionGroup>
+#include <QCloseEvent>
 #include <QDateTime>
 #include <QDir>
 #include <QDockWidget>
@@ -39,13 +41,20 @@
 #include <QMenu>
 #include <QMenuBar>
 #include <QMessageBox>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QRegularExpression>
 #include <QSettings>
 #include <QStatusBar>
+#include <QStyle>
+#include <QToolBar>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
 #include <numbers>
+#include <sstream>
 #include <string_view>
 
 namespace liversim {
@@ -55,6 +64,24 @@ namespace {
 QString formatAmount(double value) {
   const double size = std::abs(value);
   return QString::number(value, 'f', size < 1.0 ? 2 : size < 10.0 ? 1 : 0);
+}
+
+// A tissue as a session event's detail (the database's, in English): the parenchyma's parameters
+// of the effects simulated.
+std::string describe_tissue(const TissueSpec& tissue, const EffectsSpec& effects) {
+  std::ostringstream text;
+  text << "E " << tissue.elastic.youngs_modulus_pa << " Pa, nu " << tissue.elastic.poisson_ratio
+       << ", density " << tissue.elastic.density_kg_per_m3 << " kg/m3";
+  if (effects.viscoelastic && tissue.viscoelastic)
+    text << ", E1 " << tissue.viscoelastic->e1_pa << " Pa, eta1 " << tissue.viscoelastic->eta1_pa_s
+         << " Pa s";
+  if (effects.viscoplastic && tissue.viscoplastic)
+    text << ", yield limit " << tissue.viscoplastic->yield_limit_pa << " Pa, eta2 "
+         << tissue.viscoplastic->eta2_pa_s_pow_n << " Pa s^n, n "
+         << tissue.viscoplastic->creep_index_n;
+  if (effects.fibres && tissue.fibres)
+    text << ", k1 " << tissue.fibres->k1_pa << " Pa, k2 " << tissue.fibres->k2;
+  return text.str();
 }
 
 }  // namespace
@@ -93,6 +120,16 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
           [this](const IntegratorSettings& settings) { applyIntegratorSettings(settings); });
   addPanelDock(tr("Accuracy"), "accuracyDock", accuracyPanel_);
 
+  materialPanel_ = new MaterialPanel(this);
+  materialPanel_->setObjectName("materialPanel");
+  connect(materialPanel_, &MaterialPanel::tissueRequested, this, [this](const TissueSpec& tissue) {
+    if (!applyTissue(tissue))
+      materialPanel_->showError(
+          tr("a scene or an integrator change is being built; enter the "
+             "value again after it."));
+  });
+  addPanelDock(tr("Material"), "materialDock", materialPanel_);
+
   toolPanel_ = new ToolPanel(this);
   toolPanel_->setObjectName("toolPanel");
   addPanelDock(tr("Tool"), "toolDock", toolPanel_);
@@ -130,10 +167,22 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   buildMenus();
   showScenarioDetails();
   setSeeThrough(QSettings().value("view/see_through", false).toBool());
+  setInstructorMode(QSettings().value("interface/instructor_mode", false).toBool());
 
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("simulationStatus");
   statusBar()->addPermanentWidget(statusLabel_, 1);
+  buildProgress_ = new QProgressBar(this);
+  buildProgress_->setObjectName("buildProgress");
+  buildProgress_->setMaximumWidth(200);
+  buildProgress_->hide();
+  statusBar()->addPermanentWidget(buildProgress_);
+  cancelBuild_ = new QPushButton(tr("Cancel"), this);
+  cancelBuild_->setObjectName("cancelBuild");
+  cancelBuild_->setToolTip(tr("Stop building the scene; the scene that is running goes on"));
+  cancelBuild_->hide();
+  connect(cancelBuild_, &QPushButton::clicked, this, &MainWindow::cancelSceneBuild);
+  statusBar()->addPermanentWidget(cancelBuild_);
   if (toolModels_.problem.empty())
     statusBar()->showMessage(
         tr("Drag the liver with the left mouse button; drag the background to "
@@ -143,6 +192,7 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
                                 "simple shapes: %1")
                                  .arg(QString::fromStdString(toolModels_.problem)));
   resize(1200, 800);
+  restoreLayout();
 
   frameTimer_.setTimerType(Qt::PreciseTimer);
   connect(&frameTimer_, &QTimer::timeout, this, &MainWindow::showNewestSnapshot);
@@ -164,12 +214,36 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   }
 }
 
-void MainWindow::addPanelDock(const QString& title, const char* name, QWidget* panel) {
+QDockWidget* MainWindow::addPanelDock(const QString& title, const char* name, QWidget* panel) {
   auto* dock = new QDockWidget(title, this);
   dock->setObjectName(name);
   dock->setWidget(panel);
-  dock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
+  dock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable |
+                    QDockWidget::DockWidgetClosable);
   addDockWidget(Qt::RightDockWidgetArea, dock);
+  return dock;
+}
+
+void MainWindow::restoreLayout() {
+  QSettings settings;
+  restoreGeometry(settings.value("window/geometry").toByteArray());
+  restoreState(settings.value("window/state").toByteArray(), kLayoutVersion);
+}
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+  QSettings settings;
+  settings.setValue("window/geometry", saveGeometry());
+  settings.setValue("window/state", saveState(kLayoutVersion));
+  QMainWindow::closeEvent(event);
+}
+
+void MainWindow::setInstructorMode(bool on) {
+  instructorMode_ = on;
+  QSettings().setValue("interface/instructor_mode", on);
+  materialPanel_->setEditable(on);
+  if (instructorModeAction_ != nullptr) instructorModeAction_->setChecked(on);
+  if (scenarioEditorAction_ != nullptr) scenarioEditorAction_->setVisible(on);
+  if (reviewSessionsAction_ != nullptr) reviewSessionsAction_->setVisible(on);
 }
 
 void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> model) {
@@ -178,6 +252,7 @@ void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> 
   auto scene = std::make_unique<LiverScene>(setup.mesh, setup.visual);
   scene->set_tool_models(toolModels_);
   scene->set_opacity(seeThrough_ ? kSeeThroughOpacity : 1.0);
+  scene->set_ambient_occlusion(ambientOcclusion_);
   if (simulation_) {
     // The hand and the mouse's tool let go of the old liver; a device stays attached.
     if (grab_) endGrab();
@@ -193,6 +268,7 @@ void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> 
   setup_ = std::move(setup);
   sceneModel_ = std::move(model);
   shownTopology_ = 0;
+  tissueChangedInFreePractice_ = false;
 }
 
 void MainWindow::restartFromRest() {
@@ -212,7 +288,7 @@ void MainWindow::restartFromRest() {
 }
 
 bool MainWindow::openScenario(const QString& file) {
-  if (changingIntegrator_ || openingScenario_) return false;
+  if (busyBuilding()) return false;
   // The exact text is what a recorded session refers to, so it is read once, here.
   QFile in(file);
   ScenarioReading reading;
@@ -233,7 +309,7 @@ bool MainWindow::openScenario(const QString& file) {
 }
 
 bool MainWindow::tryScenario(const Scenario& scenario, const QString& file) {
-  if (changingIntegrator_ || openingScenario_) return false;
+  if (busyBuilding()) return false;
   const QString folder = file.isEmpty() ? QDir::currentPath() : QFileInfo(file).absolutePath();
   buildScenario({scenario, file, write_scenario(scenario)}, folder);
   return true;
@@ -244,13 +320,21 @@ void MainWindow::buildScenario(OpenedScenario opened, const QString& folder) {
   openingScenario_ = true;
   accuracyPanel_->setBusy(true);
   statusBar()->showMessage(tr("Building the scene of %1…").arg(scenarioName(opened)));
-  modelBuilder_ = std::thread([this, opened = std::move(opened), folder] {
+  // Until meshing reports its attempts, the bar only says that work goes on.
+  buildProgress_->setRange(0, 0);
+  buildProgress_->show();
+  cancelBuild_->setEnabled(true);
+  cancelBuild_->show();
+  auto cancelled = std::make_shared<std::atomic<bool>>(false);
+  buildCancelled_ = cancelled;
+  modelBuilder_ = std::thread([this, opened = std::move(opened), folder, cancelled] {
     std::shared_ptr<SceneSetup> setup;
     std::shared_ptr<const SimModel> model;
     QString error;
     try {
       // A surface model is meshed first: each attempt at its element count is shown.
-      const auto progress = [this, name = scenarioName(opened)](const MeshingProgress& p) {
+      const auto progress = [this, name = scenarioName(opened),
+                             cancelled](const MeshingProgress& p) {
         const QString text =
             p.tet_count == 0
                 ? tr("Building the scene of %1: meshing the organ, attempt %2 of at most %3 "
@@ -263,9 +347,18 @@ void MainWindow::buildScenario(OpenedScenario opened, const QString& folder) {
                       .arg(name)
                       .arg(p.attempt)
                       .arg(p.tet_count);
+        // Before and after each attempt: done attempts of at most max_attempts.
+        const int done = p.attempt - (p.tet_count == 0 ? 1 : 0);
         QMetaObject::invokeMethod(
-            this, [this, text] { statusBar()->showMessage(text); }, Qt::QueuedConnection);
-        return true;
+            this,
+            [this, text, done, max = p.max_attempts] {
+              if (buildCancelled_ && *buildCancelled_) return;
+              buildProgress_->setRange(0, max);
+              buildProgress_->setValue(done);
+              statusBar()->showMessage(text);
+            },
+            Qt::QueuedConnection);
+        return !*cancelled;
       };
       setup = std::make_shared<SceneSetup>(
           build_scene(opened.scenario, std::filesystem::path(folder.toStdString()), progress));
@@ -286,6 +379,16 @@ void MainWindow::finishScenarioOpen(const OpenedScenario& opened, std::shared_pt
   modelBuilder_.join();  // it ends right after posting this
   openingScenario_ = false;
   accuracyPanel_->setBusy(false);
+  buildProgress_->hide();
+  cancelBuild_->hide();
+  const bool cancelled = buildCancelled_ && *buildCancelled_;
+  buildCancelled_.reset();
+  if (cancelled) {  // asked for: not an error, and whatever was built is dropped
+    statusBar()->showMessage(tr("Opening %1 was cancelled; the scene that was running goes on.")
+                                 .arg(scenarioName(opened)));
+    emit scenarioOpenFinished(false);
+    return;
+  }
   if (!model) return refuseScenario(scenarioName(opened), error);
   // The device stays; its session was of the old scene: it ends (with the old scene's outcome)
   // and another begins on the new one.
@@ -333,6 +436,13 @@ void MainWindow::refuseScenario(const QString& file, const QString& why) {
   emit scenarioOpenFinished(false);
 }
 
+void MainWindow::cancelSceneBuild() {
+  if (!buildCancelled_) return;
+  *buildCancelled_ = true;
+  cancelBuild_->setEnabled(false);
+  statusBar()->showMessage(tr("Cancelling…"));
+}
+
 void MainWindow::showScenarioDetails() {
   const QString name = scenario_ ? QString::fromStdString(scenario_->scenario.title)
                                  : tr("free practice, %1 elements").arg(setup_.mesh.tet_count());
@@ -343,6 +453,8 @@ void MainWindow::showScenarioDetails() {
                                scenario_ ? scenario_->file : QString());
   // Free practice offers what a scenario does by default: every tool.
   toolPanel_->setAvailableTools(scenario_ ? scenario_->scenario.tools : Scenario{}.tools);
+  const Scenario described = describedScenario();
+  materialPanel_->showTissue(described.parenchyma, described.effects);
 }
 
 void MainWindow::buildMenus() {
@@ -364,6 +476,7 @@ void MainWindow::buildMenus() {
   editor->setObjectName("scenarioEditorAction");
   editor->setToolTip(tr("Instructors: author the scenario shown, or a new one"));
   editor->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_E));
+  scenarioEditorAction_ = editor;
   file->addSeparator();
   QAction* quit = file->addAction(tr("&Quit"), this, &QWidget::close);
   quit->setObjectName("quitAction");
@@ -377,6 +490,25 @@ void MainWindow::buildMenus() {
   seeThroughAction_->setCheckable(true);
   seeThroughAction_->setShortcut(QKeySequence(Qt::Key_T));
   seeThroughAction_->setToolTip(tr("Show the liver translucent, with the lesions inside it"));
+  ambientOcclusionAction_ = view->addAction(tr("&Ambient Occlusion"), this, [this](bool checked) {
+    ambientOcclusion_ = checked;
+    scene_->set_ambient_occlusion(checked);
+    QSettings().setValue("view/ambient_occlusion", checked);
+    viewport_->update();
+  });
+  ambientOcclusionAction_->setObjectName("ambientOcclusionAction");
+  ambientOcclusionAction_->setCheckable(true);
+  ambientOcclusionAction_->setToolTip(
+      tr("Darken creases and cut edges by their ambient occlusion (costs frame rate: "
+         "docs/rendering-performance.md)"));
+  ambientOcclusion_ = QSettings().value("view/ambient_occlusion", false).toBool();
+  ambientOcclusionAction_->setChecked(ambientOcclusion_);
+  scene_->set_ambient_occlusion(ambientOcclusion_);
+  view->addSeparator();
+  panelsMenu_ = view->addMenu(tr("&Panels"));
+  panelsMenu_->setObjectName("panelsMenu");
+  for (QDockWidget* dock : findChildren<QDockWidget*>())
+    panelsMenu_->addAction(dock->toggleViewAction());
 
   QMenu* session = menuBar()->addMenu(tr("&Session"));
   session->setObjectName("sessionMenu");
@@ -387,6 +519,8 @@ void MainWindow::buildMenus() {
   QAction* review =
       session->addAction(tr("&Review Sessions…"), this, [this] { openSessionReview(); });
   review->setObjectName("reviewSessionsAction");
+  review->setToolTip(tr("Instructors: review and grade every trainee's sessions"));
+  reviewSessionsAction_ = review;
   QAction* history =
       session->addAction(tr("My &Sessions…"), this, [this] { openTraineeHistory(); });
   history->setObjectName("traineeHistoryAction");
@@ -396,6 +530,14 @@ void MainWindow::buildMenus() {
 
   QMenu* settings = menuBar()->addMenu(tr("Se&ttings"));
   settings->setObjectName("settingsMenu");
+  instructorModeAction_ =
+      settings->addAction(tr("&Instructor Mode"), this, [this](bool on) { setInstructorMode(on); });
+  instructorModeAction_->setObjectName("instructorModeAction");
+  instructorModeAction_->setCheckable(true);
+  instructorModeAction_->setShortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_I));
+  instructorModeAction_->setToolTip(
+      tr("Instructor mode: change the tissue, author scenarios, review every trainee's sessions"));
+  settings->addSeparator();
   QMenu* language = settings->addMenu(tr("&Language"));
   language->setObjectName("languageMenu");
   auto* languages = new QActionGroup(language);
@@ -413,6 +555,31 @@ void MainWindow::buildMenus() {
   };
   addLanguage({}, tr("The System's Language"));
   for (const QString& code : availableLanguages()) addLanguage(code, languageName(code));
+
+  // The actions of every session in reach, each with its shortcut in its tooltip.
+  toolBar_ = addToolBar(tr("Main Toolbar"));
+  toolBar_->setObjectName("mainToolBar");
+  toolBar_->setToolButtonStyle(Qt::ToolButtonTextBesideIcon);
+  open->setIcon(style()->standardIcon(QStyle::SP_DialogOpenButton));
+  for (QAction* action : {open, editor}) toolBar_->addAction(action);
+  toolBar_->addSeparator();
+  toolBar_->addAction(seeThroughAction_);
+  toolBar_->addSeparator();
+  for (QAction* action : {mark, history, review}) toolBar_->addAction(action);
+  toolBar_->addSeparator();
+  toolBar_->addAction(instructorModeAction_);
+  static const QRegularExpression mnemonic(QStringLiteral(R"(\(&\w\)|&)"));
+  for (QAction* action : toolBar_->actions()) {
+    // A button shows no mnemonic, neither "&" nor a translation's "(&O)".
+    action->setIconText(action->text().remove(mnemonic));
+    // An action without a tooltip of its own shows its text: the button's, then.
+    QString tip = action->toolTip();
+    if (tip == QString(action->text()).remove('&')) tip = action->iconText();
+    if (!action->shortcut().isEmpty())
+      tip = tr("%1 (%2)").arg(tip, action->shortcut().toString(QKeySequence::NativeText));
+    action->setToolTip(tip);
+  }
+  panelsMenu_->addAction(toolBar_->toggleViewAction());
 }
 
 void MainWindow::setSeeThrough(bool on) {
@@ -470,8 +637,7 @@ MainWindow::~MainWindow() {
 }
 
 bool MainWindow::applyIntegratorSettings(const IntegratorSettings& settings) {
-  if (changingIntegrator_ || openingScenario_) return false;
-  if (modelBuilder_.joinable()) modelBuilder_.join();  // the last one has reported back
+  if (busyBuilding()) return false;
   changingIntegrator_ = true;
   accuracyPanel_->setBusy(true);
   ModelOptions options = setup_.model_options;
@@ -479,60 +645,128 @@ bool MainWindow::applyIntegratorSettings(const IntegratorSettings& settings) {
   // A cut liver is not the scene's mesh any more: its model is taken as it is.
   std::shared_ptr<const SimModel> cut =
       shownTopology_ > 0 ? simulation_->snapshot().model : nullptr;
-  modelBuilder_ = std::thread([this, options = std::move(options), settings, cut] {
-    std::shared_ptr<const SimModel> model;
+  startModelChange({settings, std::nullopt}, [this, options = std::move(options), settings, cut] {
+    ModelChangeBuilt built;
+    if (cut) {
+      validate_integrator(settings);
+      auto changed = std::make_shared<SimModel>(*cut);
+      changed->integrator = settings;
+      changed->stable_time_step_s = stable_time_step_s(*changed, StepInputs{});
+      built.model = std::move(changed);
+    } else {
+      // build_model checks the settings first, so a bad entry is refused at once.
+      built.model = std::make_shared<const SimModel>(build_model(setup_.mesh, options));
+      built.rest_model = built.model;
+    }
+    return built;
+  });
+  return true;
+}
+
+bool MainWindow::applyTissue(const TissueSpec& tissue) {
+  if (changingTissue_) {  // the newest entry is applied after the one being applied
+    pendingTissue_ = tissue;
+    return true;
+  }
+  if (busyBuilding()) return false;
+  Scenario described = describedScenario();
+  described.parenchyma = tissue;
+  std::vector<RegionMaterial> regions = region_materials(described);
+  changingTissue_ = true;
+  materialPanel_->setBusy(true);
+  // The model running (cut or not) and the scene's uncut one, which a restart from rest runs.
+  std::shared_ptr<const SimModel> running = simulation_->snapshot().model;
+  std::shared_ptr<const SimModel> rest = sceneModel_;
+  startModelChange({std::nullopt, tissue}, [regions = std::move(regions), running, rest] {
+    const auto changed = [&](const SimModel& model) {
+      auto copy = std::make_shared<SimModel>(model);
+      set_region_materials(*copy, regions);
+      return copy;
+    };
+    ModelChangeBuilt built;
+    built.model = changed(*running);
+    built.rest_model = running == rest ? built.model : changed(*rest);
+    return built;
+  });
+  return true;
+}
+
+bool MainWindow::busyBuilding() const {
+  return changingIntegrator_ || changingTissue_ || openingScenario_;
+}
+
+Scenario MainWindow::describedScenario() const {
+  if (scenario_) return scenario_->scenario;
+  // Free practice: the built-in liver's parenchyma (region 0), the effects its model has.
+  const ModelOptions& options = setup_.model_options;
+  const RegionMaterial& parenchyma = options.regions.at(0);
+  Scenario s;
+  s.lesions.clear();
+  s.parenchyma.elastic = parenchyma.tissue;
+  s.parenchyma.viscoelastic = parenchyma.viscoelastic;
+  s.parenchyma.viscoplastic = parenchyma.viscoplastic;
+  if (parenchyma.fibres && !options.fibre_field.first_family.empty()) {
+    const Eigen::Vector3d& d = options.fibre_field.first_family.front();
+    s.parenchyma.fibres =
+        FibreSpec{parenchyma.fibres->k1_pa, parenchyma.fibres->k2, {d.x(), d.y(), d.z()}};
+  }
+  s.effects = {options.average_nodal_pressure, parenchyma.viscoelastic.has_value(),
+               parenchyma.viscoplastic.has_value(), s.parenchyma.fibres.has_value()};
+  return s;
+}
+
+void MainWindow::startModelChange(ModelChange change, std::function<ModelChangeBuilt()> build) {
+  if (modelBuilder_.joinable()) modelBuilder_.join();  // the last one has reported back
+  modelBuilder_ = std::thread([this, change = std::move(change), build = std::move(build)] {
+    ModelChangeBuilt built;
     QString error;
     try {
-      if (cut) {
-        validate_integrator(settings);
-        auto changed = std::make_shared<SimModel>(*cut);
-        changed->integrator = settings;
-        changed->stable_time_step_s = stable_time_step_s(*changed, StepInputs{});
-        model = std::move(changed);
-      } else {
-        // build_model checks the settings first, so a bad entry is refused at once.
-        model = std::make_shared<const SimModel>(build_model(setup_.mesh, options));
-      }
+      built = build();
     } catch (const std::exception& e) {
       error = QString::fromUtf8(e.what());
     }
     // Runs on the GUI thread; dropped if the window is gone (its destructor joins this thread
     // first, and a QObject discards the events posted to it when it is destroyed).
     QMetaObject::invokeMethod(
-        this, [this, settings, model, error] { finishIntegratorChange(settings, model, error); },
+        this, [this, change, built, error] { finishModelChange(change, built, error); },
         Qt::QueuedConnection);
   });
-  return true;
 }
 
-void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
-                                        std::shared_ptr<const SimModel> model,
-                                        const QString& error) {
+void MainWindow::finishModelChange(const ModelChange& change, const ModelChangeBuilt& built,
+                                   const QString& error) {
   modelBuilder_.join();  // it ends right after posting this
-  changingIntegrator_ = false;
-  accuracyPanel_->setBusy(false);
-  if (!model) {
-    accuracyPanel_->showError(error);
-    emit integratorChangeFinished(false);
-    return;
-  }
+  const auto refuse = [&](const QString& why) {
+    if (change.integrator) {
+      changingIntegrator_ = false;
+      accuracyPanel_->setBusy(false);
+      accuracyPanel_->showError(why);
+      emit integratorChangeFinished(false);
+    } else {
+      changingTissue_ = false;
+      materialPanel_->showError(why);
+      emit tissueChangeFinished(false);
+      applyPendingTissue();
+    }
+  };
+  if (!built.model) return refuse(error);
 
   // Carry the liver's motion over: the same mesh, so the same node order. The new scheme starts
   // its own history (a multistep scheme its first step, an adaptive one its step size).
   simulation_->stop();
   const SimState& old = simulation_->state();
-  if (old.position_m.size() != model->node_count) {  // a cut came in while the model was built
+  if (old.position_m.size() != built.model->node_count) {  // a cut came in while it was built
     simulation_->start();
-    accuracyPanel_->showError(
-        tr("The liver was cut while the integrator changed; apply it again."));
-    emit integratorChangeFinished(false);
-    return;
+    return refuse(change.integrator
+                      ? tr("The liver was cut while the integrator changed; apply it again.")
+                      : tr("The liver was cut while the tissue changed; enter it again."));
   }
-  // A recorded session's input log ends here: a replay does not follow an integrator change.
+  // A recorded session's input log ends here: a replay does not follow a change of the model.
   if (recorder_) {
     simulation_->log_inputs(false);
     recorder_->record_inputs(simulation_->take_input_log());
   }
+  const std::shared_ptr<const SimModel>& model = built.model;
   SimState state = make_rest_state(*model, shared_worker_pool());
   state.position_m = old.position_m;
   state.velocity_m_per_s = old.velocity_m_per_s;
@@ -551,24 +785,53 @@ void MainWindow::finishIntegratorChange(const IntegratorSettings& settings,
   } catch (const std::exception& e) {
     if (recorder_) simulation_->log_inputs(true);  // the old one's log goes on
     simulation_->start();                          // the old one goes on where it stopped
-    accuracyPanel_->showError(QString::fromUtf8(e.what()));
-    emit integratorChangeFinished(false);
-    return;
+    return refuse(QString::fromUtf8(e.what()));
   }
   if (grab_) simulation_->set_springs(springs_);
   simulation_->enable_tools(scene_->surface());
   simulation_->enable_cutting();
   attachDevice();
   simulation_->start();
-  if (recorder_)
-    recorder_->record_event({servo_->now_s(), SessionEventKind::integrator_changed,
-                             std::string(integrator_name(settings.kind))});
-  setup_.model_options.integrator = settings;
   // Built from the scene's mesh (not a cut one): a restart from rest can use it.
-  if (model->node_count == setup_.mesh.node_count() && shownTopology_ == 0)
-    sceneModel_ = std::move(model);
-  accuracyPanel_->setSettings(settings);
-  emit integratorChangeFinished(true);
+  if (built.rest_model &&
+      (built.rest_model != built.model ||
+       (shownTopology_ == 0 && built.model->node_count == setup_.mesh.node_count())))
+    sceneModel_ = built.rest_model;
+  if (change.integrator) {
+    const IntegratorSettings& settings = *change.integrator;
+    if (recorder_)
+      recorder_->record_event({servo_->now_s(), SessionEventKind::integrator_changed,
+                               std::string(integrator_name(settings.kind))});
+    setup_.model_options.integrator = settings;
+    changingIntegrator_ = false;
+    accuracyPanel_->setBusy(false);
+    accuracyPanel_->setSettings(settings);
+    emit integratorChangeFinished(true);
+    return;
+  }
+  const TissueSpec& tissue = *change.tissue;
+  if (recorder_)
+    recorder_->record_event({servo_->now_s(), SessionEventKind::material_changed,
+                             describe_tissue(tissue, describedScenario().effects)});
+  setup_.model_options.regions = model->regions;
+  if (scenario_) {
+    // Sessions recorded from now on store the scenario as it runs, so that they replay with it.
+    scenario_->scenario.parenchyma = tissue;
+    scenario_->text = write_scenario(scenario_->scenario);
+  } else {
+    tissueChangedInFreePractice_ = true;
+  }
+  changingTissue_ = false;
+  materialPanel_->showTissue(tissue, describedScenario().effects);
+  emit tissueChangeFinished(true);
+  applyPendingTissue();
+}
+
+void MainWindow::applyPendingTissue() {
+  if (!pendingTissue_) return;
+  const TissueSpec next = *pendingTissue_;
+  pendingTissue_.reset();
+  applyTissue(next);
 }
 
 bool MainWindow::beginGrab(QPoint pos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers) {
@@ -951,6 +1214,9 @@ void MainWindow::beginRecording() {
     start.scenario_title = tr("Free practice").toStdString();
     start.scenario_text = "free practice on the built-in liver, " +
                           std::to_string(setup_.mesh.tet_count()) + " tetrahedra";
+    if (tissueChangedInFreePractice_)
+      start.scenario_text += ", tissue changed: " + describe_tissue(describedScenario().parenchyma,
+                                                                    describedScenario().effects);
   }
   start.device = ownDevice_ ? ownDevice_->name() : omni_ ? omni_->name() : "haptic device";
   start.started_unix_ms = QDateTime::currentMSecsSinceEpoch();
@@ -963,7 +1229,9 @@ void MainWindow::beginRecording() {
                                  .toStdString();
   else
     replay.built_in_liver_tets = setup_.built_in_liver_tets;
-  if (scenario_ || setup_.built_in_liver_tets) start.replay = replay;
+  // Free practice stores only its element count: a tissue changed in it cannot be built again.
+  if (scenario_ || (setup_.built_in_liver_tets && !tissueChangedInFreePractice_))
+    start.replay = replay;
   ServoLoop* servo = servo_.get();
   // The servo has queued frames since it started (the mouse's, until its first press): the
   // session's are those from now on.

@@ -24,7 +24,9 @@
 #include <QTimer>
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -32,8 +34,12 @@
 #include <string>
 #include <thread>
 
+class QDockWidget;
 class QLabel;
 class QMenu;
+class QProgressBar;
+class QPushButton;
+class QToolBar;
 
 namespace liversim {
 
@@ -41,6 +47,7 @@ class AccuracyPanel;
 class CalibrationDialog;
 class DevicePanel;
 class LiverScene;
+class MaterialPanel;
 class ScenarioEditor;
 class ScenarioPanel;
 class SessionReviewWindow;
@@ -84,6 +91,23 @@ class MainWindow : public QMainWindow {
   bool applyIntegratorSettings(const IntegratorSettings& settings);
   bool changingIntegrator() const { return changingIntegrator_; }
 
+  // The Material panel's tissue for the parenchyma (a scenario's lesions follow as its file
+  // describes), applied as an integrator change is: built on a worker, then the liver runs on
+  // from where it is, cut or not. An entry made while one is applied is applied after it (only
+  // the newest). tissueChangeFinished tells whether it was applied; a bad value is refused in
+  // the panel and the tissue in use stays. A scenario's sessions recorded afterwards store the
+  // scenario with this tissue. False while a scene or an integrator change is being built.
+  bool applyTissue(const TissueSpec& tissue);
+  bool changingTissue() const { return changingTissue_; }
+  MaterialPanel* materialPanel() const { return materialPanel_; }
+
+  // Instructor mode: the Material panel edits the tissue, and the scenario editor and the review
+  // of every trainee's sessions are offered. Trainee mode (the default) shows the tissue
+  // read-only and offers the trainee's own sessions. Remembered (Settings menu, toolbar).
+  void setInstructorMode(bool on);
+  bool instructorMode() const { return instructorMode_; }
+  QToolBar* mainToolBar() const { return toolBar_; }
+
   // Opens a scenario file. It is read and validated at once: a bad file is refused with its
   // errors (field, value, what is expected) in the Scenario panel and a message box, and the
   // running scene stays. Otherwise its scene is built on a worker thread (meshing takes seconds)
@@ -94,6 +118,10 @@ class MainWindow : public QMainWindow {
   // Runs a scenario from the instructor's editor ("Try it") as openScenario() runs a file's:
   // `file` is where it is saved (its organ file is named relative to that folder), or empty.
   bool tryScenario(const Scenario& scenario, const QString& file);
+  // Stops building the scene being opened (the status bar's Cancel): meshing stops at its next
+  // attempt and anything already built is dropped; the running scene goes on and
+  // scenarioOpenFinished(false) follows, without an error.
+  void cancelSceneBuild();
   // The instructor's scenario editor (File menu), on the scenario shown if it has a file, else
   // on a new one; its "Try it" runs here.
   ScenarioEditor* openScenarioEditor();
@@ -149,11 +177,18 @@ class MainWindow : public QMainWindow {
   // sessionsProblem()), after its end, on a worker.
   void sessionMetricsStored(qint64 session, bool stored);
   void integratorChangeFinished(bool applied);
+  void tissueChangeFinished(bool applied);
   void scenarioOpenFinished(bool opened);
 
+ protected:
+  void closeEvent(QCloseEvent* event) override;  // remembers the window's layout
+
  private:
-  // A panel docked on the right, movable and floatable.
-  void addPanelDock(const QString& title, const char* name, QWidget* panel);
+  // A panel docked on the right, movable, floatable and closable (View ▸ Panels).
+  QDockWidget* addPanelDock(const QString& title, const char* name, QWidget* panel);
+  // The window's size, docks and toolbar as the user left them (saveState).
+  void restoreLayout();
+  static constexpr int kLayoutVersion = 1;
   // Runs `model` of `setup` from rest, in place of the scene shown (if any): a new simulation,
   // liver picture and tool interaction; the device in use stays attached.
   void installScene(SceneSetup setup, std::shared_ptr<const SimModel> model);
@@ -192,8 +227,23 @@ class MainWindow : public QMainWindow {
   void endRecording();           // (detachDevice stops servo_ first: its last frames are kept)
   void recordToolChoice();       // the Tool panel's tool as a session event
   void openOmni();               // looks for the Phantom Omni: omni_, or why not in omniProblem_
-  void finishIntegratorChange(const IntegratorSettings& settings,
-                              std::shared_ptr<const SimModel> model, const QString& error);
+  // A change of the running model, built on modelBuilder_, then run on from the liver's state:
+  // an integrator setting (Accuracy panel) or a tissue (Material panel).
+  struct ModelChange {
+    std::optional<IntegratorSettings> integrator;
+    std::optional<TissueSpec> tissue;
+  };
+  struct ModelChangeBuilt {
+    std::shared_ptr<const SimModel> model;       // to run now
+    std::shared_ptr<const SimModel> rest_model;  // the scene's uncut model with the change
+  };
+  void startModelChange(ModelChange change, std::function<ModelChangeBuilt()> build);
+  void finishModelChange(const ModelChange& change, const ModelChangeBuilt& built,
+                         const QString& error);
+  void applyPendingTissue();
+  bool busyBuilding() const;  // a scene, an integrator or a tissue
+  // The scenario running, or free practice's tissue and effects as a scenario without lesions.
+  Scenario describedScenario() const;
   void showNewestSnapshot();
   void updateStatus();
   QString accuracyStatus(const RealtimeStats& stats) const;
@@ -204,6 +254,8 @@ class MainWindow : public QMainWindow {
   ToolModels toolModels_;  // read once; every scene draws its tools with them
   bool seeThrough_ = false;
   QAction* seeThroughAction_ = nullptr;
+  bool ambientOcclusion_ = false;  // View menu, remembered; off by default (its frame-rate cost)
+  QAction* ambientOcclusionAction_ = nullptr;
   std::shared_ptr<const SimModel> sceneModel_;  // setup_'s model, uncut, with the integrator in use
   std::unique_ptr<RealtimeSimulation> simulation_;
   std::unique_ptr<LiverScene> scene_;
@@ -212,9 +264,19 @@ class MainWindow : public QMainWindow {
   ToolPanel* toolPanel_ = nullptr;
   DevicePanel* devicePanel_ = nullptr;
   ScenarioPanel* scenarioPanel_ = nullptr;
+  MaterialPanel* materialPanel_ = nullptr;
+  QToolBar* toolBar_ = nullptr;
+  QMenu* panelsMenu_ = nullptr;
+  QAction* instructorModeAction_ = nullptr;
+  QAction* scenarioEditorAction_ = nullptr;
+  QAction* reviewSessionsAction_ = nullptr;
+  bool instructorMode_ = false;
   QMenu* recentMenu_ = nullptr;
   QPointer<CalibrationDialog> calibration_;
   QLabel* statusLabel_ = nullptr;
+  QProgressBar* buildProgress_ = nullptr;  // while a scene is built, with cancelBuild_
+  QPushButton* cancelBuild_ = nullptr;
+  std::shared_ptr<std::atomic<bool>> buildCancelled_;  // of the build under way
   QTimer frameTimer_;
   QTimer statusTimer_;
 
@@ -274,6 +336,9 @@ class MainWindow : public QMainWindow {
   // model is being built) or the scene of a scenario being opened.
   std::thread modelBuilder_;
   bool changingIntegrator_ = false;
+  bool changingTissue_ = false;
+  std::optional<TissueSpec> pendingTissue_;
+  bool tissueChangedInFreePractice_ = false;  // its sessions cannot be replayed then
   bool openingScenario_ = false;
 };
 

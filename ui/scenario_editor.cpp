@@ -1,6 +1,7 @@
 #include "scenario_editor.h"
 
 #include "accuracy_panel.h"
+#include "parameter_spin_box.h"
 #include "recent_scenarios.h"
 #include "render/liver_scene.h"
 #include "render/scenario_overlay.h"
@@ -89,31 +90,6 @@ enum MergeKey {
 };
 
 constexpr double kMetresPerMm = 1e-3;
-
-QDoubleSpinBox* spinBox(const char* name, double min, double max, int decimals,
-                        const QString& suffix, const QString& tip) {
-  auto* box = new QDoubleSpinBox;
-  box->setObjectName(name);
-  box->setRange(min, max);
-  box->setDecimals(decimals);
-  box->setSuffix(suffix);
-  box->setToolTip(tip);
-  box->setKeyboardTracking(false);  // an edit when the value is entered, not at each key
-  return box;
-}
-
-// A spin box over a documented parameter range (parameter_ranges.h) shown in `scale` × its unit.
-QDoubleSpinBox* rangeSpinBox(std::string_view key, double scale, const QString& suffix,
-                             int decimals) {
-  const ParameterRange& range = parameter_range(key);
-  return spinBox("", range.min / scale, range.max / scale, decimals, suffix,
-                 QString::fromUtf8("%1: %2 to %3%4. %5")
-                     .arg(QString::fromUtf8(range.label.data(), int(range.label.size())))
-                     .arg(range.min / scale)
-                     .arg(range.max / scale)
-                     .arg(suffix)
-                     .arg(QString::fromUtf8(range.why.data(), int(range.why.size()))));
-}
 
 QDoubleSpinBox* lengthSpinBox(double min_mm, double max_mm, const QString& tip) {
   return spinBox("", min_mm, max_mm, 1, " mm", tip);

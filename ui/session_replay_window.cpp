@@ -4,12 +4,14 @@
 #include "render/liver_scene.h"
 #include "vtk_viewport.h"
 
+#include "liversim/core/scenario.h"
 #include "liversim/storage/sqlite_session_store.h"
 
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkRenderer.h>
 #include <QChart>
 #include <QChartView>
+#include <QCheckBox>
 #include <QHBoxLayout>
 #include <QLabel>
 #include <QLineSeries>
@@ -52,6 +54,15 @@ SessionReplayWindow::SessionReplayWindow(const QString& databaseFile, std::int64
   connect(slider_, &QSlider::valueChanged, this, [this](int ms) { seek(ms / 1000.0); });
   timeLabel_ = new QLabel(this);
   timeLabel_->setObjectName("replayTime");
+  seeThrough_ = new QCheckBox(tr("See-through"), this);
+  seeThrough_->setObjectName("replaySeeThrough");
+  seeThrough_->setToolTip(
+      tr("Show the liver semi-transparent, with the scenario's lesions inside"));
+  connect(seeThrough_, &QCheckBox::toggled, this, [this](bool on) {
+    if (!scene_) return;  // finishBuilding applies it
+    scene_->set_opacity(on ? kSeeThroughOpacity : 1.0);
+    viewport_->scheduleRender();
+  });
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("replayStatus");
   statusLabel_->setWordWrap(true);
@@ -72,6 +83,7 @@ SessionReplayWindow::SessionReplayWindow(const QString& databaseFile, std::int64
   controls->addWidget(playButton_);
   controls->addWidget(slider_, 1);
   controls->addWidget(timeLabel_);
+  controls->addWidget(seeThrough_);
   auto* layout = new QVBoxLayout(this);
   layout->addWidget(viewport_, 3);
   layout->addLayout(controls);
@@ -93,6 +105,9 @@ SessionReplayWindow::SessionReplayWindow(const QString& databaseFile, std::int64
     setup = store.replay_setup(session);
     inputs = store.inputs(session);
     scenario_text = store.scenario_text(session);
+    // A session of free practice has no scenario, and so no lesions.
+    if (const ScenarioReading reading = read_scenario(scenario_text); reading.scenario)
+      lesions_ = visible_lesions(*reading.scenario);
     for (const SessionEvent& event : store.events(session))
       if (event.kind == SessionEventKind::integrator_changed && limitNote_.isEmpty())
         limitNote_ =
@@ -153,6 +168,8 @@ void SessionReplayWindow::finishBuilding(std::shared_ptr<SessionReplay> replay,
   replay_ = std::move(replay);  // the worker is done with it
   scene_ = std::make_unique<LiverScene>(replay_->scene().mesh, replay_->scene().visual);
   scene_->set_tool_models(load_tool_models());
+  if (!lesions_.empty()) scene_->show_lesions(lesions_);
+  scene_->set_opacity(seeThrough_->isChecked() ? kSeeThroughOpacity : 1.0);
   viewport_->renderWindow()->AddRenderer(scene_->renderer());
   scene_->reset_camera(viewport_->height() > 0
                            ? static_cast<double>(viewport_->width()) / viewport_->height()
@@ -184,6 +201,14 @@ double SessionReplayWindow::positionS() const {
 
 bool SessionReplayWindow::seeking() const {
   return replay_ && seekPending_;
+}
+
+void SessionReplayWindow::setSeeThrough(bool on) {
+  seeThrough_->setChecked(on);  // its toggled signal shows it
+}
+
+bool SessionReplayWindow::seeThrough() const {
+  return seeThrough_->isChecked();
 }
 
 void SessionReplayWindow::play() {

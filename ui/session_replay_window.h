@@ -3,7 +3,8 @@
 // replayed cycle by cycle on the session's timeline (core/session_replay.h), so the liver goes
 // through the states the trainee saw, cuts included. Play, pause and seek (a seek back replays
 // from the start); the session's recorded force is plotted with a cursor at the replayed time,
-// and the replayed force on the tool beside it.
+// and the replayed force on the tool beside it. The liver can be seen through, with the lesions
+// of the session's scenario inside it.
 
 #include "liversim/core/session_log.h"
 #include "liversim/core/session_replay.h"
@@ -16,7 +17,9 @@
 #include <cstdint>
 #include <memory>
 #include <thread>
+#include <vector>
 
+class QCheckBox;
 class QChartView;
 class QLabel;
 class QLineSeries;
@@ -27,6 +30,7 @@ namespace liversim {
 
 class LiverScene;
 class VtkViewport;
+struct LesionShape;
 
 class SessionReplayWindow : public QWidget {
   Q_OBJECT
@@ -53,8 +57,13 @@ class SessionReplayWindow : public QWidget {
   void pause();
   void seek(double seconds);
 
+  // See-through: the liver at kSeeThroughOpacity, its scenario's visible lesions inside.
+  void setSeeThrough(bool on);
+  bool seeThrough() const;
+
   SessionReplay* replay() const { return replay_.get(); }
   VtkViewport* viewport() const { return viewport_; }
+  const LiverScene* scene() const { return scene_.get(); }  // null until ready()
   int recordedForcePointCount() const;
   int replayedForcePointCount() const;
 
@@ -77,7 +86,9 @@ class SessionReplayWindow : public QWidget {
   bool seekPending_ = false;                    // a seek the replay has not caught up with yet
   std::shared_ptr<const SimModel> shownModel_;  // the model the scene shows
   std::unique_ptr<LiverScene> scene_;
+  std::vector<LesionShape> lesions_;  // the scenario's visible ones
   VtkViewport* viewport_ = nullptr;
+  QCheckBox* seeThrough_ = nullptr;
   QPushButton* playButton_ = nullptr;
   QSlider* slider_ = nullptr;
   QLabel* timeLabel_ = nullptr;

@@ -202,14 +202,19 @@ TEST(Cutting, PartialCutIsCleanOnTheSweptPlaneAndLeavesTheCrackFrontJoined) {
   EXPECT_NEAR(total_volume_m3(after), total_volume_m3(model), 1e-12 * total_volume_m3(model));
 }
 
+// Horizontal sweep at z = kTopCutZ through the whole block: the top 8 mm come off.
+constexpr double kTopCutZ = 0.032;
+CutResult cut_the_top_off(const SimModel& model) {
+  const double z = kTopCutZ;
+  return cut_tissue(model, make_rest_state(model),
+                    sweep_of({-0.01, -0.01, z}, {-0.01, 0.06, z}, {0.08, 0.0, 0.0}),
+                    cut_anything());
+}
+
 TEST(Cutting, CuttingAPieceFreeTakesItOutAndMeasuresTheResectedVolume) {
   const SimModel model = block_model();
-  const SimState state = make_rest_state(model);
-  // Horizontal sweep at z = 0.032 through the whole block: the top 8 mm come off.
-  const double z = 0.032;
-  const CutResult cut =
-      cut_tissue(model, state, sweep_of({-0.01, -0.01, z}, {-0.01, 0.06, z}, {0.08, 0.0, 0.0}),
-                 cut_anything());
+  const double z = kTopCutZ;
+  const CutResult cut = cut_the_top_off(model);
   ASSERT_TRUE(cut.cut());
   const double expected_volume = 0.06 * 0.05 * (0.04 - z);
   EXPECT_NEAR(cut.report.resected_volume_m3, expected_volume, 1e-9 * expected_volume);
@@ -227,12 +232,7 @@ TEST(Cutting, CuttingAPieceFreeTakesItOutAndMeasuresTheResectedVolume) {
 }
 
 TEST(Cutting, ANewDensityScalesTheMassesACutModelKept) {
-  const SimModel model = block_model();
-  const SimState state = make_rest_state(model);
-  const double z = 0.032;
-  const CutResult cut =
-      cut_tissue(model, state, sweep_of({-0.01, -0.01, z}, {-0.01, 0.06, z}, {0.08, 0.0, 0.0}),
-                 cut_anything());
+  const CutResult cut = cut_the_top_off(block_model());
   ASSERT_TRUE(cut.cut());
   // The same material again first: the cut's own frequency is a local estimate, this one the
   // whole model's power iteration.

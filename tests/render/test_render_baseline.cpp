@@ -10,11 +10,14 @@
 // output it names, and copy that over tests/baselines/default_scene.png.
 #include <gtest/gtest.h>
 
+#include <vtkCamera.h>
 #include <vtkImageData.h>
 #include <vtkImageDifference.h>
 #include <vtkNew.h>
 #include <vtkPNGReader.h>
 #include <vtkPNGWriter.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
 #include <vtkSmartPointer.h>
 
 #include <Eigen/Geometry>
@@ -26,6 +29,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "liversim/core/cutting.h"
 #include "liversim/core/data_paths.h"
@@ -56,7 +60,9 @@ const fs::path kOutputDir = LIVERSIM_TEST_OUTPUT_DIR;
 // kPixelThreshold: VTK's default of 105 (of 255) is meant for comparing different graphics
 // systems and is blind here: a 10 mm bump in the liver or its colour 20 % darker still give 0.
 // 16 (6 %) catches a 3 mm bump (0.58) and a 10 % darker colour (18) while forgiving a camera
-// turned by 1 degree (0.001), measured against this baseline.
+// turned by 1 degree (0.001), measured against the flat-coloured liver's baseline; against the
+// mottled liver's: the 3 mm bump 0.39, the organ's pixels made 10 % darker 2.4, the camera turned
+// by 1 degree 0.
 constexpr int kPixelThreshold = 16;
 // Largest accepted thresholded error: vtkRegressionTestImage's default.
 constexpr double kMaxThresholdedError = 0.15;
@@ -177,6 +183,17 @@ class RenderBaselineTest : public ::testing::Test {
     return file;
   }
 
+  // Where `point_m` falls in the screenshots' pixels (from the bottom-left). The scene's renderer
+  // converts only while in a window of their size: screenshot() gives it back without one.
+  static Eigen::Vector2d screenshotPixel(LiverScene& scene, const Eigen::Vector3d& point_m) {
+    vtkNew<vtkRenderWindow> window;  // never drawn, so never opened
+    window->SetSize(kWidth, kHeight);
+    window->AddRenderer(scene.renderer());
+    const Eigen::Vector2d pixel = scene.world_to_display(point_m);
+    window->RemoveRenderer(scene.renderer());
+    return pixel;
+  }
+
   // The picture `output` against tests/baselines/NAME.png; on failure the rendered picture and
   // the difference stay in the output folder, named in the message. On success `output` is
   // removed.
@@ -266,6 +283,17 @@ SceneSetup wedgeResectionScene(Scenario& scenario) {
   return build_scene(scenario, file.parent_path());
 }
 
+// A lesion shows through in its own colour: pale yellow, which neither the liver (red) nor the
+// background (grey-blue) has.
+long yellowPixels(const fs::path& file) {
+  const auto image = readPng(file);
+  const auto* p = static_cast<const unsigned char*>(image->GetScalarPointer());
+  long count = 0;
+  for (vtkIdType i = 0; i < image->GetNumberOfPoints(); ++i, p += 3)
+    count += p[0] > 120 && p[1] > 90 && p[2] < 0.8 * p[1] && p[1] > 0.6 * p[0];
+  return count;
+}
+
 TEST_F(RenderBaselineTest, SeeThroughShowsTheLesionInsideTheLiver) {
   Scenario scenario;
   const SceneSetup setup = wedgeResectionScene(scenario);
@@ -278,16 +306,7 @@ TEST_F(RenderBaselineTest, SeeThroughShowsTheLesionInsideTheLiver) {
   // Every triangle of the lesion's sphere (24 × 16 facets) lies inside the liver: all held.
   EXPECT_EQ(scene.shown_lesion_triangle_count(), 2u * 24u * 15u);
   const fs::path with = screenshot(scene, "see_through_lesion");
-  // The lesion (radius 8 mm) shows through in its own colour: pale yellow, which neither the
-  // liver (red) nor the background (grey-blue) has.
-  const auto yellowPixels = [](const fs::path& file) {
-    const auto image = readPng(file);
-    const auto* p = static_cast<const unsigned char*>(image->GetScalarPointer());
-    long count = 0;
-    for (vtkIdType i = 0; i < image->GetNumberOfPoints(); ++i, p += 3)
-      count += p[0] > 120 && p[1] > 90 && p[2] < 0.8 * p[1] && p[1] > 0.6 * p[0];
-    return count;
-  };
+  // The lesion (radius 8 mm) in its own colour.
   EXPECT_EQ(yellowPixels(without), 0);
   // Its disc seen through the liver: the liver, ~280 mm across, spans about 480 px, so the
   // lesion's 16 mm are about 27 px across; at least half its disc's area.
@@ -363,7 +382,7 @@ TEST_F(RenderBaselineTest, ToolModelsAreReadAndDrawnWhereTheirCapsulesAre) {
   for (int jaw = 1; jaw <= 2; ++jaw) {
     // Two thirds along each jaw, where both drawings have steel.
     const Eigen::Vector3d point = parts[jaw].a_m + (2.0 / 3.0) * (parts[jaw].b_m - parts[jaw].a_m);
-    const Eigen::Vector2d pixel = scene.world_to_display(point);
+    const Eigen::Vector2d pixel = screenshotPixel(scene, point);
     for (const auto& image : {a, b}) {
       const auto* p =
           static_cast<unsigned char*>(image->GetScalarPointer(int(pixel.x()), int(pixel.y()), 0));
@@ -381,6 +400,216 @@ TEST_F(RenderBaselineTest, ToolModelsAreReadAndDrawnWhereTheirCapsulesAre) {
   EXPECT_GT(changedPixels(modelled, moved), 100) << "the model did not follow the tool";
   fs::remove(moved);
   expectMatchesBaseline(modelled, "forceps_model");
+}
+
+// The organ's pixels: red well above blue, which neither the grey-blue background nor the steel
+// has.
+bool organPixel(const unsigned char* p) {
+  return p[0] >= 64 && p[0] > 2 * p[2];
+}
+
+// A pixel's hue along the liver's palette: green over red, each less blue, in levels of 255. White
+// light scales red, green and blue alike, and a white highlight adds the same to each: neither
+// changes it (until red saturates). What changes it is the surface's own colour.
+double paletteHue(const unsigned char* p) {
+  return 255.0 * (p[1] - p[2]) / (p[0] - p[2]);
+}
+
+double paletteHue(const double* colour) {
+  return 255.0 * (colour[1] - colour[2]) / (colour[0] - colour[2]);
+}
+
+// Rounding each channel to a level moves the difference above and the one below by a level each at
+// most, hence paletteHue by at most 255 * (1 + 0.3) / (red - blue) levels (the ratio stays below
+// 0.3): 5.2 levels on the pixels it is measured on, whose red exceeds their blue by 64 or more.
+constexpr int kHueMinRedOverBlue = 64;
+constexpr double kHueRounding = 255.0 * 1.3 / kHueMinRedOverBlue;
+
+double quantile(const std::vector<double>& sorted, double q) {
+  return sorted[static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1))];
+}
+
+TEST_F(RenderBaselineTest, TheLiverIsMottledAndHasHighlights) {
+  const fs::path file = render("mottled");
+  const auto image = readPng(file);
+  ASSERT_TRUE(image);
+  std::vector<double> hue;
+  long organ = 0, highlight = 0;
+  const auto* p = static_cast<const unsigned char*>(image->GetScalarPointer());
+  for (vtkIdType i = 0; i < image->GetNumberOfPoints(); ++i, p += 3) {
+    if (!organPixel(p)) continue;
+    ++organ;
+    // Highlights: white added to the red-brown brings green nearer red than the palette's
+    // lightest colour has it, by more than the rounding (2.8 levels at red >= 64).
+    highlight += 255.0 * p[1] / p[0] > 255.0 * kTissueLightColour[1] / kTissueLightColour[0] + 10.0;
+    if (p[0] - p[2] >= kHueMinRedOverBlue && p[0] < 250) hue.push_back(paletteHue(p));
+  }
+  std::sort(hue.begin(), hue.end());
+  // The organ, ~480 px across, covers well over 50 000 of the 800 x 600 pixels; most of it is
+  // bright enough to measure.
+  ASSERT_GT(organ, 50'000);
+  ASSERT_GT(hue.size(), static_cast<std::size_t>(organ / 2));
+  const double low = quantile(hue, 0.1), high = quantile(hue, 0.9);
+  std::cout << "organ pixels: " << organ << ", " << hue.size() << " measured; hue 10th to 90th "
+            << "percentile: " << low << " to " << high << " (palette "
+            << paletteHue(kTissueDarkColour) << " to " << paletteHue(kTissueLightColour)
+            << "); highlight pixels: " << highlight << '\n';
+  // One flat colour would spread the hue by the rounding alone, 2 x 5.2 levels at the most. The
+  // palette spans 39 levels: the mottle's middle 80 % must spread over more than one flat colour
+  // can...
+  EXPECT_GT(high - low, 2.0 * kHueRounding) << "the organ shows one flat colour; see " << file;
+  // ...within the palette (and the rounding).
+  EXPECT_GE(low, paletteHue(kTissueDarkColour) - kHueRounding);
+  EXPECT_LE(high, paletteHue(kTissueLightColour) + kHueRounding);
+  // A moist organ under a headlight and a lamp shows highlights: at least 200 pixels, a patch
+  // ~16 px across.
+  EXPECT_GT(highlight, 200) << "no specular highlights; see " << file;
+  if (!HasFailure()) fs::remove(file);
+}
+
+// The pattern belongs to the tissue: the organ and the camera moved by the same 37 mm (the
+// mottle's patches are 25 to 50 mm) give the same picture, which a pattern fixed in space would
+// not. Only the rasterisation of the organ's outline may change with the rounding.
+TEST_F(RenderBaselineTest, TheMottlingMovesWithTheTissue) {
+  const SceneSetup setup = default_scene();
+  LiverScene scene(setup.mesh, setup.visual);
+  const fs::path before = screenshot(scene, "mottle_before");
+  const Eigen::Vector3d shift(0.03, -0.02, 0.01);
+  NodeArray moved = setup.mesh.rest_position_m;
+  for (std::size_t i = 0; i < moved.size(); ++i) moved.set(i, moved.at(i) + shift);
+  scene.update_positions(moved);
+  vtkCamera* camera = scene.renderer()->GetActiveCamera();
+  double position[3], focal[3];
+  camera->GetPosition(position);
+  camera->GetFocalPoint(focal);
+  camera->SetPosition(position[0] + shift.x(), position[1] + shift.y(), position[2] + shift.z());
+  camera->SetFocalPoint(focal[0] + shift.x(), focal[1] + shift.y(), focal[2] + shift.z());
+  const fs::path after = screenshot(scene, "mottle_after");
+  const auto a = readPng(before);
+  const auto b = readPng(after);
+  ASSERT_TRUE(a && b);
+  // Pixels that differ by more than the rounding of a level or two, against the outline's length
+  // (organ pixels beside a non-organ pixel).
+  const int width = a->GetDimensions()[0], height = a->GetDimensions()[1];
+  const auto* pa = static_cast<const unsigned char*>(a->GetScalarPointer());
+  const auto* pb = static_cast<const unsigned char*>(b->GetScalarPointer());
+  long differing = 0, outline = 0;
+  for (int y = 1; y + 1 < height; ++y)
+    for (int x = 1; x + 1 < width; ++x) {
+      const auto* p = pa + 3 * (y * width + x);
+      const auto* q = pb + 3 * (y * width + x);
+      bool differs = false;
+      for (int c = 0; c < 3; ++c) differs |= std::abs(p[c] - q[c]) > 2;
+      differing += differs;
+      if (organPixel(p) && !(organPixel(p - 3) && organPixel(p + 3) && organPixel(p - 3 * width) &&
+                             organPixel(p + 3 * width)))
+        ++outline;
+    }
+  std::cout << "moved with the camera: " << differing << " pixels differ by more than 2 levels; "
+            << "outline " << outline << " pixels\n";
+  EXPECT_GT(outline, 1000);
+  EXPECT_LT(differing, outline) << "the pattern did not move with the tissue; see " << before
+                                << " and " << after;
+  if (!HasFailure()) {
+    fs::remove(before);
+    fs::remove(after);
+  }
+}
+
+// Luminance of an 8-bit RGB pixel (Rec. 601 weights), in levels.
+double luminance(const unsigned char* p) {
+  return 0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2];
+}
+
+// A crease made on purpose: the middle of the anterior face pressed 15 mm in over about a
+// centimetre (a Gaussian pit of width 6 mm), as a probe's tip pressing the liver leaves it. (A
+// shallow dimple, whose walls rise gently, leaves most of the sky open: little occlusion.)
+TEST_F(RenderBaselineTest, AmbientOcclusionDarkensCreases) {
+  const SceneSetup setup = default_scene();
+  const Eigen::Vector3d centre = setup.mesh.rest_position_m.at(anterior_marked_node(setup.mesh));
+  constexpr double kDepth_m = 0.015, kWidth_m = 0.006;
+  const NodeArray dented =
+      bumped(setup.mesh.rest_position_m, centre, Eigen::Vector3d(0.0, 0.0, -kDepth_m), kWidth_m);
+  LiverScene scene(setup.mesh, setup.visual);
+  scene.update_positions(dented);
+  EXPECT_FALSE(scene.ambient_occlusion());
+  const fs::path plain = screenshot(scene, "occlusion_off");
+  scene.set_ambient_occlusion(true);
+  EXPECT_TRUE(scene.ambient_occlusion());
+  const fs::path occluded = screenshot(scene, "occlusion_on");
+  const fs::path again = screenshot(scene, "occlusion_on_again");
+  const auto a = readPng(plain);
+  const auto b = readPng(occluded);
+  ASSERT_TRUE(a && b);
+  // The same picture twice: the pass's sample kernel and noise are fixed, not drawn anew.
+  EXPECT_EQ(differingPixels(b, readPng(again)).count, 0) << "see " << occluded << " and " << again;
+
+  // The dimple's floor on the screen: within one width of its centre, pressed in.
+  const Eigen::Vector2d floor_px = screenshotPixel(scene, centre - Eigen::Vector3d(0, 0, kDepth_m));
+  const double floor_radius_px = (screenshotPixel(scene, centre + Eigen::Vector3d(kWidth_m, 0, 0)) -
+                                  screenshotPixel(scene, centre))
+                                     .norm();
+  const int width = a->GetDimensions()[0];
+  const auto* pa = static_cast<const unsigned char*>(a->GetScalarPointer());
+  const auto* pb = static_cast<const unsigned char*>(b->GetScalarPointer());
+  long organ = 0, brighter = 0, floor = 0;
+  double drop_floor = 0.0, drop_elsewhere = 0.0;
+  for (vtkIdType i = 0; i < a->GetNumberOfPoints(); ++i, pa += 3, pb += 3) {
+    if (!organPixel(pa)) continue;
+    ++organ;
+    const double drop = luminance(pa) - luminance(pb);
+    // Occlusion only ever takes light away; 1 level for rounding.
+    brighter += drop < -1.0;
+    const Eigen::Vector2d pixel(static_cast<double>(i % width), static_cast<double>(i / width));
+    if ((pixel - floor_px).norm() < floor_radius_px) {
+      ++floor;
+      drop_floor += drop;
+    } else {
+      drop_elsewhere += drop;
+    }
+  }
+  ASSERT_GT(organ, 50'000);
+  ASSERT_GT(floor, 100) << "the dimple is not in the picture";
+  drop_floor /= floor;
+  drop_elsewhere /= organ - floor;
+  std::cout << "ambient occlusion: the dimple's floor (" << floor << " px) darker by " << drop_floor
+            << " levels, the rest of the organ by " << drop_elsewhere << "; " << brighter
+            << " pixels brighter\n";
+  EXPECT_EQ(brighter, 0);
+  // Visibly darker in the crease: by more than the baselines' pixel threshold, 16 levels...
+  EXPECT_GT(drop_floor, 16.0) << "see " << plain << " and " << occluded;
+  // ...and more than 4 times as much as the organ's open, mostly convex surface: occlusion, not
+  // a darker picture.
+  EXPECT_GT(drop_floor, 4.0 * drop_elsewhere);
+  scene.set_ambient_occlusion(false);
+  EXPECT_FALSE(scene.ambient_occlusion());
+  const fs::path off_again = screenshot(scene, "occlusion_off_again");
+  EXPECT_EQ(changedPixels(plain, off_again), 0) << "turning it off leaves the picture changed";
+  if (!HasFailure())
+    for (const fs::path& file : {plain, occluded, again, off_again}) fs::remove(file);
+}
+
+TEST_F(RenderBaselineTest, AmbientOcclusionKeepsTheSeeThroughView) {
+  Scenario scenario;
+  const SceneSetup setup = wedgeResectionScene(scenario);
+  LiverScene scene(setup.mesh, setup.visual);
+  scene.show_lesions(visible_lesions(scenario));
+  scene.set_opacity(kSeeThroughOpacity);
+  const fs::path plain = screenshot(scene, "see_through_occlusion_off");
+  scene.set_ambient_occlusion(true);
+  const fs::path occluded = screenshot(scene, "see_through_occlusion_on");
+  const long lesion_plain = yellowPixels(plain), lesion_occluded = yellowPixels(occluded);
+  std::cout << "lesion pixels seen through: " << lesion_plain << " without occlusion, "
+            << lesion_occluded << " with\n";
+  // The lesion still shows through, as in SeeThroughShowsTheLesionInsideTheLiver (at least half
+  // its disc, 250 px), and the liver around it is still seen through: its picture is not the
+  // solid organ's.
+  EXPECT_GT(lesion_occluded, 250) << "see " << occluded;
+  scene.set_opacity(1.0);
+  const fs::path solid = screenshot(scene, "solid_occlusion_on");
+  EXPECT_GT(changedPixels(solid, occluded), 50'000) << "see " << solid << " and " << occluded;
+  if (!HasFailure())
+    for (const fs::path& file : {plain, occluded, solid}) fs::remove(file);
 }
 
 }  // namespace

@@ -29,6 +29,7 @@
 #include "liversim/core/surface.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
+#include "palpation_points.h"
 #include "scenario_panel.h"
 #include "session_review_window.h"
 #include "tool_panel.h"
@@ -331,15 +332,8 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   const LesionSpec& lesion = scenario.lesions.at(0);
   const Eigen::Vector3d centre_m =
       Eigen::Vector3d(lesion.centre_mm[0], lesion.centre_mm[1], lesion.centre_mm[2]) * 1e-3;
-  // The surface node nearest the (spherical) lesion, and a point 10 mm outside it: the probe's
-  // ball (3 mm) clear of the curved surface around.
   const SimModel& model = *snapshot().model;
-  const BoundarySurface surface = boundary_surface(model);
-  Eigen::Vector3d nearest = model.rest_position_m.at(surface.nodes.front());
-  for (NodeIndex n : surface.nodes)
-    if ((model.rest_position_m.at(n) - centre_m).norm() < (nearest - centre_m).norm())
-      nearest = model.rest_position_m.at(n);
-  const Eigen::Vector3d hover_mm = (nearest + 0.010 * (nearest - centre_m).normalized()) * 1e3;
+  const Eigen::Vector3d hover_mm = hover_over_lesion_mm(model, centre_m);
   const QString file = writeTrajectory({{0.0, hover_mm, 0}, {600.0, hover_mm, 0}});
   window_->toolPanel()->setTool(ToolKind::probe);
   ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));

@@ -436,17 +436,25 @@ TEST_F(MainWindowTest, TheScalpelDrawnAcrossTheLiverCutsIt) {
   pictures_.emplace_back("before", before);
   // Pressed in, the blade breaks into the tissue once the stress under it reaches the cutting
   // stress (however slowly this machine simulates); then drawn across the liver, a long stroke
-  // that passes whole elements.
-  const QPoint across(160, 0);
-  sendMouse(QEvent::MouseButtonPress, *start - across / 2, Qt::LeftButton, Qt::LeftButton);
+  // that passes whole elements: 50 mm, whatever the viewport's size makes of it in pixels. It is
+  // pressed in at the middle of the liver, where it is thickest: 30 mm to the left, on the slope
+  // of the anterior face, the blade only dents the tissue (see the session note).
+  const std::optional<ScenePick> centre = pickAt(*start);
+  ASSERT_TRUE(centre);
+  const QPoint centreDisplay = toDisplay(*start);
+  const double metresPer100Px = (window_->scene().display_to_world(
+                                     centreDisplay.x() + 100, centreDisplay.y(), centre->point_m) -
+                                 centre->point_m)
+                                    .norm();
+  const QPoint across(static_cast<int>(std::lround(100.0 * 0.050 / metresPer100Px)), 0);
+  sendMouse(QEvent::MouseButtonPress, *start, Qt::LeftButton, Qt::LeftButton);
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().blade_cutting; },
                               kSimulatedTimeTimeoutMs))
       << "the pressed blade did not break into the tissue";
   // Each move after some simulated time, so that a slow machine sees the same stroke.
   for (int step = 1; step <= kDragMoves; ++step) {
     ASSERT_TRUE(waitSimulated(0.02));
-    sendMouse(QEvent::MouseMove, *start - across / 2 + across * step / kDragMoves, Qt::NoButton,
-              Qt::LeftButton);
+    sendMouse(QEvent::MouseMove, *start + across * step / kDragMoves, Qt::NoButton, Qt::LeftButton);
   }
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().topology_version > 0; },
                               kSimulatedTimeTimeoutMs))
@@ -455,7 +463,7 @@ TEST_F(MainWindowTest, TheScalpelDrawnAcrossTheLiverCutsIt) {
       << window_->simulation().snapshot().blade_cutting << ")";
   const QImage cutting = window_->viewport()->grabRendering();
   pictures_.emplace_back("cutting", cutting);
-  release(*start + across / 2);
+  release(*start + across);
   ASSERT_TRUE(waitSimulated(0.1));
   const SimulationSnapshot after = window_->simulation().snapshot();
   EXPECT_GT(after.model->node_count, nodes_before) << "no node copies along the cut";

@@ -10,6 +10,7 @@
 #include <QFileInfo>
 #include <QMenu>
 #include <QMessageBox>
+#include <QProgressBar>
 #include <QPushButton>
 #include <QSettings>
 #include <QSignalSpy>
@@ -189,6 +190,29 @@ TEST_F(ScenarioWindowTest, AScenarioOfASurfaceModelIsMeshedShowingProgressAndRun
   EXPECT_TRUE(window_->scenarioPanel()->problemText().contains("not closed"))
       << window_->scenarioPanel()->problemText().toStdString();
   EXPECT_EQ(window_->simulation().snapshot().model->tet_count, tets) << "the scene was replaced";
+
+  // Meshing shows its progress and can be cancelled: the scene running goes on, without an error.
+  auto* progress = window_->findChild<QProgressBar*>("buildProgress");
+  auto* cancel = window_->findChild<QPushButton*>("cancelBuild");
+  ASSERT_TRUE(progress && cancel);
+  EXPECT_TRUE(progress->isHidden() && cancel->isHidden());
+  const auto running = window_->simulation().snapshot().model;
+  const QString problemBefore = window_->scenarioPanel()->problemText();
+  bool progressShown = false;
+  const auto onMessage = QObject::connect(
+      window_->statusBar(), &QStatusBar::messageChanged, [&](const QString& message) {
+        if (!message.contains("meshing the organ") || !cancel->isVisible()) return;
+        progressShown = progress->isVisible() && progress->maximum() > 0;
+        QTest::mouseClick(cancel, Qt::LeftButton);
+      });
+  EXPECT_EQ(open(file), false);
+  QObject::disconnect(onMessage);
+  EXPECT_TRUE(progressShown) << "no meshing progress was shown before the cancel";
+  EXPECT_TRUE(window_->statusBar()->currentMessage().contains("cancelled"))
+      << window_->statusBar()->currentMessage().toStdString();
+  EXPECT_EQ(window_->simulation().snapshot().model, running) << "the scene was replaced";
+  EXPECT_EQ(window_->scenarioPanel()->problemText(), problemBefore) << "a cancel is no error";
+  EXPECT_TRUE(progress->isHidden() && cancel->isHidden());
 }
 
 TEST_F(ScenarioWindowTest, ABadScenarioIsRefusedWithItsErrorsAndTheSceneGoesOn) {

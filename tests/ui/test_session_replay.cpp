@@ -3,7 +3,8 @@
 // a lesion breach, and its simulation input. The instructor's review opens its replay: seeking to
 // the end gives the liver the workstation had to the last bit (cut included), seeking back shows
 // it uncut again, play moves the cursor over the force plot and pause holds it. A session
-// recorded before replays existed says why it cannot be replayed.
+// recorded before replays existed says why it cannot be replayed. The replay sees through the
+// liver to the scenario's lesions.
 #include "liversim/core/scenario.h"
 #include "liversim/core/session_replay.h"
 #include "liversim/storage/sqlite_session_store.h"
@@ -17,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include <QCheckBox>
 #include <QDir>
 #include <QFile>
 #include <QFileInfo>
@@ -219,6 +221,66 @@ TEST_F(SessionReplayWindowTest, ASessionRecordedBeforeReplaysSaysItCannotBeRepla
   SessionReplayWindow missing(database, 99);
   EXPECT_FALSE(missing.ready());
   EXPECT_FALSE(missing.problem().isEmpty());
+}
+
+// A session on the small resection (its lesion visible to the trainee), written through the
+// storage API as the recorder writes one: a few cycles of simulation input, enough to replay.
+TEST(SessionReplaySeeThrough, ShowsTheScenarioLesionsThroughTheLiver) {
+  QTemporaryDir folder;
+  ASSERT_TRUE(folder.isValid());
+  const ScenarioReading reading = read_scenario_file(kSmallScenario.toStdString());
+  ASSERT_TRUE(reading.scenario);
+  ASSERT_FALSE(visible_lesions(*reading.scenario).empty());
+  const std::string text = write_scenario(*reading.scenario);
+  const QString database = folder.filePath("sessions.sqlite");
+  std::int64_t session = 0;
+  {
+    SqliteSessionStore store(database.toStdString());
+    SessionStart start;
+    start.trainee = "Trainee R";
+    start.scenario_title = reading.scenario->title;
+    start.scenario_text = text;
+    start.device = "Mouse";
+    start.started_unix_ms = 1'795'000'000'000;
+    ReplaySetup setup;
+    setup.scenario_folder = QFileInfo(kSmallScenario).absolutePath().toStdString();
+    setup.integrator = reading.scenario->integrator;
+    start.replay = setup;
+    session = store.begin_session(start);
+    std::vector<SimulationInput> cycles(3);
+    for (std::size_t k = 0; k < cycles.size(); ++k) {
+      cycles[k].steps = 1;
+      cycles[k].servo_time_s = 0.01 * static_cast<double>(k);
+    }
+    store.append_inputs(session, cycles);
+    store.commit();
+  }
+
+  SessionReplayWindow replay(database, session);
+  replay.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&replay));
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return replay.ready() || !replay.problem().isEmpty(); }, kTimeoutMs));
+  ASSERT_TRUE(replay.ready()) << replay.problem().toStdString();
+  ASSERT_NE(replay.scene(), nullptr);
+  EXPECT_GT(replay.scene()->shown_lesion_triangle_count(), 0u);
+  EXPECT_FALSE(replay.seeThrough());
+  EXPECT_EQ(replay.scene()->opacity(), 1.0);
+  const QImage solid = replay.viewport()->grabRendering();
+
+  auto* box = replay.findChild<QCheckBox*>("replaySeeThrough");
+  ASSERT_NE(box, nullptr);
+  QTest::mouseClick(box, Qt::LeftButton, {}, box->rect().center());
+  EXPECT_TRUE(replay.seeThrough());
+  EXPECT_EQ(replay.scene()->opacity(), kSeeThroughOpacity);
+  const QImage seen_through = replay.viewport()->grabRendering();
+  // Seen through, every pixel of the liver changes: fitted to the view, it covers tens of
+  // thousands of pixels even in the smallest viewport (480 x 360); at least 10 000 must change.
+  EXPECT_GT(differentPixels(solid, seen_through), 10'000);
+
+  QTest::mouseClick(box, Qt::LeftButton, {}, box->rect().center());
+  EXPECT_FALSE(replay.seeThrough());
+  EXPECT_EQ(replay.scene()->opacity(), 1.0);
 }
 
 }  // namespace

@@ -99,13 +99,15 @@ std::vector<ShownText> shownTexts(const MainWindow& window) {
 }
 
 // What may stay in Latin letters in a Chinese interface: names (of the product, devices,
-// methods, file formats), units, key names, mnemonics "(&F)", numbers.
+// methods, file formats), units, the symbols of the tissue's parameters (E, n, k1...), key names
+// and shortcuts "（Ctrl+O）", mnemonics "(&F)", file names in docs/, numbers.
 QString withoutNamesAndUnits(QString text) {
   static const QRegularExpression allowed(QStringLiteral(
       R"(\(&[A-Z]\)|LiverSim|Phantom Omni|Geomagic Touch|OpenHaptics|libHD\.so|SQLite|JSON|)"
       R"(CSV|PDF|RK4|BDF2|Dormand|Prince|Gmsh|English|Shift|Ctrl|p99|)"
+      R"(（((Ctrl|Shift|Alt)\+)*[A-Z]）|docs/[\w.-]+\.md|kg/m³|)"
       R"([-+]?\d+(\.\d+)?(e[-+]?\d+)?|)"
-      R"(\b(N|mm|m|s|ms|µm|nm|pm|mL|Pa|kPa|Hz|x|y|z)\b)"));
+      R"(\b(N|mm|m|s|ms|µm|nm|pm|mL|Pa|kPa|Hz|x|y|z|E|E1|E2|n|k1|k2)\b)"));
   return text.remove(allowed);
 }
 

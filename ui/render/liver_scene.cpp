@@ -21,28 +21,87 @@
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
+#include <vtkRenderStepsPass.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkSSAOPass.h>
 #include <vtkSphereSource.h>
 #include <vtkTubeFilter.h>
 #include <vtkUnsignedCharArray.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <stdexcept>
 
 namespace liversim {
 namespace {
 
-// Liver parenchyma: a dark red-brown with a moist sheen.
-constexpr double kTissueColour[3] = {0.52, 0.17, 0.13};
-// Cut parenchyma: lighter and redder than the capsule-covered surface.
-constexpr double kCutColour[3] = {0.70, 0.24, 0.20};
 constexpr double kBackgroundTop[3] = {0.16, 0.18, 0.22};
 constexpr double kSteel[3] = {0.7, 0.72, 0.75};
 constexpr double kBackgroundBottom[3] = {0.05, 0.05, 0.07};
 // The tool models' files in resources/tools, in millimetres.
 constexpr double kToolModelMetresPerUnit = 1e-3;
+
+// The mottling's two scales: patches a few centimetres across with smaller ones on them. The
+// colours are per vertex, blended across each triangle, so neither scale may be finer than two
+// vertex spacings (12 mm on the built-in liver's surface, 10 mm at 10 583 elements) or the
+// triangles would show.
+constexpr double kMottleCoarse_m = 0.05;
+constexpr double kMottleFine_m = 0.025;
+constexpr double kMottleFineWeight = 0.35;
+// Blended lattice values crowd around their mean (a standard deviation of 0.16 for the two scales
+// together, against 0.29 for values spread evenly over [0, 1]): stretched so that the patches
+// reach both ends of the palette, about 4 % of the surface beyond them (clamped).
+constexpr double kMottleContrast = 1.5;
+
+// A repeatable pseudo-random value in [0, 1) for a lattice point: an integer hash, the same on
+// every run and machine (no generator state).
+double lattice_value(std::int64_t i, std::int64_t j, std::int64_t k) {
+  std::uint64_t h = static_cast<std::uint64_t>(i) * 0x9E3779B97F4A7C15ull ^
+                    static_cast<std::uint64_t>(j) * 0xC2B2AE3D27D4EB4Full ^
+                    static_cast<std::uint64_t>(k) * 0x165667B19E3779F9ull;
+  h ^= h >> 33;
+  h *= 0xFF51AFD7ED558CCDull;
+  h ^= h >> 33;
+  h *= 0xC4CEB9FE1A85EC53ull;
+  h ^= h >> 33;
+  return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
+// Value noise in [0, 1] at `p` (in lattice cells): the eight surrounding lattice values blended
+// with a quintic fade, whose first two derivatives vanish at the cells' faces, so the pattern has
+// no creases.
+double value_noise(const Eigen::Vector3d& p) {
+  const Eigen::Vector3d cell = p.array().floor();
+  const auto fade = [](double t) { return t * t * t * (t * (6.0 * t - 15.0) + 10.0); };
+  const Eigen::Vector3d f = p - cell;
+  const double w[3] = {fade(f.x()), fade(f.y()), fade(f.z())};
+  const auto i = static_cast<std::int64_t>(cell.x()), j = static_cast<std::int64_t>(cell.y()),
+             k = static_cast<std::int64_t>(cell.z());
+  double value = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
+    value += (di ? w[0] : 1.0 - w[0]) * (dj ? w[1] : 1.0 - w[1]) * (dk ? w[2] : 1.0 - w[2]) *
+             lattice_value(i + di, j + dj, k + dk);
+  }
+  return value;
+}
+
+// The capsule-covered tissue's colour at a rest position, as 8-bit RGB.
+std::array<unsigned char, 3> tissue_colour(const Eigen::Vector3d& rest_m) {
+  // The fine scale's lattice is offset so that its cells' corners do not line up with the coarse.
+  const double mottle =
+      (1.0 - kMottleFineWeight) * value_noise(rest_m / kMottleCoarse_m) +
+      kMottleFineWeight * value_noise(rest_m / kMottleFine_m + Eigen::Vector3d(17.3, 5.1, 9.7));
+  const double t = std::clamp(0.5 + kMottleContrast * (mottle - 0.5), 0.0, 1.0);
+  std::array<unsigned char, 3> rgb;
+  for (int c = 0; c < 3; ++c)
+    rgb[c] = static_cast<unsigned char>(
+        std::lround(255.0 * ((1.0 - t) * kTissueDarkColour[c] + t * kTissueLightColour[c])));
+  return rgb;
+}
 
 vtkSmartPointer<vtkActor> model_actor(const VisualMesh& mesh) {
   vtkNew<vtkPoints> points;
@@ -148,26 +207,27 @@ LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual)
   points_->SetDataTypeToDouble();
   normals_->SetNumberOfComponents(3);
   normals_->SetName("Normals");
-  face_colours_->SetNumberOfComponents(3);
-  face_colours_->SetName("Colours");
+  vertex_colours_->SetNumberOfComponents(3);
+  vertex_colours_->SetName("Colours");
   polydata_->SetPoints(points_);
   polydata_->GetPointData()->SetNormals(normals_);
-  polydata_->GetCellData()->SetScalars(face_colours_);
-  set_surface(std::move(visual), {}, mesh.rest_position_m);
+  polydata_->GetPointData()->SetScalars(vertex_colours_);
+  set_surface(std::move(visual), {}, mesh.rest_position_m, mesh.rest_position_m);
 
   vtkNew<vtkPolyDataMapper> mapper;
   mapper->SetInputData(polydata_);
-  // The faces' own colours (the organ's surface, or its interior where cut), lit as the actor.
-  mapper->SetScalarModeToUseCellData();
+  // The vertices' own colours (the mottled surface, or the interior where cut) in place of the
+  // diffuse and ambient colour; the highlights stay white, as on a moist surface.
+  mapper->SetScalarModeToUsePointData();
   mapper->SetColorModeToDirectScalars();
   liver_actor_->SetMapper(mapper);
   vtkProperty* tissue = liver_actor_->GetProperty();
-  tissue->SetColor(kTissueColour[0], kTissueColour[1], kTissueColour[2]);
   tissue->SetInterpolationToPhong();
   tissue->SetAmbient(0.12);
   tissue->SetDiffuse(0.85);
+  // A moist capsule: small, bright white highlights.
   tissue->SetSpecular(0.35);
-  tissue->SetSpecularPower(28.0);
+  tissue->SetSpecularPower(50.0);
   renderer_->AddActor(liver_actor_);
 
   vtkNew<vtkSphereSource> sphere;
@@ -241,6 +301,18 @@ LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual)
   lamp->SetIntensity(0.45);
   renderer_->AddLight(lamp);
 
+  occlusion_pass_->SetDelegatePass(scene_passes_);
+  // Creases between lobes, around the hilum and along a cut are a centimetre or two deep on a
+  // liver about 25 cm across: samples within 2 cm.
+  occlusion_pass_->SetRadius(0.02);
+  // The pass keeps view-space positions as half floats, whose steps are 0.5 mm at the camera's
+  // distance (0.4 to 0.8 m): a sample must lie 2 steps behind a surface to count, or a smooth
+  // surface would shadow itself in speckles.
+  occlusion_pass_->SetBias(0.001);
+  // VTK's 32 samples a pixel, blurred over its neighbours to smooth their grain.
+  occlusion_pass_->SetKernelSize(32);
+  occlusion_pass_->BlurOn();
+
   picker_->SetTolerance(0.0005);
   picker_->PickFromListOn();
   picker_->AddPickList(liver_actor_);
@@ -254,25 +326,62 @@ vtkRenderer* LiverScene::renderer() const {
 }
 
 void LiverScene::set_surface(VisualSurface visual, const std::vector<std::uint8_t>& cut_faces,
-                             const NodeArray& position_m) {
+                             const NodeArray& rest_position_m, const NodeArray& position_m) {
   visual_ = std::move(visual);
   const BoundarySurface& surface = visual_.surface;
-  points_->SetNumberOfPoints(static_cast<vtkIdType>(surface.nodes.size()));
-  normals_->SetNumberOfTuples(static_cast<vtkIdType>(surface.nodes.size()));
-  vtkNew<vtkCellArray> triangles;
-  triangles->AllocateExact(static_cast<vtkIdType>(surface.triangles.size()),
-                           static_cast<vtkIdType>(3 * surface.triangles.size()));
-  face_colours_->SetNumberOfTuples(static_cast<vtkIdType>(surface.triangles.size()));
+  const std::size_t vertex_count = surface.nodes.size();
+  const auto is_cut = [&](std::size_t t) { return t < cut_faces.size() && cut_faces[t]; };
+  // The cut faces are drawn apart from the capsule: a vertex on the cut's rim is drawn twice, once
+  // for each, so that each side has its own colour up to the edge and its own normal (the rim is
+  // an edge, not a bend).
+  std::vector<std::uint8_t> on_capsule(vertex_count, 0);
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t)
+    if (!is_cut(t))
+      for (std::int32_t v : surface.triangles[t]) on_capsule[static_cast<std::size_t>(v)] = 1;
+  drawn_triangles_ = surface.triangles;
+  rim_copy_of_.clear();
+  std::vector<std::int32_t> rim_copy(vertex_count, -1);
   for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
-    const vtkIdType ids[3] = {surface.triangles[t][0], surface.triangles[t][1],
-                              surface.triangles[t][2]};
+    if (!is_cut(t)) continue;
+    for (std::int32_t& v : drawn_triangles_[t]) {
+      const auto original = static_cast<std::size_t>(v);
+      if (!on_capsule[original]) continue;
+      if (rim_copy[original] < 0) {
+        rim_copy[original] = static_cast<std::int32_t>(vertex_count + rim_copy_of_.size());
+        rim_copy_of_.push_back(v);
+      }
+      v = rim_copy[original];
+    }
+  }
+  const auto drawn_count = static_cast<vtkIdType>(vertex_count + rim_copy_of_.size());
+  points_->SetNumberOfPoints(drawn_count);
+  normals_->SetNumberOfTuples(drawn_count);
+  drawn_xyz_.resize(3 * static_cast<std::size_t>(drawn_count));
+
+  // The colours are made here, once per surface: a vertex keeps its colour however the tissue
+  // moves, and a frame only moves the vertices.
+  map_visual_positions(visual_, rest_position_m, rest_xyz_);
+  vertex_colours_->SetNumberOfTuples(drawn_count);
+  for (std::size_t v = 0; v < vertex_count; ++v) {
+    const auto rgb = tissue_colour(
+        Eigen::Vector3d(rest_xyz_[3 * v], rest_xyz_[3 * v + 1], rest_xyz_[3 * v + 2]));
+    vertex_colours_->SetTypedTuple(static_cast<vtkIdType>(v), rgb.data());
+  }
+  unsigned char cut_rgb[3];
+  for (int c = 0; c < 3; ++c)
+    cut_rgb[c] = static_cast<unsigned char>(std::lround(255.0 * kCutColour[c]));
+  vtkNew<vtkCellArray> triangles;
+  triangles->AllocateExact(static_cast<vtkIdType>(drawn_triangles_.size()),
+                           static_cast<vtkIdType>(3 * drawn_triangles_.size()));
+  for (std::size_t t = 0; t < drawn_triangles_.size(); ++t) {
+    const vtkIdType ids[3] = {drawn_triangles_[t][0], drawn_triangles_[t][1],
+                              drawn_triangles_[t][2]};
     triangles->InsertNextCell(3, ids);
-    const double* colour = t < cut_faces.size() && cut_faces[t] ? kCutColour : kTissueColour;
-    for (int k = 0; k < 3; ++k)
-      face_colours_->SetComponent(static_cast<vtkIdType>(t), k, std::round(255.0 * colour[k]));
+    if (is_cut(t))
+      for (vtkIdType id : ids) vertex_colours_->SetTypedTuple(id, cut_rgb);
   }
   polydata_->SetPolys(triangles);
-  face_colours_->Modified();
+  vertex_colours_->Modified();
   update_positions(position_m);
 }
 
@@ -314,7 +423,7 @@ void LiverScene::show_cut_model(const SimModel& model, const NodeArray& position
   }
   VisualSurface visual = embed_visual_surface(mesh, surface, vertex_rest);
   const auto cut_faces = cut_face_flags(model, visual.surface);
-  set_surface(std::move(visual), cut_faces, position_m);
+  set_surface(std::move(visual), cut_faces, mesh.rest_position_m, position_m);
   if (!lesion_rest_m_.empty()) {
     show_lesion_embedding(embed_points(mesh, lesion_rest_m_));
     update_lesion_positions(position_m);
@@ -322,7 +431,7 @@ void LiverScene::show_cut_model(const SimModel& model, const NodeArray& position
 }
 
 void LiverScene::show_uncut(const NodeArray& position_m) {
-  set_surface(uncut_visual_, {}, position_m);
+  set_surface(uncut_visual_, {}, uncut_mesh_.rest_position_m, position_m);
   if (!lesion_rest_m_.empty()) {
     show_lesion_embedding(uncut_lesion_embedding_);
     update_lesion_positions(position_m);
@@ -403,10 +512,15 @@ void LiverScene::update_lesion_positions(const NodeArray& position_m) {
 
 void LiverScene::update_positions(const NodeArray& position_m) {
   map_visual_positions(visual_, position_m, vertex_xyz_);
-  for (std::size_t i = 0; i < visual_.vertex_count(); ++i)
-    points_->SetPoint(static_cast<vtkIdType>(i), vertex_xyz_[3 * i], vertex_xyz_[3 * i + 1],
-                      vertex_xyz_[3 * i + 2]);
-  compute_vertex_normals(visual_.surface.triangles, vertex_xyz_, normal_scratch_);
+  std::copy(vertex_xyz_.begin(), vertex_xyz_.end(), drawn_xyz_.begin());
+  for (std::size_t i = 0; i < rim_copy_of_.size(); ++i)
+    std::copy_n(&vertex_xyz_[3 * static_cast<std::size_t>(rim_copy_of_[i])], 3,
+                &drawn_xyz_[vertex_xyz_.size() + 3 * i]);
+  const std::size_t drawn_count = drawn_xyz_.size() / 3;
+  for (std::size_t i = 0; i < drawn_count; ++i)
+    points_->SetPoint(static_cast<vtkIdType>(i), drawn_xyz_[3 * i], drawn_xyz_[3 * i + 1],
+                      drawn_xyz_[3 * i + 2]);
+  compute_vertex_normals(drawn_triangles_, drawn_xyz_, normal_scratch_);
   std::copy(normal_scratch_.begin(), normal_scratch_.end(), normals_->GetPointer(0));
   points_->Modified();
   normals_->Modified();
@@ -434,6 +548,24 @@ void LiverScene::set_opacity(double opacity) {
 
 double LiverScene::opacity() const {
   return liver_actor_->GetProperty()->GetOpacity();
+}
+
+void LiverScene::set_ambient_occlusion(bool on) {
+  // No pass: the renderer's own default passes, as before.
+  renderer_->SetPass(on ? occlusion_pass_.Get() : nullptr);
+  // VTK 9.1's occlusion pass reads every pixel's view position, which the gradient background's
+  // quad leaves undefined (it writes colour only): the organ's outline then darkens by chance,
+  // differently each frame. With occlusion, the background is one colour, the gradient's middle,
+  // which the clear writes with no position.
+  renderer_->SetGradientBackground(!on);
+  double bottom[3];
+  for (int c = 0; c < 3; ++c)
+    bottom[c] = on ? 0.5 * (kBackgroundBottom[c] + kBackgroundTop[c]) : kBackgroundBottom[c];
+  renderer_->SetBackground(bottom);
+}
+
+bool LiverScene::ambient_occlusion() const {
+  return renderer_->GetPass() == occlusion_pass_.Get();
 }
 
 void LiverScene::show_grab_marker(const std::optional<Eigen::Vector3d>& point_m) {

@@ -29,6 +29,8 @@ class vtkFloatArray;
 class vtkPoints;
 class vtkPolyData;
 class vtkRenderer;
+class vtkRenderStepsPass;
+class vtkSSAOPass;
 class vtkLineSource;
 class vtkSphereSource;
 class vtkTubeFilter;
@@ -38,6 +40,13 @@ namespace liversim {
 
 // The organ's opacity in the see-through view.
 inline constexpr double kSeeThroughOpacity = 0.35;
+
+// The capsule-covered surface of the liver: a smooth mottling between a deep maroon and a lighter
+// red-brown, fixed to the tissue (a function of each vertex's rest position).
+inline constexpr double kTissueDarkColour[3] = {0.36, 0.09, 0.09};
+inline constexpr double kTissueLightColour[3] = {0.60, 0.22, 0.14};
+// Cut parenchyma: lighter and redder than the capsule-covered surface.
+inline constexpr double kCutColour[3] = {0.70, 0.24, 0.20};
 
 // A lesion as the see-through view draws it: an ellipsoid at rest, carried by the organ.
 struct LesionShape {
@@ -75,9 +84,10 @@ class LiverScene {
   const BoundarySurface& surface() const { return visual_.surface; }
 
   // Shows another surface (the mesh changed: a cut), at these node positions; faces flagged in
-  // `cut_faces` (one per triangle; empty: none) in the colour of the organ's interior.
+  // `cut_faces` (one per triangle; empty: none) in the colour of the organ's interior, the others
+  // mottled by where their vertices are at rest (`rest_position_m`, of the same nodes).
   void set_surface(VisualSurface visual, const std::vector<std::uint8_t>& cut_faces,
-                   const NodeArray& position_m);
+                   const NodeArray& rest_position_m, const NodeArray& position_m);
   // Shows a cut model's boundary at these positions, its cut faces in the interior colour. A node
   // still where a node of the organ's first surface was (the same node, or its copy) keeps that
   // node's smooth visual vertex; the others show where they are.
@@ -99,6 +109,12 @@ class LiverScene {
   // is solid.
   void set_opacity(double opacity);
   double opacity() const;
+  // Screen-space ambient occlusion: creases, pits and the folds between lobes darkened as a diffuse
+  // operating-room light would leave them; while on, the background is one colour instead of a
+  // gradient (liver_scene.cpp says why). Off by default: it costs full-screen passes every frame
+  // (docs/rendering-performance.md).
+  void set_ambient_occlusion(bool on);
+  bool ambient_occlusion() const;
   // A small sphere at the grabbed point, or none.
   void show_grab_marker(const std::optional<Eigen::Vector3d>& point_m);
   // The tool's parts (tools.h: tool_capsules) as steel-grey rods with rounded ends; none hides it.
@@ -123,11 +139,14 @@ class LiverScene {
   vtkNew<vtkRenderer> renderer_;
   vtkNew<vtkPoints> points_;
   vtkNew<vtkFloatArray> normals_;
-  vtkNew<vtkUnsignedCharArray> face_colours_;
+  vtkNew<vtkUnsignedCharArray> vertex_colours_;
+  std::vector<double> rest_xyz_;  // the visual vertices at rest, for their colours
   vtkNew<vtkPolyData> polydata_;
   vtkNew<vtkActor> liver_actor_;
   vtkNew<vtkActor> grab_marker_;
   vtkNew<vtkCellPicker> picker_;
+  vtkNew<vtkRenderStepsPass> scene_passes_;  // VTK's usual passes, which the occlusion wraps
+  vtkNew<vtkSSAOPass> occlusion_pass_;
   // One rod per tool part: a tube along the segment and spheres on its ends.
   struct ToolPart {
     vtkSmartPointer<vtkLineSource> line;
@@ -162,7 +181,11 @@ class LiverScene {
   std::vector<float> lesion_normal_scratch_;
   void show_lesion_embedding(EmbeddedPoints embedding);  // its held triangles
   void update_lesion_positions(const NodeArray& position_m);
-  std::vector<double> vertex_xyz_;
+  // What is drawn: the visual vertices, then a second copy of each vertex on a cut's rim for the
+  // cut faces (rim_copy_of_: the visual vertex each copies), and the triangles on them.
+  std::vector<std::array<std::int32_t, 3>> drawn_triangles_;
+  std::vector<std::int32_t> rim_copy_of_;
+  std::vector<double> vertex_xyz_, drawn_xyz_;
   std::vector<float> normal_scratch_;
 };
 

@@ -6,6 +6,8 @@
 #include <vtkRenderWindow.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <X11/Xlib.h>
+
 #include <cstdlib>
 #include <stdexcept>
 #include <system_error>
@@ -25,7 +27,16 @@ void check_offscreen_png_target(const std::filesystem::path& file, const std::st
                              " does not exist");
 }
 
+void use_shared_x_connection(vtkRenderWindow* window) {
+  // Never closed: it lives as long as the process, so the server always has this client.
+  static Display* const connection = XOpenDisplay(nullptr);
+  // Without one (no server), the window tries its own and VTK reports the failure.
+  if (connection != nullptr && window->GetGenericDisplayId() == nullptr)
+    window->SetDisplayId(connection);
+}
+
 void write_window_png(vtkRenderWindow* window, const std::filesystem::path& file) {
+  use_shared_x_connection(window);
   window->Render();
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(window);

@@ -13,8 +13,15 @@ namespace liversim {
 // `action` says what was asked, e.g. "render" or "plot".
 void check_offscreen_png_target(const std::filesystem::path& file, const std::string& action);
 
-// Renders `window` and writes its picture to `file`; on failure removes any partial file and
-// throws std::runtime_error naming it.
+// Has an offscreen window not yet drawn talk to the X server through the process's one connection,
+// opened at the first call and kept. An X server resets when its last client leaves (Xvfb does,
+// unless started with -noreset) and refuses connections meanwhile, and VTK aborts the process when
+// a window cannot connect: windows that each opened and closed a connection of their own, one
+// after another, raced that reset.
+void use_shared_x_connection(vtkRenderWindow* window);
+
+// Renders `window` (on the shared X connection when not yet drawn) and writes its picture to
+// `file`; on failure removes any partial file and throws std::runtime_error naming it.
 void write_window_png(vtkRenderWindow* window, const std::filesystem::path& file);
 
 }  // namespace liversim

@@ -1,0 +1,168 @@
+// The main window as a desktop product: the toolbar, trainee and instructor modes, the layout
+// remembered between starts, and the Material panel changing the running liver's tissue.
+#include <gtest/gtest.h>
+
+#include <QAction>
+#include <QDockWidget>
+#include <QDoubleSpinBox>
+#include <QSettings>
+#include <QSignalSpy>
+#include <QTest>
+#include <QToolBar>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "liversim/core/default_scene.h"
+#include "main_window.h"
+#include "material_panel.h"
+
+namespace liversim {
+namespace {
+
+constexpr int kTetCount = 3841;  // as the other window tests: small enough for Xvfb
+constexpr int kTimeoutMs = 60'000;
+
+std::unique_ptr<MainWindow> openWindow() {
+  auto window = std::make_unique<MainWindow>(default_scene(kTetCount));
+  window->show();
+  EXPECT_TRUE(QTest::qWaitForWindowExposed(window.get()));
+  return window;
+}
+
+QAction* action(const MainWindow& window, const char* name) {
+  return window.findChild<QAction*>(name);
+}
+
+double simulatedTime(const MainWindow& window) {
+  return const_cast<MainWindow&>(window).simulation().snapshot().time_s;
+}
+
+TEST(Workstation, TheToolbarAndTheModesOfferWhatEachUserMayDo) {
+  QSettings().clear();
+  auto window = openWindow();
+  QToolBar* toolbar = window->mainToolBar();
+  ASSERT_NE(toolbar, nullptr);
+  for (const char* name :
+       {"openScenarioAction", "scenarioEditorAction", "seeThroughAction", "markLesionAction",
+        "traineeHistoryAction", "reviewSessionsAction", "instructorModeAction"})
+    EXPECT_TRUE(toolbar->actions().contains(action(*window, name))) << name;
+  // A shortcut is named in its tooltip.
+  EXPECT_TRUE(action(*window, "seeThroughAction")->toolTip().contains("(T)"))
+      << action(*window, "seeThroughAction")->toolTip().toStdString();
+
+  // A new workstation starts in trainee mode: the tissue read-only, no authoring or grading.
+  EXPECT_FALSE(window->instructorMode());
+  EXPECT_FALSE(action(*window, "scenarioEditorAction")->isVisible());
+  EXPECT_FALSE(action(*window, "reviewSessionsAction")->isVisible());
+  EXPECT_TRUE(action(*window, "traineeHistoryAction")->isVisible());
+  auto* modulus = window->findChild<QDoubleSpinBox*>("materialYoungsModulus");
+  ASSERT_NE(modulus, nullptr);
+  EXPECT_TRUE(modulus->isReadOnly());
+  const double before = modulus->value();
+  modulus->setFocus();
+  QTest::keyClick(modulus, Qt::Key_Up);  // a read-only spin box does not step
+  EXPECT_EQ(modulus->value(), before);
+  EXPECT_FALSE(window->changingTissue());
+
+  // Ambient occlusion: off by default (its frame-rate cost), on from the View menu.
+  EXPECT_FALSE(window->scene().ambient_occlusion());
+  action(*window, "ambientOcclusionAction")->trigger();
+  EXPECT_TRUE(window->scene().ambient_occlusion());
+
+  action(*window, "instructorModeAction")->trigger();
+  EXPECT_TRUE(window->instructorMode());
+  EXPECT_TRUE(action(*window, "scenarioEditorAction")->isVisible());
+  EXPECT_TRUE(action(*window, "reviewSessionsAction")->isVisible());
+  EXPECT_FALSE(modulus->isReadOnly());
+
+  // The mode is remembered.
+  window.reset();
+  window = openWindow();
+  EXPECT_TRUE(window->instructorMode());
+  EXPECT_TRUE(action(*window, "instructorModeAction")->isChecked());
+  EXPECT_TRUE(window->scene().ambient_occlusion());  // remembered too
+}
+
+TEST(Workstation, TheWindowLayoutIsRememberedBetweenStarts) {
+  QSettings().clear();
+  auto window = openWindow();
+  auto* material = window->findChild<QDockWidget*>("materialDock");
+  auto* device = window->findChild<QDockWidget*>("deviceDock");
+  ASSERT_TRUE(material && device);
+  EXPECT_EQ(window->dockWidgetArea(material), Qt::RightDockWidgetArea);
+  window->addDockWidget(Qt::LeftDockWidgetArea, material);
+  device->toggleViewAction()->trigger();  // View ▸ Panels: closed
+  EXPECT_TRUE(device->isHidden());
+  window->resize(1000, 700);  // the docks' least heights may make it taller
+  QTest::qWait(50);
+  const QSize size = window->size();
+  EXPECT_EQ(size.width(), 1000);
+  window->close();  // saved as it closes
+  window.reset();
+
+  window = openWindow();
+  material = window->findChild<QDockWidget*>("materialDock");
+  device = window->findChild<QDockWidget*>("deviceDock");
+  EXPECT_EQ(window->dockWidgetArea(material), Qt::LeftDockWidgetArea);
+  EXPECT_TRUE(device->isHidden());
+  EXPECT_EQ(window->size(), size);
+}
+
+TEST(Workstation, TheMaterialPanelChangesTheRunningLiversTissue) {
+  QSettings().clear();
+  auto window = openWindow();
+  window->setInstructorMode(true);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return simulatedTime(*window) > 0.0; }, kTimeoutMs));
+  const SimModel& original = window->simulation().model();
+  const double stepBefore_s = original.stable_time_step_s;
+  const double nu = original.regions[0].tissue.poisson_ratio;
+
+  // Twice the default modulus, entered in the panel in kPa.
+  auto* modulus = window->findChild<QDoubleSpinBox*>("materialYoungsModulus");
+  ASSERT_NE(modulus, nullptr);
+  const double newModulusPa = 2.0 * original.regions[0].tissue.youngs_modulus_pa;
+  QSignalSpy finished(window.get(), &MainWindow::tissueChangeFinished);
+  const double timeBefore_s = simulatedTime(*window);
+  modulus->setValue(newModulusPa / 1e3);
+  ASSERT_TRUE(finished.wait(kTimeoutMs));
+  ASSERT_TRUE(finished.first().first().toBool());
+  const SimModel& changed = window->simulation().model();
+  // μ = E / (2 (1 + ν)) in every element of the parenchyma (the only region here).
+  EXPECT_DOUBLE_EQ(changed.shear_modulus_pa[0], newModulusPa / (2.0 * (1.0 + nu)));
+  // Stiffer at the same mass: ω_max rises by √2, so the stable step shrinks.
+  EXPECT_LT(changed.stable_time_step_s, stepBefore_s);
+  // The liver went on from where it was: no restart from rest.
+  EXPECT_GE(window->simulation().state().time_s, timeBefore_s);
+  EXPECT_EQ(window->materialPanel()->tissueInUse().elastic.youngs_modulus_pa, newModulusPa);
+  EXPECT_TRUE(window->materialPanel()->errorText().isEmpty());
+
+  // A value no liver has is refused by name; the tissue in use stays.
+  finished.clear();
+  TissueSpec bad = window->materialPanel()->tissueInUse();
+  bad.elastic.poisson_ratio = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(window->applyTissue(bad));
+  ASSERT_TRUE(finished.wait(kTimeoutMs));
+  EXPECT_FALSE(finished.first().first().toBool());
+  EXPECT_TRUE(window->materialPanel()->errorText().contains("Poisson"))
+      << window->materialPanel()->errorText().toStdString();
+  EXPECT_DOUBLE_EQ(window->simulation().model().shear_modulus_pa[0],
+                   newModulusPa / (2.0 * (1.0 + nu)));
+  EXPECT_EQ(modulus->value(), newModulusPa / 1e3);
+
+  // Entries made while one is applied: the newest is applied after it.
+  finished.clear();
+  TissueSpec first = window->materialPanel()->tissueInUse();
+  first.elastic.density_kg_per_m3 = 1100.0;
+  TissueSpec newest = first;
+  newest.elastic.density_kg_per_m3 = 1000.0;
+  ASSERT_TRUE(window->applyTissue(first));
+  ASSERT_TRUE(window->applyTissue(newest));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return finished.size() == 2; }, kTimeoutMs));
+  EXPECT_EQ(window->simulation().model().regions[0].tissue.density_kg_per_m3, 1000.0);
+  EXPECT_FALSE(window->changingTissue());
+}
+
+}  // namespace
+}  // namespace liversim

@@ -1,0 +1,192 @@
+#include "material_panel.h"
+
+#include "parameter_spin_box.h"
+
+#include "liversim/core/parameter_ranges.h"
+
+#include <QDoubleSpinBox>
+#include <QFormLayout>
+#include <QLabel>
+#include <QVBoxLayout>
+
+#include <initializer_list>
+
+namespace liversim {
+
+MaterialPanel::MaterialPanel(QWidget* parent) : QWidget(parent) {
+  form_ = new QFormLayout;
+  const auto add = [&](QDoubleSpinBox*& box, std::string_view range, double scale,
+                       const QString& suffix, int decimals, const char* name,
+                       const QString& label) {
+    box = rangeSpinBox(range, scale, suffix, decimals);
+    box->setParent(this);
+    box->setObjectName(name);
+    // The documented range, in the interface's language (docs/tissue-model.md says why).
+    box->setToolTip(
+        tr("%1: %2 to %3%4").arg(label).arg(box->minimum()).arg(box->maximum()).arg(suffix));
+    form_->addRow(label, box);
+    connect(box, &QDoubleSpinBox::valueChanged, this, [this] { request(); });
+  };
+  add(youngsModulusKpa_, parameter::youngs_modulus, 1e3, tr(" kPa"), 2, "materialYoungsModulus",
+      tr("Young's modulus E"));
+  add(poissonRatio_, parameter::poisson_ratio, 1.0, QString(), 3, "materialPoissonRatio",
+      tr("Poisson's ratio ν"));
+  poissonRatio_->setSingleStep(0.005);
+  add(density_, parameter::density, 1.0, tr(" kg/m³"), 0, "materialDensity", tr("Density ρ"));
+  add(e1_, parameter::e1, 1.0, tr(" Pa"), 0, "materialE1", tr("Maxwell arm E1"));
+  e1_->setToolTip(e1_->toolTip() + tr(". E2 = E − E1 follows."));
+  add(eta1_, parameter::eta1, 1.0, tr(" Pa·s"), 0, "materialEta1", tr("Maxwell arm η1"));
+  add(yieldLimit_, parameter::yield_limit, 1.0, tr(" Pa"), 0, "materialYieldLimit",
+      tr("Yield limit σs"));
+  add(eta2_, parameter::eta2, 1.0, tr(" Pa·sⁿ"), 0, "materialEta2", tr("Viscoplastic η2"));
+  add(creepIndex_, parameter::creep_index, 1.0, QString(), 2, "materialCreepIndex",
+      tr("Creep index n"));
+  add(fibreK1_, parameter::fibre_k1, 1.0, tr(" Pa"), 0, "materialFibreK1", tr("Fibre k1"));
+  add(fibreK2_, parameter::fibre_k2, 1.0, QString(), 2, "materialFibreK2", tr("Fibre k2"));
+
+  derived_ = new QLabel(this);
+  derived_->setObjectName("materialDerived");
+  derived_->setWordWrap(true);
+  status_ = new QLabel(this);
+  status_->setObjectName("materialStatus");
+  status_->setWordWrap(true);
+  error_ = new QLabel(this);
+  error_->setObjectName("materialError");
+  error_->setWordWrap(true);
+  error_->setStyleSheet("color: #b00020;");
+  error_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  error_->hide();
+  readOnlyNote_ = new QLabel(tr("Trainee mode: the tissue is the scenario's. An instructor can "
+                                "change it in instructor mode (Settings menu)."),
+                             this);
+  readOnlyNote_->setObjectName("materialReadOnlyNote");
+  readOnlyNote_->setWordWrap(true);
+  readOnlyNote_->hide();
+
+  auto* layout = new QVBoxLayout(this);
+  layout->addLayout(form_);
+  layout->addWidget(derived_);
+  layout->addWidget(status_);
+  layout->addWidget(error_);
+  layout->addWidget(readOnlyNote_);
+  layout->addStretch(1);
+  setToolTip(
+      tr("A value entered is applied to the running liver at once; it goes on from where "
+         "it is. The laws of effects the scene leaves off are not simulated and not "
+         "shown."));
+  showTissue(TissueSpec{}, EffectsSpec{});
+}
+
+void MaterialPanel::showTissue(const TissueSpec& tissue, const EffectsSpec& effects) {
+  inUse_ = tissue;
+  effects_ = effects;
+  refreshing_ = true;
+  youngsModulusKpa_->setValue(tissue.elastic.youngs_modulus_pa / 1e3);
+  shownModulusKpa_ = youngsModulusKpa_->value();
+  poissonRatio_->setValue(tissue.elastic.poisson_ratio);
+  density_->setValue(tissue.elastic.density_kg_per_m3);
+  const bool viscoelastic = effects.viscoelastic && tissue.viscoelastic;
+  const bool viscoplastic = effects.viscoplastic && tissue.viscoplastic;
+  const bool fibres = effects.fibres && tissue.fibres;
+  if (viscoelastic) {
+    e1_->setValue(tissue.viscoelastic->e1_pa);
+    eta1_->setValue(tissue.viscoelastic->eta1_pa_s);
+  }
+  if (viscoplastic) {
+    yieldLimit_->setValue(tissue.viscoplastic->yield_limit_pa);
+    eta2_->setValue(tissue.viscoplastic->eta2_pa_s_pow_n);
+    creepIndex_->setValue(tissue.viscoplastic->creep_index_n);
+  }
+  if (fibres) {
+    fibreK1_->setValue(tissue.fibres->k1_pa);
+    fibreK2_->setValue(tissue.fibres->k2);
+  }
+  for (QDoubleSpinBox* box : {e1_, eta1_}) form_->setRowVisible(box, viscoelastic);
+  for (QDoubleSpinBox* box : {yieldLimit_, eta2_, creepIndex_})
+    form_->setRowVisible(box, viscoplastic);
+  for (QDoubleSpinBox* box : {fibreK1_, fibreK2_}) form_->setRowVisible(box, fibres);
+  refreshing_ = false;
+  error_->hide();
+  error_->clear();
+  status_->setText(tr("In use. Effects left off (not simulated): %1.").arg([&] {
+    QStringList off;
+    if (!effects.viscoelastic) off << tr("viscoelasticity");
+    if (!effects.viscoplastic) off << tr("viscoplasticity");
+    if (!effects.fibres) off << tr("fibres");
+    return off.isEmpty() ? tr("none") : off.join(tr(", "));
+  }()));
+  updateNotes();
+}
+
+TissueSpec MaterialPanel::requestedTissue() const {
+  TissueSpec tissue = inUse_;
+  tissue.elastic.youngs_modulus_pa = youngsModulusKpa_->value() * 1e3;
+  tissue.elastic.poisson_ratio = poissonRatio_->value();
+  tissue.elastic.density_kg_per_m3 = density_->value();
+  if (effects_.viscoelastic && tissue.viscoelastic) {
+    tissue.viscoelastic->e1_pa = e1_->value();
+    tissue.viscoelastic->e2_pa = tissue.elastic.youngs_modulus_pa - e1_->value();
+    tissue.viscoelastic->eta1_pa_s = eta1_->value();
+  }
+  if (effects_.viscoplastic && tissue.viscoplastic)
+    tissue.viscoplastic =
+        ViscoplasticParameters{yieldLimit_->value(), eta2_->value(), creepIndex_->value()};
+  if (effects_.fibres && tissue.fibres) {
+    tissue.fibres->k1_pa = fibreK1_->value();
+    tissue.fibres->k2 = fibreK2_->value();
+  }
+  return tissue;
+}
+
+void MaterialPanel::request() {
+  if (refreshing_) return;
+  // With viscoelasticity E = E1 + E2: a new E scales both arms, so the relaxation keeps its shape.
+  if (youngsModulusKpa_->value() != shownModulusKpa_ && effects_.viscoelastic &&
+      inUse_.viscoelastic && shownModulusKpa_ > 0.0) {
+    refreshing_ = true;
+    e1_->setValue(e1_->value() * youngsModulusKpa_->value() / shownModulusKpa_);
+    refreshing_ = false;
+  }
+  shownModulusKpa_ = youngsModulusKpa_->value();
+  updateNotes();
+  emit tissueRequested(requestedTissue());
+}
+
+void MaterialPanel::updateNotes() {
+  const TissueSpec tissue = requestedTissue();
+  if (effects_.viscoelastic && tissue.viscoelastic) {
+    const ViscoelasticParameters& law = *tissue.viscoelastic;
+    derived_->setText(tr("E2 = E − E1 = %1 Pa; relaxation time τ = η1/E1 = %2 s")
+                          .arg(law.e2_pa, 0, 'f', 0)
+                          .arg(law.relaxation_time_s(), 0, 'g', 3));
+    derived_->show();
+  } else {
+    derived_->hide();
+  }
+}
+
+void MaterialPanel::setEditable(bool editable) {
+  editable_ = editable;
+  for (QDoubleSpinBox* box : findChildren<QDoubleSpinBox*>()) box->setReadOnly(!editable);
+  readOnlyNote_->setVisible(!editable);
+}
+
+void MaterialPanel::setBusy(bool busy) {
+  if (busy) status_->setText(tr("Applying the new tissue to the running liver…"));
+}
+
+void MaterialPanel::showError(const QString& message) {
+  error_->setText(tr("Not applied: %1").arg(message));
+  error_->show();
+  // The fields go back to the tissue in use, which stays.
+  const QString kept = error_->text();
+  showTissue(inUse_, effects_);
+  error_->setText(kept);
+  error_->show();
+}
+
+QString MaterialPanel::errorText() const {
+  return error_->isHidden() ? QString() : error_->text();
+}
+
+}  // namespace liversim
