@@ -1872,6 +1872,10 @@ Simulated: %2.
         <source>Show the liver semi-transparent, with the scenario&apos;s lesions inside</source>
         <translation>以半透明显示肝脏及其内部的场景病灶</translation>
     </message>
+    <message>
+        <source>The replay ends at %1 s, where the tissue was changed (to %2): what followed was not logged for replay.</source>
+        <translation>回放在 %1 s 处结束，此时组织参数被更改（更改为 %2）：之后的过程未记录，无法回放。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::SessionReviewWindow</name>

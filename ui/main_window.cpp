@@ -810,9 +810,10 @@ void MainWindow::finishModelChange(const ModelChange& change, const ModelChangeB
     return;
   }
   const TissueSpec& tissue = *change.tissue;
+  const EffectsSpec effects = describedScenario().effects;  // a tissue change keeps them
   if (recorder_)
-    recorder_->record_event({servo_->now_s(), SessionEventKind::material_changed,
-                             describe_tissue(tissue, describedScenario().effects)});
+    recorder_->record_event(
+        {servo_->now_s(), SessionEventKind::material_changed, describe_tissue(tissue, effects)});
   setup_.model_options.regions = model->regions;
   if (scenario_) {
     // Sessions recorded from now on store the scenario as it runs, so that they replay with it.
@@ -822,7 +823,7 @@ void MainWindow::finishModelChange(const ModelChange& change, const ModelChangeB
     tissueChangedInFreePractice_ = true;
   }
   changingTissue_ = false;
-  materialPanel_->showTissue(tissue, describedScenario().effects);
+  materialPanel_->showTissue(tissue, effects);
   emit tissueChangeFinished(true);
   applyPendingTissue();
 }
@@ -1214,9 +1215,11 @@ void MainWindow::beginRecording() {
     start.scenario_title = tr("Free practice").toStdString();
     start.scenario_text = "free practice on the built-in liver, " +
                           std::to_string(setup_.mesh.tet_count()) + " tetrahedra";
-    if (tissueChangedInFreePractice_)
-      start.scenario_text += ", tissue changed: " + describe_tissue(describedScenario().parenchyma,
-                                                                    describedScenario().effects);
+    if (tissueChangedInFreePractice_) {
+      const Scenario described = describedScenario();
+      start.scenario_text +=
+          ", tissue changed: " + describe_tissue(described.parenchyma, described.effects);
+    }
   }
   start.device = ownDevice_ ? ownDevice_->name() : omni_ ? omni_->name() : "haptic device";
   start.started_unix_ms = QDateTime::currentMSecsSinceEpoch();

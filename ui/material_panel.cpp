@@ -176,12 +176,8 @@ void MaterialPanel::setBusy(bool busy) {
 }
 
 void MaterialPanel::showError(const QString& message) {
+  showTissue(inUse_, effects_);  // the fields go back to the tissue in use, which stays
   error_->setText(tr("Not applied: %1").arg(message));
-  error_->show();
-  // The fields go back to the tissue in use, which stays.
-  const QString kept = error_->text();
-  showTissue(inUse_, effects_);
-  error_->setText(kept);
   error_->show();
 }
 

@@ -108,13 +108,20 @@ SessionReplayWindow::SessionReplayWindow(const QString& databaseFile, std::int64
     // A session of free practice has no scenario, and so no lesions.
     if (const ScenarioReading reading = read_scenario(scenario_text); reading.scenario)
       lesions_ = visible_lesions(*reading.scenario);
-    for (const SessionEvent& event : store.events(session))
-      if (event.kind == SessionEventKind::integrator_changed && limitNote_.isEmpty())
-        limitNote_ =
-            tr("The replay ends at %1 s, where the integrator was changed (to %2): "
-               "what followed was not logged for replay.")
-                .arg(event.time_s - (frames.empty() ? 0.0 : frames.front().time_s), 0, 'f', 2)
-                .arg(QString::fromStdString(event.detail));
+    // A change of the model ends the session's input log: the replay stops there.
+    for (const SessionEvent& event : store.events(session)) {
+      const bool integrator = event.kind == SessionEventKind::integrator_changed;
+      if (!limitNote_.isEmpty() ||
+          !(integrator || event.kind == SessionEventKind::material_changed))
+        continue;
+      const double at_s = event.time_s - (frames.empty() ? 0.0 : frames.front().time_s);
+      limitNote_ = (integrator ? tr("The replay ends at %1 s, where the integrator was changed "
+                                    "(to %2): what followed was not logged for replay.")
+                               : tr("The replay ends at %1 s, where the tissue was changed (to "
+                                    "%2): what followed was not logged for replay."))
+                       .arg(at_s, 0, 'f', 2)
+                       .arg(QString::fromStdString(event.detail));
+    }
     t0_s_ = frames.empty() ? 0.0 : frames.front().time_s;
     const ForceCurve curve = force_curve(frames, scale ? 1.0 / *scale : 1.0, t0_s_);
     recordedForce_->replace(curve.points);

@@ -28,6 +28,7 @@
 #include <QTest>
 
 #include <filesystem>
+#include <span>
 
 namespace liversim {
 namespace {
@@ -224,7 +225,8 @@ TEST_F(SessionReplayWindowTest, ASessionRecordedBeforeReplaysSaysItCannotBeRepla
 }
 
 // A session on the small resection (its lesion visible to the trainee), written through the
-// storage API as the recorder writes one: a few cycles of simulation input, enough to replay.
+// storage API as the recorder writes one: a few cycles of simulation input, enough to replay, and
+// a tissue change, where its replay stops.
 TEST(SessionReplaySeeThrough, ShowsTheScenarioLesionsThroughTheLiver) {
   QTemporaryDir folder;
   ASSERT_TRUE(folder.isValid());
@@ -253,6 +255,9 @@ TEST(SessionReplaySeeThrough, ShowsTheScenarioLesionsThroughTheLiver) {
       cycles[k].servo_time_s = 0.01 * static_cast<double>(k);
     }
     store.append_inputs(session, cycles);
+    // The Material panel changed the tissue at the end: the replay says it stops there.
+    const SessionEvent changed{0.02, SessionEventKind::material_changed, "E 7000 Pa, nu 0.45"};
+    store.append_events(session, std::span(&changed, 1));
     store.commit();
   }
 
@@ -262,6 +267,8 @@ TEST(SessionReplaySeeThrough, ShowsTheScenarioLesionsThroughTheLiver) {
   ASSERT_TRUE(
       QTest::qWaitFor([&] { return replay.ready() || !replay.problem().isEmpty(); }, kTimeoutMs));
   ASSERT_TRUE(replay.ready()) << replay.problem().toStdString();
+  EXPECT_TRUE(replay.statusText().contains("where the tissue was changed (to E 7000 Pa, nu 0.45)"))
+      << replay.statusText().toStdString();
   ASSERT_NE(replay.scene(), nullptr);
   EXPECT_GT(replay.scene()->shown_lesion_triangle_count(), 0u);
   EXPECT_FALSE(replay.seeThrough());

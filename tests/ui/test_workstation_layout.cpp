@@ -108,6 +108,15 @@ TEST(Workstation, TheWindowLayoutIsRememberedBetweenStarts) {
   EXPECT_EQ(window->dockWidgetArea(material), Qt::LeftDockWidgetArea);
   EXPECT_TRUE(device->isHidden());
   EXPECT_EQ(window->size(), size);
+  window.reset();
+
+  // A damaged layout (another version's, a broken file) is ignored: the default layout.
+  QSettings().setValue("window/state", QByteArray("not a window state"));
+  QSettings().setValue("window/geometry", QByteArray("\x01\x02"));
+  window = openWindow();
+  material = window->findChild<QDockWidget*>("materialDock");
+  EXPECT_EQ(window->dockWidgetArea(material), Qt::RightDockWidgetArea);
+  EXPECT_FALSE(window->findChild<QDockWidget*>("deviceDock")->isHidden());
 }
 
 TEST(Workstation, TheMaterialPanelChangesTheRunningLiversTissue) {
