@@ -40,18 +40,21 @@ struct StudyCommandOptions {
 };
 
 // A bar on stderr, redrawn in place on a terminal, one line per run otherwise (logs, CI).
-void print_progress(int done, int total, const std::string& next) {
+bool print_progress(const StudyProgressReport& report) {
   static const bool terminal = isatty(fileno(stderr)) != 0;
   constexpr int kWidth = 30;
-  const int filled = total > 0 ? done * kWidth / total : kWidth;
+  const int done = report.runs_done, total = report.runs_total;
   if (terminal) {
+    const double runs = done + report.fraction_of_run;
+    const int filled = total > 0 ? static_cast<int>(runs * kWidth / total) : kWidth;
     std::cerr << "\r[" << std::string(static_cast<std::size_t>(filled), '#')
               << std::string(static_cast<std::size_t>(kWidth - filled), '.') << "] " << done << "/"
-              << total << "  " << next.substr(0, 70) << "\x1b[K" << std::flush;
+              << total << "  " << report.running.substr(0, 70) << "\x1b[K" << std::flush;
     if (done == total) std::cerr << "\n";
-  } else {
-    std::cerr << "[" << done << "/" << total << "] " << next << "\n";
+  } else if (report.fraction_of_run == 0.0) {
+    std::cerr << "[" << done << "/" << total << "] " << report.running << "\n";
   }
+  return true;
 }
 
 std::string setting_of(const AccuracyStudyRow& row) {
@@ -61,40 +64,6 @@ std::string setting_of(const AccuracyStudyRow& row) {
 
 std::string group_key(const AccuracyStudyRow& row) {
   return std::to_string(row.tet_count) + "-" + std::string(study_effects_name(row.effects));
-}
-
-// Runs of the group that no other run beats in both error and cost.
-std::vector<bool> pareto_front(const std::vector<const AccuracyStudyRow*>& group) {
-  std::vector<bool> on_front(group.size(), true);
-  for (std::size_t i = 0; i < group.size(); ++i)
-    for (std::size_t j = 0; j < group.size(); ++j)
-      if (i != j && group[j]->max_node_error_m <= group[i]->max_node_error_m &&
-          group[j]->wall_s <= group[i]->wall_s &&
-          (group[j]->max_node_error_m < group[i]->max_node_error_m ||
-           group[j]->wall_s < group[i]->wall_s))
-        on_front[i] = false;
-  return on_front;
-}
-
-void write_csv(const std::filesystem::path& file, const AccuracyStudyOptions& options,
-               const AccuracyStudyResult& result) {
-  std::ofstream csv(file);
-  csv << "tets,effects,integrator,step_s,tolerance_m,mean_step_s,stability_limited_steps,"
-         "smallest_stable_step_s,marked_point_error_m,max_node_error_m,displacement_m,wall_s,"
-         "wall_per_simulated_s,force_evaluations,linear_solves,factorizations,newton_iterations,"
-         "rejected_steps,unconverged_steps,error_estimate_m\n";
-  csv << std::setprecision(8);
-  for (const AccuracyStudyRow& row : result.rows)
-    csv << row.tet_count << ',' << study_effects_name(row.effects) << ','
-        << integrator_name(row.integrator) << ',' << row.step_s << ',' << row.tolerance_m << ','
-        << row.mean_step_s(options) << ',' << row.steps.stability_limited_steps << ','
-        << row.steps.smallest_stable_step_s << ',' << row.marked_point_error_m << ','
-        << row.max_node_error_m << ',' << row.displacement_m << ',' << row.wall_s << ','
-        << row.wall_per_simulated_s(options) << ',' << row.steps.force_evaluations << ','
-        << row.steps.linear_solves << ',' << row.steps.factorizations << ','
-        << row.steps.newton_iterations << ',' << row.steps.rejected_steps << ','
-        << row.steps.unconverged_steps << ',' << row.steps.error_estimate_m << '\n';
-  if (!csv) throw std::runtime_error("cannot write " + file.string());
 }
 
 void write_mesh_csv(const std::filesystem::path& file, const AccuracyStudyResult& result) {
@@ -167,7 +136,11 @@ int run_study(const StudyCommandOptions& command) {
 
   const std::filesystem::path csv = command.output_dir / "accuracy-study.csv";
   const std::filesystem::path mesh_csv = command.output_dir / "accuracy-study-meshes.csv";
-  write_csv(csv, options, result);
+  {
+    std::ofstream csv_file(csv);
+    write_accuracy_study_csv(csv_file, options, result);
+    if (!csv_file) throw std::runtime_error("cannot write " + csv.string());
+  }
   write_mesh_csv(mesh_csv, result);
   std::cout << "wrote " << csv.string() << "\nwrote " << mesh_csv.string() << "\n";
 

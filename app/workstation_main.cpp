@@ -224,8 +224,13 @@ int main(int argc, char** argv) {
                          &QApplication::quit);
     return QApplication::exec();
   } catch (const std::exception& e) {
-    QMessageBox::critical(nullptr, QApplication::translate("main", "LiverSim cannot start"),
-                          QString::fromUtf8(e.what()));
+    QMessageBox::critical(
+        nullptr, QApplication::translate("main", "LiverSim cannot start"),
+        QApplication::translate("main",
+                                "The main window could not be opened: %1\n\nStart LiverSim from a "
+                                "terminal to see its messages; liversim --help lists its options "
+                                "(a smaller liver: --tets N; another scenario: --scenario FILE).")
+            .arg(QString::fromUtf8(e.what())));
     return 1;
   }
 }

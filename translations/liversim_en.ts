@@ -2,6 +2,16 @@
 <!DOCTYPE TS>
 <TS version="2.1" language="en" sourcelanguage="en">
 <context>
+    <name>liversim::AccuracyStudyDialog</name>
+    <message numerus="yes">
+        <source>Done: %n run(s). Select one and press Use This Setting to advance the running liver with it.</source>
+        <translation>
+            <numerusform>Done: %n run. Select it and press Use This Setting to advance the running liver with it.</numerusform>
+            <numerusform>Done: %n runs. Select one and press Use This Setting to advance the running liver with it.</numerusform>
+        </translation>
+    </message>
+</context>
+<context>
     <name>liversim::ScenarioEditor</name>
     <message numerus="yes">
         <source>%n ball(s)</source>

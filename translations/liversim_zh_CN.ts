@@ -20,6 +20,52 @@
     </message>
 </context>
 <context>
+    <name>SessionReading</name>
+    <message>
+        <source>Reading the frames of session %1…</source>
+        <translation>正在读取会话 %1 的帧…</translation>
+    </message>
+    <message>
+        <source>Cancel</source>
+        <translation>取消</translation>
+    </message>
+    <message>
+        <source>Reading a session</source>
+        <translation>正在读取会话</translation>
+    </message>
+    <message>
+        <source>The force trace of session %1 was not read: reading was cancelled. Open the session again to read it.</source>
+        <translation>会话 %1 的力曲线未读取：读取已取消。再次打开该会话即可读取。</translation>
+    </message>
+</context>
+<context>
+    <name>liversim</name>
+    <message>
+        <source>Check that the folder exists and can be written and that its disk is mounted, or start LiverSim with another file (liversim --database FILE).</source>
+        <translation>请检查文件夹是否存在且可写、其磁盘是否已挂载，或用另一个文件启动 LiverSim（liversim --database FILE）。</translation>
+    </message>
+    <message>
+        <source>Make the file and its folder writable, or start LiverSim with another file (liversim --database FILE). The sessions already saved in it are kept.</source>
+        <translation>请使该文件及其文件夹可写，或用另一个文件启动 LiverSim（liversim --database FILE）。其中已保存的会话会保留。</translation>
+    </message>
+    <message>
+        <source>Free space on the disk, then start a new session. The sessions already saved are kept.</source>
+        <translation>请释放磁盘空间，然后开始新的会话。已保存的会话会保留。</translation>
+    </message>
+    <message>
+        <source>Keep a copy of the file and restore it from a backup (sqlite3&apos;s .recover command can rescue what is left), or start LiverSim with a new file (liversim --database FILE).</source>
+        <translation>请保留该文件的副本并从备份恢复（sqlite3 的 .recover 命令可挽救剩余内容），或用新文件启动 LiverSim（liversim --database FILE）。</translation>
+    </message>
+    <message>
+        <source>Choose a LiverSim sessions database, or a new file name (liversim --database FILE).</source>
+        <translation>请选择一个 LiverSim 会话数据库，或一个新文件名（liversim --database FILE）。</translation>
+    </message>
+    <message>
+        <source>Open it with the newer LiverSim that wrote it, or start this one with another file (liversim --database FILE).</source>
+        <translation>请用写入它的较新版 LiverSim 打开，或用另一个文件启动本程序（liversim --database FILE）。</translation>
+    </message>
+</context>
+<context>
     <name>liversim::AccuracyPanel</name>
     <message>
         <source>explicit</source>
@@ -120,6 +166,223 @@
     <message>
         <source>BDF2</source>
         <translation>BDF2</translation>
+    </message>
+    <message>
+        <source>Compare Integrators…</source>
+        <translation>比较积分器…</translation>
+    </message>
+    <message>
+        <source>Measure what each integrator and step costs in time and how far it is from a reference (the accuracy study)</source>
+        <translation>测量每种积分器和步长的时间开销及其与参考解的偏差（精度研究）</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::AccuracyStudyDialog</name>
+    <message>
+        <source>Elastic (neo-Hookean)</source>
+        <translation>弹性（新胡克）</translation>
+    </message>
+    <message>
+        <source>Viscoelastic</source>
+        <translation>黏弹性</translation>
+    </message>
+    <message>
+        <source>Viscoelastic and viscoplastic</source>
+        <translation>黏弹性与黏塑性</translation>
+    </message>
+    <message>
+        <source>Elastic with fibres</source>
+        <translation>弹性加纤维</translation>
+    </message>
+    <message>
+        <source>Accuracy Study: What Accuracy Costs in Time</source>
+        <translation>精度研究：精度的时间代价</translation>
+    </message>
+    <message>
+        <source> tetrahedra</source>
+        <translation> 个四面体</translation>
+    </message>
+    <message>
+        <source>Size of the built-in liver the study runs on (about this many).</source>
+        <translation>研究所用内置肝脏的规模（约为此数）。</translation>
+    </message>
+    <message>
+        <source>The tissue laws simulated (docs/accuracy-study.md gives the parameters).</source>
+        <translation>所模拟的组织本构（参数见 docs/accuracy-study.md）。</translation>
+    </message>
+    <message>
+        <source> ms</source>
+        <translation> ms</translation>
+    </message>
+    <message>
+        <source>Simulated time of each run: the liver is pulled at its marked point, the force rising smoothly to %1 N.</source>
+        <translation>每次运行的模拟时长：在肝脏标记点施加拉力，力平滑上升至 %1 N。</translation>
+    </message>
+    <message>
+        <source>Fixed-step schemes run at 1, 0.5 and 0.25 ms; Dormand–Prince at tolerances 0.1, 0.001 and 0.00001 µm. Errors are against Runge–Kutta 4 at 1/64 of the smallest step.</source>
+        <translation>定步长方法以 1、0.5 和 0.25 ms 运行；Dormand–Prince 以 0.1、0.001 和 0.00001 µm 容差运行。误差以最小步长 1/64 的四阶龙格–库塔为参考。</translation>
+    </message>
+    <message>
+        <source>&amp;Run Study</source>
+        <translation>运行研究(&amp;R)</translation>
+    </message>
+    <message>
+        <source>Cancel</source>
+        <translation>取消</translation>
+    </message>
+    <message>
+        <source>Choose the runs and press Run Study.</source>
+        <translation>选择要运行的内容，然后按“运行研究”。</translation>
+    </message>
+    <message>
+        <source>Integrator</source>
+        <translation>积分器</translation>
+    </message>
+    <message>
+        <source>Setting</source>
+        <translation>设置</translation>
+    </message>
+    <message>
+        <source>Mean step (ms)</source>
+        <translation>平均步长（ms）</translation>
+    </message>
+    <message>
+        <source>Largest error (µm)</source>
+        <translation>最大误差（µm）</translation>
+    </message>
+    <message>
+        <source>Error at the load (µm)</source>
+        <translation>加载点误差（µm）</translation>
+    </message>
+    <message>
+        <source>Cost (s per simulated s)</source>
+        <translation>开销（每模拟秒所需秒数）</translation>
+    </message>
+    <message>
+        <source>Against real time</source>
+        <translation>相对实时</translation>
+    </message>
+    <message>
+        <source>Best trade-off</source>
+        <translation>最佳权衡</translation>
+    </message>
+    <message>
+        <source>Largest distance of any node from the reference at the end.</source>
+        <translation>结束时任一节点与参考解的最大距离。</translation>
+    </message>
+    <message>
+        <source>Wall time of the steps per simulated second, on one thread of this machine: below 1 runs faster than real time.</source>
+        <translation>本机单线程上每模拟秒的步进耗时：小于 1 即快于实时。</translation>
+    </message>
+    <message>
+        <source>No other run is both more accurate and cheaper.</source>
+        <translation>没有其他运行既更精确又更省时。</translation>
+    </message>
+    <message>
+        <source>&amp;Use This Setting</source>
+        <translation>使用此设置(&amp;U)</translation>
+    </message>
+    <message>
+        <source>Advance the running liver with the selected run&apos;s integrator and step.</source>
+        <translation>用所选运行的积分器和步长推进正在运行的肝脏。</translation>
+    </message>
+    <message>
+        <source>&amp;Save as CSV…</source>
+        <translation>另存为 CSV(&amp;S)…</translation>
+    </message>
+    <message>
+        <source>Liver:</source>
+        <translation>肝脏：</translation>
+    </message>
+    <message>
+        <source>Tissue:</source>
+        <translation>组织：</translation>
+    </message>
+    <message>
+        <source>Integrators:</source>
+        <translation>积分器：</translation>
+    </message>
+    <message>
+        <source>Duration:</source>
+        <translation>时长：</translation>
+    </message>
+    <message>
+        <source>Save the study</source>
+        <translation>保存研究结果</translation>
+    </message>
+    <message>
+        <source>CSV (*.csv)</source>
+        <translation>CSV（*.csv）</translation>
+    </message>
+    <message>
+        <source>A study is running: wait for it or cancel it first.</source>
+        <translation>研究正在运行：请等待其完成或先取消。</translation>
+    </message>
+    <message>
+        <source>Check at least one integrator to study.</source>
+        <translation>请至少勾选一个要研究的积分器。</translation>
+    </message>
+    <message>
+        <source>Starting…</source>
+        <translation>正在开始…</translation>
+    </message>
+    <message>
+        <source>Cancelling…</source>
+        <translation>正在取消…</translation>
+    </message>
+    <message>
+        <source>There is no result to save yet: run the study first.</source>
+        <translation>尚无可保存的结果：请先运行研究。</translation>
+    </message>
+    <message>
+        <source>Could not write %1: check that its folder exists and is writable, and that the disk has space.</source>
+        <translation>无法写入 %1：请检查其文件夹是否存在且可写，以及磁盘是否有空间。</translation>
+    </message>
+    <message>
+        <source>Saved %1.</source>
+        <translation>已保存 %1。</translation>
+    </message>
+    <message>
+        <source>Run %1 of %2: %3</source>
+        <translation>第 %1 次运行，共 %2 次：%3</translation>
+    </message>
+    <message>
+        <source>Cancelled: no result was kept.</source>
+        <translation>已取消：未保留任何结果。</translation>
+    </message>
+    <message>
+        <source>The study stopped: %1</source>
+        <translation>研究已停止：%1</translation>
+    </message>
+    <message numerus="yes">
+        <source>Done: %n run(s). Select one and press Use This Setting to advance the running liver with it.</source>
+        <translation>
+            <numerusform>完成：%n 次运行。选择一次并按“使用此设置”，即可用它推进正在运行的肝脏。</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>tolerance %1 µm</source>
+        <translation>容差 %1 µm</translation>
+    </message>
+    <message>
+        <source>step %1 ms</source>
+        <translation>步长 %1 ms</translation>
+    </message>
+    <message>
+        <source>%1× faster</source>
+        <translation>快 %1 倍</translation>
+    </message>
+    <message>
+        <source>%1× slower</source>
+        <translation>慢 %1 倍</translation>
+    </message>
+    <message>
+        <source> (stability-limited)</source>
+        <translation>（受稳定性限制）</translation>
+    </message>
+    <message>
+        <source>yes</source>
+        <translation>是</translation>
     </message>
 </context>
 <context>
@@ -780,6 +1043,14 @@ The scene that was running goes on.</source>
     <message>
         <source>The liver was cut while the tissue changed; enter it again.</source>
         <translation>修改组织参数期间肝脏被切开；请重新输入。</translation>
+    </message>
+    <message>
+        <source>Session %1 is not replayed: reading it was cancelled.</source>
+        <translation>会话 %1 未回放：读取已取消。</translation>
+    </message>
+    <message>
+        <source>Not applied: a model is being built. Try again when it is done.</source>
+        <translation>未应用：正在构建模型。请在完成后重试。</translation>
     </message>
 </context>
 <context>
@@ -1876,6 +2147,10 @@ Simulated: %2.
         <source>The replay ends at %1 s, where the tissue was changed (to %2): what followed was not logged for replay.</source>
         <translation>回放在 %1 s 处结束，此时组织参数被更改（更改为 %2）：之后的过程未记录，无法回放。</translation>
     </message>
+    <message>
+        <source>Session %1 is not replayed: reading it was cancelled. Open the replay again to read it.</source>
+        <translation>会话 %1 未回放：读取已取消。再次打开回放即可读取。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::SessionReviewWindow</name>
@@ -2087,6 +2362,10 @@ Simulated: %2.
         <source>Grades</source>
         <translation>评分</translation>
     </message>
+    <message>
+        <source>Nothing was exported: reading session %1 was cancelled.</source>
+        <translation>未导出任何内容：会话 %1 的读取已取消。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::ToolPanel</name>
@@ -2164,6 +2443,14 @@ Simulated: %2.
     <message>
         <source>A scenario file to run, as with --scenario.</source>
         <translation>要运行的场景文件，与 --scenario 相同。</translation>
+    </message>
+    <message>
+        <source>The main window could not be opened: %1
+
+Start LiverSim from a terminal to see its messages; liversim --help lists its options (a smaller liver: --tets N; another scenario: --scenario FILE).</source>
+        <translation>无法打开主窗口：%1
+
+请从终端启动 LiverSim 以查看其消息；liversim --help 列出其选项（更小的肝脏：--tets N；另一个场景：--scenario FILE）。</translation>
     </message>
 </context>
 </TS>

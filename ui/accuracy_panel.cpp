@@ -61,6 +61,12 @@ AccuracyPanel::AccuracyPanel(QWidget* parent) : QWidget(parent) {
   apply_->setToolTip(
       tr("Rebuilds the model with this integrator and carries the liver's current motion over."));
 
+  study_ = new QPushButton(tr("Compare Integrators…"), this);
+  study_->setObjectName("openAccuracyStudy");
+  study_->setToolTip(
+      tr("Measure what each integrator and step costs in time and how far it is from a reference "
+         "(the accuracy study)"));
+
   inUseLabel_ = new QLabel(this);
   inUseLabel_->setObjectName("accuracyInUse");
   inUseLabel_->setWordWrap(true);
@@ -78,6 +84,7 @@ AccuracyPanel::AccuracyPanel(QWidget* parent) : QWidget(parent) {
   auto* layout = new QVBoxLayout(this);
   layout->addLayout(form);
   layout->addWidget(apply_);
+  layout->addWidget(study_);
   layout->addWidget(inUseLabel_);
   layout->addWidget(error_);
   layout->addStretch(1);
@@ -86,6 +93,7 @@ AccuracyPanel::AccuracyPanel(QWidget* parent) : QWidget(parent) {
           &AccuracyPanel::updateFieldsForIntegrator);
   connect(apply_, &QPushButton::clicked, this,
           [this] { emit applyRequested(requestedSettings()); });
+  connect(study_, &QPushButton::clicked, this, &AccuracyPanel::studyRequested);
   setSettings(inUse_);
 }
 

@@ -43,6 +43,8 @@ class AccuracyPanel : public QWidget {
 
  signals:
   void applyRequested(const liversim::IntegratorSettings& settings);
+  // "Compare Integrators…": the accuracy study, which measures each setting's error and cost.
+  void studyRequested();
 
  private:
   void updateFieldsForIntegrator();
@@ -55,6 +57,7 @@ class AccuracyPanel : public QWidget {
   QLabel* toleranceLabel_ = nullptr;
   QDoubleSpinBox* toleranceUm_ = nullptr;
   QPushButton* apply_ = nullptr;
+  QPushButton* study_ = nullptr;
   QLabel* inUseLabel_ = nullptr;
   QLabel* error_ = nullptr;
 };

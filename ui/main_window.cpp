@@ -1,6 +1,7 @@
 #include "main_window.h"
 
 #include "accuracy_panel.h"
+#include "accuracy_study_dialog.h"
 #include "calibration_dialog.h"
 #include "device_panel.h"
 #include "material_panel.h"
@@ -20,7 +21,9 @@
 #include "liversim/core/session_replay.h"
 #include "liversim/core/surface.h"
 #include "liversim/storage/sqlite_session_store.h"
+#include "session_reading.h"
 #include "session_review_window.h"
+#include "storage_messages.h"
 
 #include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>
@@ -118,6 +121,7 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   accuracyPanel_->setSettings(setup_.model_options.integrator);
   connect(accuracyPanel_, &AccuracyPanel::applyRequested, this,
           [this](const IntegratorSettings& settings) { applyIntegratorSettings(settings); });
+  connect(accuracyPanel_, &AccuracyPanel::studyRequested, this, [this] { openAccuracyStudy(); });
   addPanelDock(tr("Accuracy"), "accuracyDock", accuracyPanel_);
 
   materialPanel_ = new MaterialPanel(this);
@@ -1132,7 +1136,7 @@ bool MainWindow::setSessionsDatabase(const QString& file) {
     sessions_ = std::make_unique<SqliteSessionStore>(std::filesystem::path(file.toStdString()));
     sessionsFile_ = file;
   } catch (const StorageError& e) {
-    sessionsProblem_ = tr("Sessions are not recorded: %1").arg(QString::fromUtf8(e.what()));
+    sessionsProblem_ = storageProblemText(tr("Sessions are not recorded: %1"), e);
     statusBar()->showMessage(sessionsProblem_);
     return false;
   }
@@ -1156,13 +1160,16 @@ bool MainWindow::replaySession(std::int64_t session) {
                                              : sessionsProblem_);
   std::vector<ServoFrame> frames;
   try {
-    frames = sessions_->frames(session);
+    std::optional<std::vector<ServoFrame>> read = readSessionFrames(*sessions_, session, this);
+    if (!read)
+      return refuse(tr("Session %1 is not replayed: reading it was cancelled.").arg(session));
+    frames = std::move(*read);
     // Mapped as it was recorded (sessions before schema 2 kept no mapping: today's).
     replayMapping_ = haptics_.mapping;
     for (const SessionSummary& summary : sessions_->sessions())
       if (summary.id == session && summary.mapping) replayMapping_ = *summary.mapping;
   } catch (const StorageError& e) {
-    return refuse(tr("Cannot replay session %1: %2").arg(session).arg(QString::fromUtf8(e.what())));
+    return refuse(storageProblemText(tr("Cannot replay session %1: %2").arg(session), e));
   }
   if (frames.empty()) return refuse(tr("Session %1 has no device input to replay.").arg(session));
   replayPoints_ = trajectory_of_frames(frames);
@@ -1175,7 +1182,7 @@ void MainWindow::chooseSessionToReplay() {
   try {
     if (sessions_) sessions = sessions_->sessions();
   } catch (const StorageError& e) {
-    sessionsProblem_ = QString::fromUtf8(e.what());
+    sessionsProblem_ = storageProblemText(QStringLiteral("%1"), e);
   }
   QStringList items;
   for (auto it = sessions.rbegin(); it != sessions.rend(); ++it)
@@ -1246,7 +1253,7 @@ void MainWindow::beginRecording() {
     recorder_ = std::make_unique<SessionRecorder>(
         *sessions_, start, [servo](ServoFrame& frame) { return servo->next_logged_frame(frame); });
   } catch (const StorageError& e) {
-    sessionsProblem_ = tr("Sessions are not recorded: %1").arg(QString::fromUtf8(e.what()));
+    sessionsProblem_ = storageProblemText(tr("Sessions are not recorded: %1"), e);
     statusBar()->showMessage(sessionsProblem_);
     return;
   }
@@ -1300,6 +1307,26 @@ QString MainWindow::traineeName() const {
   return QSettings()
       .value("sessions/trainee", qEnvironmentVariable("USER", tr("Trainee")))
       .toString();
+}
+
+AccuracyStudyDialog* MainWindow::openAccuracyStudy() {
+  if (!accuracyStudy_) {
+    accuracyStudy_ = new AccuracyStudyDialog(this);
+    connect(accuracyStudy_, &AccuracyStudyDialog::settingChosen, this,
+            [this](const IntegratorSettings& chosen) {
+              // The study sets the scheme and its step or tolerance; Newton's settings stay.
+              IntegratorSettings settings = setup_.model_options.integrator;
+              settings.kind = chosen.kind;
+              settings.step_s = chosen.step_s;
+              settings.tolerance_m = chosen.tolerance_m;
+              if (!applyIntegratorSettings(settings))
+                statusBar()->showMessage(
+                    tr("Not applied: a model is being built. Try again when it is done."));
+            });
+  }
+  accuracyStudy_->show();
+  accuracyStudy_->raise();
+  return accuracyStudy_;
 }
 
 SessionReviewWindow* MainWindow::openSessionReview() {
@@ -1442,6 +1469,8 @@ void MainWindow::computeSessionMetrics(std::int64_t session, std::optional<Outco
         values.insert(values.end(), simulated.begin(), simulated.end());
       }
       if (!values.empty()) store.store_metrics(session, values);
+    } catch (const StorageError& e) {
+      problem = storageProblemText(tr("The session's metrics were not stored: %1"), e);
     } catch (const std::exception& e) {
       problem = tr("The session's metrics were not stored: %1").arg(QString::fromUtf8(e.what()));
     }

@@ -44,6 +44,7 @@ class QToolBar;
 namespace liversim {
 
 class AccuracyPanel;
+class AccuracyStudyDialog;
 class CalibrationDialog;
 class DevicePanel;
 class LiverScene;
@@ -90,6 +91,9 @@ class MainWindow : public QMainWindow {
   // an earlier change is still being built.
   bool applyIntegratorSettings(const IntegratorSettings& settings);
   bool changingIntegrator() const { return changingIntegrator_; }
+  // The accuracy study (Accuracy panel's "Compare Integrators…"): each integrator's error and
+  // cost measured on the built-in liver; a run's setting chosen there is applied here.
+  AccuracyStudyDialog* openAccuracyStudy();
 
   // The Material panel's tissue for the parenchyma (a scenario's lesions follow as its file
   // describes), applied as an integrator change is: built on a worker, then the liver runs on
@@ -261,6 +265,7 @@ class MainWindow : public QMainWindow {
   std::unique_ptr<LiverScene> scene_;
   VtkViewport* viewport_ = nullptr;
   AccuracyPanel* accuracyPanel_ = nullptr;
+  QPointer<AccuracyStudyDialog> accuracyStudy_;
   ToolPanel* toolPanel_ = nullptr;
   DevicePanel* devicePanel_ = nullptr;
   ScenarioPanel* scenarioPanel_ = nullptr;

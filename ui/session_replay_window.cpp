@@ -2,6 +2,8 @@
 
 #include "force_curve.h"
 #include "render/liver_scene.h"
+#include "session_reading.h"
+#include "storage_messages.h"
 #include "vtk_viewport.h"
 
 #include "liversim/core/scenario.h"
@@ -101,7 +103,9 @@ SessionReplayWindow::SessionReplayWindow(const QString& databaseFile, std::int64
     std::optional<double> scale;
     for (const SessionSummary& summary : store.sessions())
       if (summary.id == session && summary.mapping) scale = summary.mapping->scale;
-    const std::vector<ServoFrame> frames = store.frames(session);
+    const std::optional<std::vector<ServoFrame>> read = readSessionFrames(store, session, parent);
+    if (!read) throw ReadingCancelled();
+    const std::vector<ServoFrame>& frames = *read;
     setup = store.replay_setup(session);
     inputs = store.inputs(session);
     scenario_text = store.scenario_text(session);
@@ -127,7 +131,11 @@ SessionReplayWindow::SessionReplayWindow(const QString& databaseFile, std::int64
     recordedForce_->replace(curve.points);
     largestForceN_ = std::max(curve.largest_n, 0.1);
   } catch (const StorageError& e) {
-    problem_ = tr("Session %1 cannot be read: %2").arg(session).arg(QString::fromUtf8(e.what()));
+    problem_ = storageProblemText(tr("Session %1 cannot be read: %2").arg(session), e);
+  } catch (const ReadingCancelled&) {
+    problem_ = tr("Session %1 is not replayed: reading it was cancelled. Open the replay again "
+                  "to read it.")
+                   .arg(session);
   }
   if (problem_.isEmpty() && !setup)
     problem_ = tr("Session %1 was recorded without its simulation input (by a version before "

@@ -1,7 +1,9 @@
 #include "session_review_window.h"
 
 #include "force_curve.h"
+#include "session_reading.h"
 #include "session_replay_window.h"
+#include "storage_messages.h"
 
 #include "liversim/core/scenario.h"
 #include "liversim/core/session_export.h"
@@ -25,6 +27,7 @@
 #include <QPushButton>
 #include <QSaveFile>
 #include <QScatterSeries>
+#include <QSignalBlocker>
 #include <QSplitter>
 #include <QTableWidget>
 #include <QTextDocument>
@@ -186,7 +189,7 @@ SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
     store_ =
         std::make_unique<SqliteSessionStore>(std::filesystem::path(databaseFile.toStdString()));
   } catch (const StorageError& e) {
-    problem_ = tr("The sessions cannot be read: %1").arg(QString::fromUtf8(e.what()));
+    problem_ = storageProblemText(tr("The sessions cannot be read: %1"), e);
   }
   refresh();
 }
@@ -203,7 +206,7 @@ void SessionReviewWindow::refresh() {
         scores_.push_back(
             grade_against_rubric(rubric_of(*store_, s.id), store_->metrics(s.id)).score_percent);
     } catch (const StorageError& e) {
-      problem_ = tr("The sessions cannot be read: %1").arg(QString::fromUtf8(e.what()));
+      problem_ = storageProblemText(tr("The sessions cannot be read: %1"), e);
       sessions_.clear();
       scores_.clear();
     }
@@ -262,9 +265,15 @@ int SessionReviewWindow::listedSessionCount() const {
 bool SessionReviewWindow::openSession(std::int64_t session) {
   for (int row = 0; row < sessionTable_->rowCount(); ++row)
     if (sessionTable_->item(row, 0)->data(Qt::UserRole).toLongLong() == session) {
-      if (opened_ == session) return true;
+      if (opened_ == session) {
+        if (!traceRead_) showOpenedSession();  // its reading was cancelled: read it now
+        return true;
+      }
       opened_ = session;
-      sessionTable_->selectRow(row);
+      {
+        const QSignalBlocker opening(sessionTable_);  // the selection opens nothing more
+        sessionTable_->selectRow(row);
+      }
       showOpenedSession();
       return true;
     }
@@ -277,6 +286,7 @@ void SessionReviewWindow::showOpenedSession() {
   eventList_->clear();
   metricTable_->setRowCount(0);
   rubric_ = {};
+  traceRead_ = false;
   if (!opened_ || !store_) return;
   try {
     const std::vector<MetricValue> metrics = store_->metrics(*opened_);
@@ -319,12 +329,18 @@ void SessionReviewWindow::showOpenedSession() {
       if (summary.id == *opened_ && summary.mapping) scale = summary.mapping->scale;
     forceSeries_->setName(scale ? tr("Force on the tissue (N)") : tr("Force on the device (N)"));
     const double force_factor = scale ? 1.0 / *scale : 1.0;
-    const std::vector<ServoFrame> frames = store_->frames(*opened_);
+    const std::optional<std::vector<ServoFrame>> read =
+        readSessionFrames(*store_, *opened_, this, readingDialogDelayMs_);
+    traceRead_ = read.has_value();
+    forceChart_->chart()->setTitle(read ? QString() : sessionReadingCancelledText(*opened_));
+    const std::vector<ServoFrame> frames = read.value_or(std::vector<ServoFrame>{});
     const double t0 = frames.empty() ? 0.0 : frames.front().time_s;
     const ForceCurve curve = force_curve(frames, force_factor, t0);
     const double largest = curve.largest_n;
     forceSeries_->replace(curve.points);
-    const std::vector<SessionEvent> events = store_->events(*opened_);
+    // Event times are from the first frame: without the frames they are not listed either.
+    const std::vector<SessionEvent> events =
+        read ? store_->events(*opened_) : std::vector<SessionEvent>{};
     for (const SessionEvent& e : events) {
       const std::string_view kind = session_event_name(e.kind);
       // A mark's detail is kept at full precision; shown to the tenth of a millimetre.
@@ -363,8 +379,7 @@ void SessionReviewWindow::showOpenedSession() {
                       QString::fromStdString(g.comment));
     gradesLabel_->setText(lines.isEmpty() ? tr("none yet") : lines.join('\n'));
   } catch (const StorageError& e) {
-    scoreLabel_->setText(
-        tr("Session %1 cannot be read: %2").arg(*opened_).arg(QString::fromUtf8(e.what())));
+    scoreLabel_->setText(storageProblemText(tr("Session %1 cannot be read: %2").arg(*opened_), e));
   }
 }
 
@@ -435,7 +450,7 @@ bool SessionReviewWindow::saveGrade() {
   try {
     store_->store_grade(*opened_, entry);
   } catch (const StorageError& e) {
-    gradesLabel_->setText(tr("The grade was not saved: %1").arg(QString::fromUtf8(e.what())));
+    gradesLabel_->setText(storageProblemText(tr("The grade was not saved: %1"), e));
     return false;
   }
   gradeEdit_->clear();
@@ -467,7 +482,13 @@ bool SessionReviewWindow::exportCsv(const QString& folder) {
   QString problem;
   try {
     std::ostringstream frames, events, metrics;
-    write_frames_csv(store_->frames(*opened_), frames);
+    const std::optional<std::vector<ServoFrame>> read =
+        readSessionFrames(*store_, *opened_, this, readingDialogDelayMs_);
+    if (!read) {
+      setProblem(tr("Nothing was exported: reading session %1 was cancelled.").arg(*opened_));
+      return false;
+    }
+    write_frames_csv(*read, frames);
     write_events_csv(store_->events(*opened_), events);
     write_metrics_csv(store_->metrics(*opened_), rubric_, metrics);
     const bool written = write_whole(base + "frames.csv", frames.str(), problem) &&
@@ -476,7 +497,7 @@ bool SessionReviewWindow::exportCsv(const QString& folder) {
     setProblem(written ? QString() : problem);
     return written;
   } catch (const StorageError& e) {
-    setProblem(tr("Session %1 cannot be read: %2").arg(*opened_).arg(QString::fromUtf8(e.what())));
+    setProblem(storageProblemText(tr("Session %1 cannot be read: %2").arg(*opened_), e));
     return false;
   }
 }

@@ -6,6 +6,7 @@
 
 #include "liversim/core/grading.h"
 #include "liversim/core/session_log.h"
+#include "session_reading.h"
 
 #include <QPointer>
 #include <QString>
@@ -52,6 +53,11 @@ class SessionReviewWindow : public QWidget {
   // Opens a session in the lower half; false when it is not listed.
   bool openSession(std::int64_t session);
   std::optional<std::int64_t> openedSession() const { return opened_; }
+  // Whether the opened session's frames were read: a long session shows a progress dialog whose
+  // Cancel leaves the trace and events out (opening the session again reads them).
+  bool traceRead() const { return traceRead_; }
+  // How long reading goes on before its progress dialog appears (session_reading.h).
+  void setReadingDialogDelayMs(int delayMs) { readingDialogDelayMs_ = delayMs; }
 
   // What the opened session shows.
   const RubricResult& rubricResult() const { return rubric_; }
@@ -88,6 +94,8 @@ class SessionReviewWindow : public QWidget {
   QString filter_;
   std::optional<QString> trainee_;
   std::optional<std::int64_t> opened_;
+  bool traceRead_ = false;
+  int readingDialogDelayMs_ = kSessionReadingDialogDelayMs;
   std::vector<RubricCriterion> openedRubric_;
   RubricResult rubric_;
 

@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <ostream>
 #include <sstream>
 #include <stdexcept>
 
@@ -83,9 +85,12 @@ struct RunOutcome {
   StepReport steps;
 };
 
+// Reports the run's progress after each load interval; throws StudyCancelled when asked to stop.
+using RunProgress = std::function<void(double fraction_of_run)>;
+
 RunOutcome run_case(const SimModel& model, const LoadPatch& patch,
                     const AccuracyStudyOptions& options, double load_interval_s,
-                    const std::string& what) {
+                    const std::string& what, const RunProgress& run_progress) {
   SimState state = make_rest_state(model);
   std::vector<PointLoad> loads;
   const auto intervals = static_cast<int>(std::lround(options.duration_s / load_interval_s));
@@ -100,6 +105,7 @@ RunOutcome run_case(const SimModel& model, const LoadPatch& patch,
     if (!state.position_m.at(patch.marked_node).allFinite())
       throw std::runtime_error(
           what + ": the motion stopped being finite at t = " + std::to_string(state.time_s) + " s");
+    run_progress(static_cast<double>(k + 1) / intervals);
   }
   outcome.position_m = std::move(state.position_m);
   return outcome;
@@ -205,9 +211,14 @@ AccuracyStudyResult run_accuracy_study(const AccuracyStudyOptions& options,
                                                                      : options.steps_s.size());
   const int total =
       runs_per_mesh * static_cast<int>(options.tet_counts.size() * options.effects.size());
-  int done = 0;
-  auto report_progress = [&](const std::string& next) {
-    if (progress) progress(done, total, next);
+  StudyProgressReport report{0, total, {}, 0.0};
+  auto report_progress = [&](double fraction_of_run) {
+    report.fraction_of_run = fraction_of_run;
+    if (progress && !progress(report)) throw StudyCancelled();
+  };
+  auto start_run = [&](std::string what) {
+    report.running = std::move(what);
+    report_progress(0.0);
   };
 
   // The finest mesh first: its marked node is the material point of the mesh comparison.
@@ -232,13 +243,13 @@ AccuracyStudyResult run_accuracy_study(const AccuracyStudyOptions& options,
       ModelOptions reference_options = base;
       reference_options.integrator.kind = IntegratorKind::rk4;
       reference_options.integrator.step_s = smallest_step / options.reference_refinement;
-      report_progress(label.str() + ": reference");
+      start_run(label.str() + ": reference");
       const SimModel reference_model = build_model(scene.mesh, reference_options);
       const LoadPatch patch =
           make_load_patch(scene.mesh, reference_model, marked, options.load_radius_m);
-      const RunOutcome reference =
-          run_case(reference_model, patch, options, largest_step, label.str() + " reference");
-      ++done;
+      const RunOutcome reference = run_case(reference_model, patch, options, largest_step,
+                                            label.str() + " reference", report_progress);
+      ++report.runs_done;
       MeshConvergenceRow mesh_row;
       mesh_row.requested_tets = tets;
       mesh_row.tet_count = scene.mesh.tet_count();
@@ -259,10 +270,11 @@ AccuracyStudyResult run_accuracy_study(const AccuracyStudyOptions& options,
           std::ostringstream what;
           what << label.str() << ", " << integrator_name(kind)
                << (adaptive ? ", tolerance " : ", step ") << setting << (adaptive ? " m" : " s");
-          report_progress(what.str());
+          start_run(what.str());
           const SimModel model = build_model(scene.mesh, run_options);
-          const RunOutcome run = run_case(model, patch, options, largest_step, what.str());
-          ++done;
+          const RunOutcome run =
+              run_case(model, patch, options, largest_step, what.str(), report_progress);
+          ++report.runs_done;
           AccuracyStudyRow row;
           row.requested_tets = tets;
           row.tet_count = scene.mesh.tet_count();
@@ -289,8 +301,40 @@ AccuracyStudyResult run_accuracy_study(const AccuracyStudyOptions& options,
     for (const MeshConvergenceRow& finest : result.mesh_rows)
       if (finest.effects == row.effects && finest.requested_tets == tet_counts.front())
         row.difference_from_finest_m = (row.displacement_m - finest.displacement_m).norm();
-  if (progress) progress(done, total, "done");
+  start_run("done");
   return result;
+}
+
+std::vector<bool> pareto_front(const std::vector<const AccuracyStudyRow*>& runs) {
+  std::vector<bool> on_front(runs.size(), true);
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    for (std::size_t j = 0; j < runs.size(); ++j)
+      if (i != j && runs[j]->max_node_error_m <= runs[i]->max_node_error_m &&
+          runs[j]->wall_s <= runs[i]->wall_s &&
+          (runs[j]->max_node_error_m < runs[i]->max_node_error_m ||
+           runs[j]->wall_s < runs[i]->wall_s))
+        on_front[i] = false;
+  return on_front;
+}
+
+void write_accuracy_study_csv(std::ostream& csv, const AccuracyStudyOptions& options,
+                              const AccuracyStudyResult& result) {
+  csv << "tets,effects,integrator,step_s,tolerance_m,mean_step_s,stability_limited_steps,"
+         "smallest_stable_step_s,marked_point_error_m,max_node_error_m,displacement_m,wall_s,"
+         "wall_per_simulated_s,force_evaluations,linear_solves,factorizations,newton_iterations,"
+         "rejected_steps,unconverged_steps,error_estimate_m\n";
+  const auto precision = csv.precision(8);
+  for (const AccuracyStudyRow& row : result.rows)
+    csv << row.tet_count << ',' << study_effects_name(row.effects) << ','
+        << integrator_name(row.integrator) << ',' << row.step_s << ',' << row.tolerance_m << ','
+        << row.mean_step_s(options) << ',' << row.steps.stability_limited_steps << ','
+        << row.steps.smallest_stable_step_s << ',' << row.marked_point_error_m << ','
+        << row.max_node_error_m << ',' << row.displacement_m << ',' << row.wall_s << ','
+        << row.wall_per_simulated_s(options) << ',' << row.steps.force_evaluations << ','
+        << row.steps.linear_solves << ',' << row.steps.factorizations << ','
+        << row.steps.newton_iterations << ',' << row.steps.rejected_steps << ','
+        << row.steps.unconverged_steps << ',' << row.steps.error_estimate_m << '\n';
+  csv.precision(precision);
 }
 
 }  // namespace liversim

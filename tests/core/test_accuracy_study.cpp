@@ -25,11 +25,14 @@ TEST(AccuracyStudy, MeasuresEveryRunOfTheGrid) {
   const AccuracyStudyOptions options = small_study();
   int calls = 0, last_done = -1, total = 0;
   const AccuracyStudyResult result =
-      run_accuracy_study(options, [&](int done, int all, const std::string&) {
-        EXPECT_GE(done, last_done);
-        last_done = done;
-        total = all;
+      run_accuracy_study(options, [&](const StudyProgressReport& report) {
+        EXPECT_GE(report.runs_done, last_done);
+        EXPECT_GE(report.fraction_of_run, 0.0);
+        EXPECT_LE(report.fraction_of_run, 1.0);
+        last_done = report.runs_done;
+        total = report.runs_total;
         ++calls;
+        return true;
       });
   ASSERT_EQ(result.rows.size(), 6u);  // 3 integrators × 2 steps
   EXPECT_EQ(total, 7);                // and the reference
@@ -58,6 +61,36 @@ TEST(AccuracyStudy, MeasuresEveryRunOfTheGrid) {
   EXPECT_LT(row_of(IntegratorKind::rk4, 2.5e-4).max_node_error_m,
             row_of(IntegratorKind::central_difference, 2.5e-4).max_node_error_m);
   EXPECT_GT(row_of(IntegratorKind::backward_euler, 2.5e-4).steps.linear_solves, 0);
+}
+
+// A cancel is honoured within the run under way, not only between runs: a reference of many
+// small steps can take long.
+TEST(AccuracyStudy, ACancelStopsTheRunUnderWayAtItsNextLoadInterval) {
+  AccuracyStudyOptions options = small_study();
+  int reports = 0;
+  double last_fraction = -1.0;
+  EXPECT_THROW(run_accuracy_study(options,
+                                  [&](const StudyProgressReport& report) {
+                                    ++reports;
+                                    last_fraction = report.fraction_of_run;
+                                    EXPECT_EQ(report.runs_done, 0);
+                                    EXPECT_NE(report.running.find("reference"), std::string::npos);
+                                    return report.fraction_of_run == 0.0;  // cancel mid-run
+                                  }),
+               StudyCancelled);
+  // The start of the reference, then the end of its first load interval (of 4: 2 ms at 0.5 ms).
+  EXPECT_EQ(reports, 2);
+  EXPECT_DOUBLE_EQ(last_fraction, 0.25);
+}
+
+TEST(AccuracyStudy, TheBestTradeOffsAreTheRunsNoOtherBeatsInErrorAndCost) {
+  AccuracyStudyRow cheap_rough, dear_fine, dominated, tie;
+  cheap_rough.max_node_error_m = 1e-4, cheap_rough.wall_s = 1.0;
+  dear_fine.max_node_error_m = 1e-7, dear_fine.wall_s = 9.0;
+  dominated.max_node_error_m = 2e-4, dominated.wall_s = 3.0;  // rougher and dearer than the first
+  tie = cheap_rough;                                          // equal runs do not beat each other
+  const std::vector<bool> front = pareto_front({&cheap_rough, &dear_fine, &dominated, &tie});
+  EXPECT_EQ(front, (std::vector<bool>{true, true, false, true}));
 }
 
 TEST(AccuracyStudy, ObservedOrderIsUndefinedForAStabilityLimitedRun) {

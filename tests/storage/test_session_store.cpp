@@ -87,6 +87,16 @@ std::string open_error(const fs::path& file,
   return "";
 }
 
+// The kind of problem opening the file for writing meets (other: none met).
+StorageProblem open_problem(const fs::path& file) {
+  try {
+    SqliteSessionStore store(file);
+  } catch (const StorageError& e) {
+    return e.problem();
+  }
+  return StorageProblem::other;
+}
+
 // open_error in a child process running as the user "nobody" (uid 65534).
 std::string open_error_as_nobody(const fs::path& file) {
   int channel[2];
@@ -147,6 +157,40 @@ TEST(SessionStore, SixtySecondsAtOneKilohertzReadBackExactly) {
   expect_same_frames(store.frames(session), frames);
   // 84 bytes a frame in the chunks, plus SQLite's pages: well under a row per frame's cost.
   std::printf("60 s at 1 kHz: %.1f MB on disk\n", static_cast<double>(fs::file_size(file)) / 1e6);
+}
+
+// A long session is read with progress after each chunk, and a cancel stops it mid-way without
+// harming the connection: the next reading gets every frame.
+TEST(SessionStore, ReadingFramesReportsProgressPerChunkAndCanBeCancelled) {
+  const fs::path file = fresh_database("reading-progress");
+  const std::vector<ServoFrame> frames = synthetic_frames(1000, 4);
+  SqliteSessionStore store(file);
+  const std::int64_t session = store.begin_session(start_of("Trainee A", "{}"));
+  for (std::size_t first = 0; first < frames.size(); first += 50) {
+    store.append_frames(session, std::span(frames).subspan(first, 50));
+    store.commit();
+  }
+  std::vector<std::size_t> read;
+  const std::vector<ServoFrame> all =
+      store.frames(session, [&](std::size_t done, std::size_t total) {
+        EXPECT_EQ(total, frames.size());
+        read.push_back(done);
+        return true;
+      });
+  expect_same_frames(all, frames);
+  ASSERT_EQ(read.size(), 21u);  // before the first chunk, then after each of the 20
+  for (std::size_t i = 0; i < read.size(); ++i) EXPECT_EQ(read[i], 50 * i);
+
+  int reports = 0;
+  EXPECT_THROW(store.frames(session,
+                            [&](std::size_t done, std::size_t) {
+                              ++reports;
+                              return done < 300;  // stop after the sixth chunk
+                            }),
+               ReadingCancelled);
+  EXPECT_EQ(reports, 7);
+  expect_same_frames(store.frames(session), frames);
+  EXPECT_TRUE(store.frames(999, [](std::size_t, std::size_t total) { return total == 0; }).empty());
 }
 
 TEST(SessionStore, KeepsTheExactScenarioOnceAndTheEventsInOrder) {
@@ -493,17 +537,23 @@ TEST(SessionStore, RefusesFilesItCannotUseWithTheFileAndTheReasonNamed) {
   std::string message = open_error(text);
   EXPECT_NE(message.find(text.string()), std::string::npos) << message;
   EXPECT_NE(message.find("not a database"), std::string::npos) << message;
+  // Each refusal also says what kind of problem it is, for the workstation's advice.
+  EXPECT_EQ(open_problem(text), StorageProblem::not_a_database);
   // Another program's database.
   const fs::path foreign = fresh_database("foreign");
   run_sql(foreign, "CREATE TABLE invoices (id INTEGER PRIMARY KEY)");
   message = open_error(foreign);
   EXPECT_NE(message.find("not a LiverSim sessions database"), std::string::npos) << message;
+  EXPECT_EQ(open_problem(foreign), StorageProblem::not_a_database);
   // Written by a newer LiverSim.
   const fs::path newer = fresh_database("newer");
   { SqliteSessionStore store(newer); }
   run_sql(newer, "PRAGMA user_version = 7");
   message = open_error(newer);
   EXPECT_NE(message.find("newer LiverSim (schema version 7"), std::string::npos) << message;
+  EXPECT_EQ(open_problem(newer), StorageProblem::newer_version);
+  EXPECT_EQ(open_problem(fresh_database("no-such-folder") / "sessions.sqlite"),
+            StorageProblem::unreachable);
   // A file its user may not write: root may write any file, so as root the attempt is made by a
   // child process that has become the unprivileged user "nobody".
   const fs::path locked = fresh_database("read-only-file");
@@ -523,6 +573,7 @@ TEST(SessionStore, RefusesFilesItCannotUseWithTheFileAndTheReasonNamed) {
     ADD_FAILURE() << "a read-only store began a session";
   } catch (const StorageError& e) {
     EXPECT_NE(std::string(e.what()).find("read-only"), std::string::npos) << e.what();
+    EXPECT_EQ(e.problem(), StorageProblem::read_only);
   }
 }
 
@@ -545,6 +596,7 @@ TEST(SessionStore, ADamagedFileGivesAClearMessageAndNoCrash) {
     for (int i = 0; i < 64 * 1024; ++i) bytes.put(static_cast<char>(random()));
   }
   std::string message;
+  StorageProblem problem = StorageProblem::other;
   try {
     SqliteSessionStore store(file);
     const std::string check = store.integrity_check();
@@ -553,11 +605,13 @@ TEST(SessionStore, ADamagedFileGivesAClearMessageAndNoCrash) {
     store.sessions();
   } catch (const StorageError& e) {
     message = e.what();
+    problem = e.problem();
   }
   ASSERT_FALSE(message.empty()) << "the damage went unnoticed";
   if (message.rfind("integrity: ", 0) != 0) {
     EXPECT_NE(message.find(file.string()), std::string::npos) << message;
     EXPECT_NE(message.find("damaged"), std::string::npos) << message;
+    EXPECT_EQ(problem, StorageProblem::damaged);
   }
 }
 
@@ -599,6 +653,39 @@ TEST(SessionRecorder, AFullDiskStopsTheRecordingAndKeepsWhatWasCommitted) {
   const std::vector<ServoFrame> read = reader.frames(recorder.session());
   ASSERT_EQ(static_cast<std::int64_t>(read.size()), kept);
   expect_same_frames(read, std::vector<ServoFrame>(frames.begin(), frames.begin() + kept));
+}
+
+// The store itself says a full file is full, as a kind the workstation gives advice for.
+TEST(SessionStore, AFullFileIsReportedAsADiskFullProblem) {
+  const fs::path file = fresh_database("full-store");
+  SqliteSessionStore store(file);
+  const std::int64_t session = store.begin_session(start_of("Trainee A", "{}"));
+  store.limit_pages_for_testing(32);
+  const std::vector<ServoFrame> frames = synthetic_frames(2000, 7);
+  try {
+    for (int commit = 0; commit < 1000; ++commit) {
+      store.append_frames(session, frames);
+      store.commit();
+    }
+    ADD_FAILURE() << "the file never filled";
+  } catch (const StorageError& e) {
+    EXPECT_EQ(e.problem(), StorageProblem::disk_full) << e.what();
+  }
+}
+
+// Found by fuzzing (docs/fuzzing.md): a file whose schema version (SQLite's user_version) is
+// negative was taken for an old LiverSim file and "migrated" from a version that indexes no
+// migration. It is another program's file, and refused as one, for reading and for writing.
+TEST(SessionStore, AFileWithANegativeSchemaVersionIsNotTakenForOneToMigrate) {
+  const fs::path file = fresh_database("negative-version");
+  run_sql(file, "PRAGMA user_version = -7");
+  for (const auto access :
+       {SqliteSessionStore::Access::read_write, SqliteSessionStore::Access::read_only}) {
+    EXPECT_EQ(open_error(file, access),
+              "sessions database " + file.string() +
+                  ": not a LiverSim sessions database (its schema version is -7, below 0)");
+  }
+  EXPECT_EQ(open_problem(file), StorageProblem::not_a_database);
 }
 
 }  // namespace

@@ -32,6 +32,7 @@
 #include "palpation_points.h"
 #include "scenario_panel.h"
 #include "session_review_window.h"
+#include "storage_messages.h"
 #include "tool_panel.h"
 
 namespace liversim {
@@ -264,6 +265,9 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   std::ofstream(not_a_database.toStdString()) << "not a database\n";
   EXPECT_FALSE(window_->setSessionsDatabase(not_a_database));
   EXPECT_TRUE(window_->sessionsProblem().contains("notes.txt"))
+      << window_->sessionsProblem().toStdString();
+  // What to do about it is said too.
+  EXPECT_TRUE(window_->sessionsProblem().contains(storageAdvice(StorageProblem::not_a_database)))
       << window_->sessionsProblem().toStdString();
   ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
   EXPECT_FALSE(window_->recordingSession().has_value());

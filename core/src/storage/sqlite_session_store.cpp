@@ -138,6 +138,7 @@ enum StatementId {
   kEndSession,
   kSessions,
   kChunks,
+  kChunkFrameSum,
   kEvents,
   kScenarioText,
   kStoreMetric,
@@ -242,7 +243,7 @@ SqliteSessionStore::SqliteSessionStore(const std::filesystem::path& file, Access
     const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
     db_ = nullptr;
-    throw error("cannot open it (" + message + ")");
+    throw error("cannot open it (" + message + ")", StorageProblem::unreachable);
   }
   statements_.resize(kStatementCount);
   try {
@@ -250,14 +251,21 @@ SqliteSessionStore::SqliteSessionStore(const std::filesystem::path& file, Access
     sqlite3_busy_timeout(db_, 2000);
     // Reading the version reads the header: a file that is no database fails here.
     const int version = schema_version();
+    // LiverSim writes 1, 2, ...: another program's number would index no migration.
+    if (version < 0)
+      throw error("not a LiverSim sessions database (its schema version is " +
+                      std::to_string(version) + ", below 0)",
+                  StorageProblem::not_a_database);
     if (version > kSchemaVersion)
       throw error("written by a newer LiverSim (schema version " + std::to_string(version) +
-                  "; this one reads up to " + std::to_string(kSchemaVersion) + ")");
+                      "; this one reads up to " + std::to_string(kSchemaVersion) + ")",
+                  StorageProblem::newer_version);
     if (access == Access::read_write && sqlite3_db_readonly(db_, "main") == 1)
-      throw error("cannot write to it (the file is read-only)");
+      throw error("cannot write to it (the file is read-only)", StorageProblem::read_only);
     if (version == 0) {
       if (Statement(*this, "SELECT count(*) FROM sqlite_master").single_integer("reading it") != 0)
-        throw error("not a LiverSim sessions database (it holds other tables)");
+        throw error("not a LiverSim sessions database (it holds other tables)",
+                    StorageProblem::not_a_database);
     }
     if (access == Access::read_write) {
       execute("PRAGMA journal_mode = WAL", "opening it for writing");
@@ -292,33 +300,42 @@ SqliteSessionStore::~SqliteSessionStore() {
   sqlite3_close(db_);
 }
 
-StorageError SqliteSessionStore::error(const std::string& what) const {
-  return StorageError("sessions database " + file_.string() + ": " + what);
+StorageError SqliteSessionStore::error(const std::string& what, StorageProblem problem) const {
+  return StorageError("sessions database " + file_.string() + ": " + what, problem);
 }
 
 void SqliteSessionStore::fail(const std::string& doing) {
   const int code = sqlite3_extended_errcode(db_);
   std::string what = sqlite3_errmsg(db_);
+  StorageProblem problem = StorageProblem::other;
   switch (code & 0xff) {
     case SQLITE_FULL:
       what = "the disk or the database is full (" + what + ")";
+      problem = StorageProblem::disk_full;
       break;
     case SQLITE_CORRUPT:
       what = "the file is damaged (" + what + ")";
+      problem = StorageProblem::damaged;
       break;
     case SQLITE_NOTADB:
       what = "not a database file (" + what + ")";
+      problem = StorageProblem::not_a_database;
       break;
     case SQLITE_READONLY:
       what = "the file is read-only (" + what + ")";
+      problem = StorageProblem::read_only;
       break;
     case SQLITE_IOERR:
       what = "the file could not be read or written (" + what + ")";
+      problem = StorageProblem::unreachable;
+      break;
+    case SQLITE_CANTOPEN:
+      problem = StorageProblem::unreachable;
       break;
     default:
       break;
   }
-  throw error(doing + " failed: " + what);
+  throw error(doing + " failed: " + what, problem);
 }
 
 void SqliteSessionStore::execute(const char* sql, const char* doing) {
@@ -679,10 +696,18 @@ std::vector<SessionSummary> SqliteSessionStore::sessions() {
 
 template <typename Item, typename Decode>
 std::vector<Item> SqliteSessionStore::chunks_of(std::int64_t session, Statement& chunks,
-                                                const std::string& items, int layout,
-                                                Decode decode) {
+                                                const std::string& items, int layout, Decode decode,
+                                                const ReadingProgress& progress,
+                                                std::size_t total) {
   chunks.bind(1, session);
-  std::vector<Item> result;
+  std::vector<Item> result;  // not reserved from `total`: a damaged file may claim any count
+  const auto report = [&] {
+    if (progress && !progress(result.size(), total)) {
+      chunks.reset();
+      throw ReadingCancelled();
+    }
+  };
+  report();
   try {
     while (chunks.step(("reading " + items).c_str())) {
       if (chunks.integer(0) != static_cast<std::int64_t>(result.size()))
@@ -690,24 +715,38 @@ std::vector<Item> SqliteSessionStore::chunks_of(std::int64_t session, Statement&
                            std::to_string(chunks.integer(0)) + " are missing");
       if (chunks.integer(1) != layout)
         throw StorageError("a chunk of " + items + " has layout " +
-                           std::to_string(chunks.integer(1)) + ", which this version cannot read");
+                               std::to_string(chunks.integer(1)) +
+                               ", which this version cannot read",
+                           StorageProblem::newer_version);
       std::vector<Item> part = decode(chunks.blob(2));
       std::move(part.begin(), part.end(), std::back_inserter(result));
+      report();
     }
   } catch (const StorageError& e) {
     chunks.reset();
-    throw error("session " + std::to_string(session) + ": " + e.what());
+    // A chunk that does not decode, or is missing, is damage.
+    throw error("session " + std::to_string(session) + ": " + e.what(),
+                e.problem() == StorageProblem::other ? StorageProblem::damaged : e.problem());
   }
   chunks.reset();
   return result;
 }
 
-std::vector<ServoFrame> SqliteSessionStore::frames(std::int64_t session) {
+std::vector<ServoFrame> SqliteSessionStore::frames(std::int64_t session,
+                                                   const ReadingProgress& progress) {
+  std::size_t total = 0;
+  if (progress) {
+    total = static_cast<std::size_t>(
+        prepared(kChunkFrameSum,
+                 "SELECT COALESCE(SUM(frame_count), 0) FROM frame_chunks WHERE session_id = ?1")
+            .bind(1, session)
+            .single_integer("counting frames"));
+  }
   return chunks_of<ServoFrame>(session,
                                prepared(kChunks,
                                         "SELECT first_frame, layout, data FROM frame_chunks "
                                         "WHERE session_id = ?1 ORDER BY first_frame"),
-                               "frames", kFrameChunkLayout, decode_frame_chunk);
+                               "frames", kFrameChunkLayout, decode_frame_chunk, progress, total);
 }
 
 std::vector<SessionEvent> SqliteSessionStore::events(std::int64_t session) {

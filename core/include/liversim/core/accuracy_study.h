@@ -7,7 +7,9 @@
 #include "liversim/core/integrator.h"
 
 #include <functional>
+#include <iosfwd>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -90,13 +92,34 @@ struct AccuracyStudyResult {
 // not positive or either run was stability-limited (its step was not the requested one).
 double observed_order(const AccuracyStudyRow& coarse, const AccuracyStudyRow& fine);
 
-// Progress: runs finished, runs in all, and what runs next.
-using StudyProgress = std::function<void(int done, int total, const std::string& next)>;
+// Where a study is: runs finished, runs in all, the run under way and how far it has got (0 at
+// its start, then after each load interval), so a reference run of many small steps still shows
+// progress and can be cancelled.
+struct StudyProgressReport {
+  int runs_done = 0;
+  int runs_total = 0;
+  std::string running;  // "3841 tets, elastic, rk4, step 0.0005 s"; "done" at the end
+  double fraction_of_run = 0.0;
+};
+// Returning false cancels the study (StudyCancelled).
+using StudyProgress = std::function<bool(const StudyProgressReport&)>;
+
+struct StudyCancelled : std::runtime_error {
+  StudyCancelled() : std::runtime_error("the accuracy study was cancelled") {}
+};
 
 // Throws std::invalid_argument naming a bad option (empty lists, non-positive steps or
-// tolerances, a step that does not divide the load interval) and std::runtime_error when a run
-// stops being finite.
+// tolerances, a step that does not divide the load interval), std::runtime_error when a run
+// stops being finite, and StudyCancelled when `progress` returns false.
 AccuracyStudyResult run_accuracy_study(const AccuracyStudyOptions& options,
                                        const StudyProgress& progress = {});
+
+// The runs of one mesh and effect set that no other run of theirs beats in both error (largest
+// over the nodes) and cost (wall time): the best trade-offs. True at the index of each.
+std::vector<bool> pareto_front(const std::vector<const AccuracyStudyRow*>& runs);
+
+// One line per run, with a header: what `study accuracy` writes to accuracy-study.csv.
+void write_accuracy_study_csv(std::ostream& csv, const AccuracyStudyOptions& options,
+                              const AccuracyStudyResult& result);
 
 }  // namespace liversim

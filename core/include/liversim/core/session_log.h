@@ -9,7 +9,9 @@
 #include "liversim/core/simulation_input.h"
 #include "liversim/core/trace_metrics.h"
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -21,9 +23,25 @@ namespace liversim {
 
 // A storage failure: names the database file and what is wrong with it (read-only, damaged, full,
 // written by a newer version...).
+// What kind of trouble a storage error is, so that an interface can say what to do about it.
+enum class StorageProblem {
+  other,
+  unreachable,     // cannot be opened: no such folder, no permission, the disk gone
+  read_only,       // the file or its folder cannot be written
+  disk_full,       // the disk, or the database's page limit, is full
+  damaged,         // the file is corrupt
+  not_a_database,  // not a (LiverSim) database
+  newer_version,   // written by a newer LiverSim
+};
+
 class StorageError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit StorageError(const std::string& what, StorageProblem problem = StorageProblem::other)
+      : std::runtime_error(what), problem_(problem) {}
+  StorageProblem problem() const { return problem_; }
+
+ private:
+  StorageProblem problem_;
 };
 
 enum class SessionEventKind {
@@ -137,6 +155,13 @@ std::vector<std::uint8_t> encode_input_chunk(std::span<const SimulationInput> in
 // Throws StorageError when the bytes are not a layout-1 input chunk, naming what is wrong.
 std::vector<SimulationInput> decode_input_chunk(std::span<const std::uint8_t> bytes);
 
+// Reading a long session's frames (ten minutes at 1 kHz are 600 000): frames read so far and in
+// the session, after each chunk. Returning false stops the reading (ReadingCancelled).
+using ReadingProgress = std::function<bool(std::size_t frames_read, std::size_t frames_total)>;
+struct ReadingCancelled : std::runtime_error {
+  ReadingCancelled() : std::runtime_error("reading the session was cancelled") {}
+};
+
 // Where sessions go. One writer: the recorder's thread calls the writing functions; a writer's
 // appends become durable together at commit(). Every function may throw StorageError.
 class SessionStore {
@@ -165,7 +190,8 @@ class SessionStore {
 
   virtual std::vector<SessionSummary> sessions() = 0;
   virtual std::vector<MetricValue> metrics(std::int64_t session) = 0;  // by name
-  virtual std::vector<ServoFrame> frames(std::int64_t session) = 0;
+  std::vector<ServoFrame> frames(std::int64_t session) { return frames(session, {}); }
+  virtual std::vector<ServoFrame> frames(std::int64_t session, const ReadingProgress& progress) = 0;
   virtual std::vector<SessionEvent> events(std::int64_t session) = 0;
   // What a replay needs: how the scene was built (none: not recorded) and the input log.
   virtual std::optional<ReplaySetup> replay_setup(std::int64_t session) = 0;

@@ -50,7 +50,8 @@ class SqliteSessionStore final : public SessionStore {
   std::vector<SessionGrade> grades(std::int64_t session) override;
   std::vector<SessionSummary> sessions() override;
   std::vector<MetricValue> metrics(std::int64_t session) override;
-  std::vector<ServoFrame> frames(std::int64_t session) override;
+  using SessionStore::frames;
+  std::vector<ServoFrame> frames(std::int64_t session, const ReadingProgress& progress) override;
   std::vector<SessionEvent> events(std::int64_t session) override;
   std::string scenario_text(std::int64_t session) override;
   std::optional<ReplaySetup> replay_setup(std::int64_t session) override;
@@ -61,14 +62,16 @@ class SqliteSessionStore final : public SessionStore {
   void execute(const char* sql, const char* doing);
   void begin_if_needed();
   // An error about this file: "sessions database FILE: what".
-  StorageError error(const std::string& what) const;
+  StorageError error(const std::string& what, StorageProblem problem = StorageProblem::other) const;
   [[noreturn]] void fail(const std::string& doing);
   Statement& prepared(int which, const char* sql);
   // The session's chunks of `items` ("frames", "inputs") from `chunks` (first item, layout, data,
-  // in order), decoded and joined; a gap or a layout this version cannot read is named.
+  // in order), decoded and joined; a gap or a layout this version cannot read is named. With
+  // `progress`, `total` is how many items there are.
   template <typename Item, typename Decode>
   std::vector<Item> chunks_of(std::int64_t session, Statement& chunks, const std::string& items,
-                              int layout, Decode decode);
+                              int layout, Decode decode, const ReadingProgress& progress = {},
+                              std::size_t total = 0);
   // The id of the person of that name and role ("trainee", "instructor"), added if new.
   std::int64_t person(std::string_view name, std::string_view role);
 
