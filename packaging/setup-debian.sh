@@ -5,9 +5,10 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
+  clang libclang-rt-14-dev
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev qt6-tools-dev qt6-tools-dev-tools qt6-l10n-tools
   libqt6sql6-sqlite libgl-dev libgl1-mesa-dri
-  libvtk9-dev libeigen3-dev libassimp-dev libgmsh-dev libsqlite3-dev libx11-dev
+  libvtk9-dev libeigen3-dev libassimp-dev libgmsh-dev libsqlite3-dev libx11-dev libsodium-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev python3 python3-jsonschema
   xvfb xauth

@@ -563,6 +563,65 @@
     </message>
 </context>
 <context>
+    <name>liversim::InstructorLoginDialog</name>
+    <message>
+        <source>Instructor Log-in</source>
+        <translation>教师登录</translation>
+    </message>
+    <message>
+        <source>First Instructor Account</source>
+        <translation>第一个教师账户</translation>
+    </message>
+    <message>
+        <source>Add an Instructor Account</source>
+        <translation>添加教师账户</translation>
+    </message>
+    <message>
+        <source>Instructor mode changes the tissue, authors scenarios and grades sessions. Log in with your instructor account.</source>
+        <translation>教师模式可修改组织、编写场景并为会话评分。请用您的教师账户登录。</translation>
+    </message>
+    <message>
+        <source>This workstation has no instructor account yet. Set up the first one: its name and a password of at least %1 characters. Further accounts can then be added only by an instructor who has logged in.</source>
+        <translation>此工作站尚无教师账户。请设置第一个账户：名称及至少 %1 个字符的密码。之后只有已登录的教师才能添加更多账户。</translation>
+    </message>
+    <message>
+        <source>A new instructor account: its name and a password of at least %1 characters.</source>
+        <translation>新的教师账户：名称及至少 %1 个字符的密码。</translation>
+    </message>
+    <message>
+        <source>Name:</source>
+        <translation>名称：</translation>
+    </message>
+    <message>
+        <source>Password:</source>
+        <translation>密码：</translation>
+    </message>
+    <message>
+        <source>Password again:</source>
+        <translation>再次输入密码：</translation>
+    </message>
+    <message>
+        <source>Create Account</source>
+        <translation>创建账户</translation>
+    </message>
+    <message>
+        <source>Log In</source>
+        <translation>登录</translation>
+    </message>
+    <message>
+        <source>Enter the instructor&apos;s name.</source>
+        <translation>请输入教师的名称。</translation>
+    </message>
+    <message>
+        <source>Enter the password.</source>
+        <translation>请输入密码。</translation>
+    </message>
+    <message>
+        <source>The two passwords differ: type the same password twice.</source>
+        <translation>两次输入的密码不同：请两次输入相同的密码。</translation>
+    </message>
+</context>
+<context>
     <name>liversim::MainWindow</name>
     <message>
         <source>Scenario</source>
@@ -1029,10 +1088,6 @@ The scene that was running goes on.</source>
         <translation>教师模式(&amp;I)</translation>
     </message>
     <message>
-        <source>Instructor mode: change the tissue, author scenarios, review every trainee&apos;s sessions</source>
-        <translation>教师模式：修改组织参数、编写场景、查看所有学员的训练记录</translation>
-    </message>
-    <message>
         <source>Main Toolbar</source>
         <translation>主工具栏</translation>
     </message>
@@ -1051,6 +1106,58 @@ The scene that was running goes on.</source>
     <message>
         <source>Not applied: a model is being built. Try again when it is done.</source>
         <translation>未应用：正在构建模型。请在完成后重试。</translation>
+    </message>
+    <message>
+        <source>Instructor accounts are kept in the sessions database, which cannot be used: %1</source>
+        <translation>教师账户保存在会话数据库中，但该数据库无法使用：%1</translation>
+    </message>
+    <message>
+        <source>there is none</source>
+        <translation>没有数据库</translation>
+    </message>
+    <message>
+        <source>Cannot log in: %1</source>
+        <translation>无法登录：%1</translation>
+    </message>
+    <message>
+        <source>Cannot set up the account: %1</source>
+        <translation>无法设置账户：%1</translation>
+    </message>
+    <message>
+        <source>Wrong name or password.</source>
+        <translation>名称或密码错误。</translation>
+    </message>
+    <message>
+        <source>Logged in as %1 (instructor).</source>
+        <translation>已以 %1（教师）身份登录。</translation>
+    </message>
+    <message>
+        <source>Only an instructor who has logged in can add instructor accounts.</source>
+        <translation>只有已登录的教师才能添加教师账户。</translation>
+    </message>
+    <message>
+        <source>The account was not added: %1</source>
+        <translation>账户未添加：%1</translation>
+    </message>
+    <message>
+        <source>Instructor account %1 added.</source>
+        <translation>已添加教师账户 %1。</translation>
+    </message>
+    <message>
+        <source>Instructor mode, after a log-in: change the tissue, author scenarios, review and grade every trainee&apos;s sessions</source>
+        <translation>教师模式（需登录）：修改组织、编写场景、查看并评分每位学员的会话</translation>
+    </message>
+    <message>
+        <source>&amp;Add Instructor Account…</source>
+        <translation>添加教师账户(&amp;A)…</translation>
+    </message>
+    <message>
+        <source>Session %1 is not yours to replay: trainees replay their own sessions (an instructor may replay any).</source>
+        <translation>会话 %1 不属于您，无法回放：学员只能回放自己的会话（教师可回放任何会话）。</translation>
+    </message>
+    <message>
+        <source>Reviewing every trainee&apos;s sessions is for instructors: log in first (Settings ▸ Instructor Mode).</source>
+        <translation>查看所有学员的会话仅限教师：请先登录（设置 ▸ 教师模式）。</translation>
     </message>
 </context>
 <context>
@@ -2331,10 +2438,6 @@ Simulated: %2.
         <translation>学员不能为训练记录评分。</translation>
     </message>
     <message>
-        <source>A grade needs the instructor&apos;s name and the grade.</source>
-        <translation>评分需要填写教员姓名和评分。</translation>
-    </message>
-    <message>
         <source>The grade was not saved: %1</source>
         <translation>评分未保存：%1</translation>
     </message>
@@ -2365,6 +2468,18 @@ Simulated: %2.
     <message>
         <source>Nothing was exported: reading session %1 was cancelled.</source>
         <translation>未导出任何内容：会话 %1 的读取已取消。</translation>
+    </message>
+    <message>
+        <source>(log in as an instructor to grade)</source>
+        <translation>（以教师身份登录后方可评分）</translation>
+    </message>
+    <message>
+        <source>Log in as an instructor to grade sessions (Settings ▸ Instructor Mode).</source>
+        <translation>请以教师身份登录后为会话评分（设置 ▸ 教师模式）。</translation>
+    </message>
+    <message>
+        <source>Enter the grade first (e.g. pass, fail, B+).</source>
+        <translation>请先输入评分（例如 通过、不通过、B+）。</translation>
     </message>
 </context>
 <context>

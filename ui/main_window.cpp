@@ -4,6 +4,7 @@
 #include "accuracy_study_dialog.h"
 #include "calibration_dialog.h"
 #include "device_panel.h"
+#include "instructor_login_dialog.h"
 #include "material_panel.h"
 #include "recent_scenarios.h"
 #include "render/liver_scene.h"
@@ -171,7 +172,7 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   buildMenus();
   showScenarioDetails();
   setSeeThrough(QSettings().value("view/see_through", false).toBool());
-  setInstructorMode(QSettings().value("interface/instructor_mode", false).toBool());
+  applyMode(false);  // every start is a trainee's: instructor mode needs a log-in
 
   statusLabel_ = new QLabel(this);
   statusLabel_->setObjectName("simulationStatus");
@@ -242,12 +243,101 @@ void MainWindow::closeEvent(QCloseEvent* event) {
 }
 
 void MainWindow::setInstructorMode(bool on) {
-  instructorMode_ = on;
-  QSettings().setValue("interface/instructor_mode", on);
-  materialPanel_->setEditable(on);
-  if (instructorModeAction_ != nullptr) instructorModeAction_->setChecked(on);
-  if (scenarioEditorAction_ != nullptr) scenarioEditorAction_->setVisible(on);
-  if (reviewSessionsAction_ != nullptr) reviewSessionsAction_->setVisible(on);
+  if (on && !instructor_) {  // the mode follows a log-in
+    applyMode(false);
+    openInstructorLogin(InstructorLoginDialog::Purpose::log_in);
+    return;
+  }
+  if (!on) logOutInstructor();
+  applyMode(on);
+}
+
+void MainWindow::applyMode(bool instructor) {
+  instructorMode_ = instructor;
+  materialPanel_->setEditable(instructor);
+  if (instructorModeAction_ != nullptr) instructorModeAction_->setChecked(instructor);
+  if (scenarioEditorAction_ != nullptr) scenarioEditorAction_->setVisible(instructor);
+  if (reviewSessionsAction_ != nullptr) reviewSessionsAction_->setVisible(instructor);
+  if (addInstructorAction_ != nullptr) addInstructorAction_->setVisible(instructor);
+}
+
+bool MainWindow::logInInstructor(const QString& name, const QString& password, QString* why) {
+  const auto refuse = [&](const QString& reason) {
+    if (why != nullptr) *why = reason;
+    return false;
+  };
+  if (!sessions_)
+    return refuse(tr("Instructor accounts are kept in the sessions database, which cannot be "
+                     "used: %1")
+                      .arg(sessionsProblem_.isEmpty() ? tr("there is none") : sessionsProblem_));
+  try {
+    if (!sessions_->has_instructor_accounts())
+      instructor_ =
+          sessions_->add_instructor_account(name.toStdString(), password.toStdString(), nullptr);
+    else
+      instructor_ = sessions_->log_in_instructor(name.toStdString(), password.toStdString());
+  } catch (const StorageError& e) {
+    return refuse(storageProblemText(tr("Cannot log in: %1"), e));
+  } catch (const std::exception& e) {  // a password that breaks the rule, a name taken
+    return refuse(tr("Cannot set up the account: %1").arg(QString::fromUtf8(e.what())));
+  }
+  if (!instructor_) return refuse(tr("Wrong name or password."));
+  applyMode(true);
+  statusBar()->showMessage(
+      tr("Logged in as %1 (instructor).").arg(QString::fromStdString(instructor_->name())));
+  return true;
+}
+
+bool MainWindow::addInstructorAccount(const QString& name, const QString& password, QString* why) {
+  const auto refuse = [&](const QString& reason) {
+    if (why != nullptr) *why = reason;
+    return false;
+  };
+  if (!sessions_ || !instructor_)
+    return refuse(tr("Only an instructor who has logged in can add instructor accounts."));
+  try {
+    sessions_->add_instructor_account(name.toStdString(), password.toStdString(), &*instructor_);
+  } catch (const StorageError& e) {
+    return refuse(storageProblemText(tr("The account was not added: %1"), e));
+  } catch (const std::exception& e) {
+    return refuse(tr("The account was not added: %1").arg(QString::fromUtf8(e.what())));
+  }
+  statusBar()->showMessage(tr("Instructor account %1 added.").arg(name));
+  return true;
+}
+
+void MainWindow::logOutInstructor() {
+  instructor_.reset();
+  if (review_) review_->close();  // it grades as the instructor who logged in
+  applyMode(false);
+}
+
+InstructorLoginDialog* MainWindow::openInstructorLogin(InstructorLoginDialog::Purpose purpose) {
+  if (purpose == InstructorLoginDialog::Purpose::log_in && sessions_) {
+    try {
+      if (!sessions_->has_instructor_accounts())
+        purpose = InstructorLoginDialog::Purpose::create_first_account;
+    } catch (const StorageError&) {
+      // logInInstructor says what is wrong with the database when the form is sent
+    }
+  }
+  if (loginDialog_) loginDialog_->close();
+  auto* dialog = new InstructorLoginDialog(purpose, this);
+  dialog->setAttribute(Qt::WA_DeleteOnClose);
+  connect(dialog, &InstructorLoginDialog::requested, this,
+          [this, dialog](const QString& name, const QString& password) {
+            QString why;
+            const bool done = dialog->purpose() == InstructorLoginDialog::Purpose::add_account
+                                  ? addInstructorAccount(name, password, &why)
+                                  : logInInstructor(name, password, &why);
+            if (done)
+              dialog->accept();
+            else
+              dialog->showError(why);
+          });
+  loginDialog_ = dialog;
+  dialog->open();
+  return dialog;
 }
 
 void MainWindow::installScene(SceneSetup setup, std::shared_ptr<const SimModel> model) {
@@ -540,7 +630,13 @@ void MainWindow::buildMenus() {
   instructorModeAction_->setCheckable(true);
   instructorModeAction_->setShortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_I));
   instructorModeAction_->setToolTip(
-      tr("Instructor mode: change the tissue, author scenarios, review every trainee's sessions"));
+      tr("Instructor mode, after a log-in: change the tissue, author scenarios, review and "
+         "grade every trainee's sessions"));
+  addInstructorAction_ = settings->addAction(tr("&Add Instructor Account…"), this, [this] {
+    openInstructorLogin(InstructorLoginDialog::Purpose::add_account);
+  });
+  addInstructorAction_->setObjectName("addInstructorAction");
+  addInstructorAction_->setVisible(instructorMode_);
   settings->addSeparator();
   QMenu* language = settings->addMenu(tr("&Language"));
   language->setObjectName("languageMenu");
@@ -1130,6 +1226,7 @@ void MainWindow::detachDevice() {
 
 bool MainWindow::setSessionsDatabase(const QString& file) {
   endRecording();
+  if (instructor_) logOutInstructor();  // an account is of one database
   sessions_.reset();
   sessionsProblem_.clear();
   try {
@@ -1160,6 +1257,15 @@ bool MainWindow::replaySession(std::int64_t session) {
                                              : sessionsProblem_);
   std::vector<ServoFrame> frames;
   try {
+    if (!instructor_) {
+      const std::vector<SessionSummary> own =
+          sessions_->sessions_of_trainee(traineeName().toStdString());
+      if (std::none_of(own.begin(), own.end(),
+                       [&](const SessionSummary& s) { return s.id == session; }))
+        return refuse(tr("Session %1 is not yours to replay: trainees replay their own sessions "
+                         "(an instructor may replay any).")
+                          .arg(session));
+    }
     std::optional<std::vector<ServoFrame>> read = readSessionFrames(*sessions_, session, this);
     if (!read)
       return refuse(tr("Session %1 is not replayed: reading it was cancelled.").arg(session));
@@ -1180,7 +1286,10 @@ bool MainWindow::replaySession(std::int64_t session) {
 void MainWindow::chooseSessionToReplay() {
   std::vector<SessionSummary> sessions;
   try {
-    if (sessions_) sessions = sessions_->sessions();
+    // A trainee replays their own sessions only.
+    if (sessions_)
+      sessions = instructor_ ? sessions_->sessions()
+                             : sessions_->sessions_of_trainee(traineeName().toStdString());
   } catch (const StorageError& e) {
     sessionsProblem_ = storageProblemText(QStringLiteral("%1"), e);
   }
@@ -1330,6 +1439,12 @@ AccuracyStudyDialog* MainWindow::openAccuracyStudy() {
 }
 
 SessionReviewWindow* MainWindow::openSessionReview() {
+  if (!instructor_) {
+    statusBar()->showMessage(
+        tr("Reviewing every trainee's sessions is for instructors: log in first (Settings ▸ "
+           "Instructor Mode)."));
+    return nullptr;
+  }
   return showSessionsWindow(review_, std::nullopt);
 }
 
@@ -1345,7 +1460,8 @@ SessionReviewWindow* MainWindow::showSessionsWindow(QPointer<SessionReviewWindow
     return nullptr;
   }
   if (!window) {
-    window = new SessionReviewWindow(sessionsFile_, trainee, this);
+    window =
+        new SessionReviewWindow(sessionsFile_, trainee, trainee ? std::nullopt : instructor_, this);
     window->setAttribute(Qt::WA_DeleteOnClose);
   } else {
     window->refresh();

@@ -4,6 +4,7 @@
 // status bar. The simulation runs on its own thread; the viewport renders from its newest snapshot.
 
 #include "haptic_preferences.h"
+#include "instructor_login_dialog.h"
 #include "render/liver_scene.h"
 
 #include "liversim/core/default_scene.h"
@@ -106,10 +107,23 @@ class MainWindow : public QMainWindow {
   MaterialPanel* materialPanel() const { return materialPanel_; }
 
   // Instructor mode: the Material panel edits the tissue, and the scenario editor and the review
-  // of every trainee's sessions are offered. Trainee mode (the default) shows the tissue
-  // read-only and offers the trainee's own sessions. Remembered (Settings menu, toolbar).
+  // and grading of every trainee's sessions are offered. Trainee mode shows the tissue read-only
+  // and offers the trainee's own sessions only. Every start is in trainee mode; turning
+  // instructor mode on (Settings menu, toolbar) asks for an instructor's log-in, or sets up the
+  // first account of a database without one. Turning it off logs out.
   void setInstructorMode(bool on);
   bool instructorMode() const { return instructorMode_; }
+  // Logs in with an instructor account of the sessions database (on a database without accounts,
+  // creates the first one with this name and password) and turns instructor mode on. False, with
+  // the reason in `why`, for a wrong name or password, a password too short for a new account, or
+  // without a database.
+  bool logInInstructor(const QString& name, const QString& password, QString* why = nullptr);
+  void logOutInstructor();
+  const std::optional<Instructor>& instructor() const { return instructor_; }
+  // A further account, added by the instructor logged in (Settings ▸ Add Instructor Account…).
+  bool addInstructorAccount(const QString& name, const QString& password, QString* why = nullptr);
+  // The log-in form (or the first account's, or a further account's), not modal-blocking.
+  InstructorLoginDialog* openInstructorLogin(InstructorLoginDialog::Purpose purpose);
   QToolBar* mainToolBar() const { return toolBar_; }
 
   // Opens a scenario file. It is read and validated at once: a bad file is refused with its
@@ -188,6 +202,7 @@ class MainWindow : public QMainWindow {
   void closeEvent(QCloseEvent* event) override;  // remembers the window's layout
 
  private:
+  void applyMode(bool instructor);
   // A panel docked on the right, movable, floatable and closable (View ▸ Panels).
   QDockWidget* addPanelDock(const QString& title, const char* name, QWidget* panel);
   // The window's size, docks and toolbar as the user left them (saveState).
@@ -266,6 +281,9 @@ class MainWindow : public QMainWindow {
   VtkViewport* viewport_ = nullptr;
   AccuracyPanel* accuracyPanel_ = nullptr;
   QPointer<AccuracyStudyDialog> accuracyStudy_;
+  std::optional<Instructor> instructor_;  // who logged in, in instructor mode
+  QPointer<InstructorLoginDialog> loginDialog_;
+  QAction* addInstructorAction_ = nullptr;
   ToolPanel* toolPanel_ = nullptr;
   DevicePanel* devicePanel_ = nullptr;
   ScenarioPanel* scenarioPanel_ = nullptr;

@@ -60,8 +60,12 @@ QTableWidgetItem* cell(const QString& text) {
 }  // namespace
 
 SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
-                                         const std::optional<QString>& trainee, QWidget* parent)
-    : QWidget(parent, Qt::Window), trainee_(trainee), databaseFile_(databaseFile) {
+                                         const std::optional<QString>& trainee,
+                                         const std::optional<Instructor>& grader, QWidget* parent)
+    : QWidget(parent, Qt::Window),
+      trainee_(trainee),
+      grader_(trainee ? std::nullopt : grader),
+      databaseFile_(databaseFile) {
   setObjectName(trainee ? "traineeHistoryWindow" : "sessionReviewWindow");
   setWindowTitle(trainee ? tr("Sessions of %1").arg(*trainee)
                          : tr("Sessions — %1").arg(databaseFile));
@@ -112,6 +116,9 @@ SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
 
   instructorEdit_ = new QLineEdit(this);
   instructorEdit_->setObjectName("gradeInstructor");
+  instructorEdit_->setReadOnly(true);  // who logged in grades
+  instructorEdit_->setText(grader_ ? QString::fromStdString(grader_->name())
+                                   : tr("(log in as an instructor to grade)"));
   gradeEdit_ = new QLineEdit(this);
   gradeEdit_->setObjectName("gradeText");
   gradeEdit_->setPlaceholderText(tr("e.g. pass, fail, B+"));
@@ -201,7 +208,8 @@ void SessionReviewWindow::refresh() {
   scores_.clear();
   if (store_) {
     try {
-      sessions_ = store_->sessions();
+      sessions_ =
+          trainee_ ? store_->sessions_of_trainee(trainee_->toStdString()) : store_->sessions();
       for (const SessionSummary& s : sessions_)
         scores_.push_back(
             grade_against_rubric(rubric_of(*store_, s.id), store_->metrics(s.id)).score_percent);
@@ -234,7 +242,6 @@ void SessionReviewWindow::showSessions() {
     const SessionSummary& s = sessions_[i];
     const QString trainee = QString::fromStdString(s.trainee);
     const QString scenario = QString::fromStdString(s.scenario_title);
-    if (trainee_ && trainee != *trainee_) continue;
     if (!filter_.isEmpty() && !trainee.contains(filter_, Qt::CaseInsensitive) &&
         !scenario.contains(filter_, Qt::CaseInsensitive))
       continue;
@@ -422,9 +429,7 @@ QString SessionReviewWindow::gradesText() const {
   return gradesLabel_->text();
 }
 
-void SessionReviewWindow::setGradeForm(const QString& instructor, const QString& grade,
-                                       const QString& comment) {
-  instructorEdit_->setText(instructor);
+void SessionReviewWindow::setGradeForm(const QString& grade, const QString& comment) {
   gradeEdit_->setText(grade);
   commentEdit_->setPlainText(comment);
 }
@@ -435,20 +440,28 @@ bool SessionReviewWindow::saveGrade() {
     gradesLabel_->setText(tr("Trainees cannot grade sessions."));
     return false;
   }
-  const QString instructor = instructorEdit_->text().trimmed();
+  if (!grader_) {
+    gradesLabel_->setText(
+        tr("Log in as an instructor to grade sessions (Settings ▸ Instructor "
+           "Mode)."));
+    return false;
+  }
   const QString grade = gradeEdit_->text().trimmed();
-  if (instructor.isEmpty() || grade.isEmpty()) {
-    gradesLabel_->setText(tr("A grade needs the instructor's name and the grade."));
+  if (grade.isEmpty()) {
+    gradesLabel_->setText(tr("Enter the grade first (e.g. pass, fail, B+)."));
     return false;
   }
   SessionGrade entry;
-  entry.instructor = instructor.toStdString();
+  entry.instructor = grader_->name();
   entry.graded_unix_ms = QDateTime::currentMSecsSinceEpoch();
   entry.score_percent = rubric_.score_percent;
   entry.grade = grade.toStdString();
   entry.comment = commentEdit_->toPlainText().toStdString();
   try {
-    store_->store_grade(*opened_, entry);
+    store_->store_grade(*grader_, *opened_, entry);
+  } catch (const AccessDenied& e) {
+    gradesLabel_->setText(tr("The grade was not saved: %1").arg(QString::fromUtf8(e.what())));
+    return false;
   } catch (const StorageError& e) {
     gradesLabel_->setText(storageProblemText(tr("The grade was not saved: %1"), e));
     return false;

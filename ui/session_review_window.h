@@ -38,9 +38,12 @@ class SessionReviewWindow : public QWidget {
  public:
   // Opens its own connection to the database file (the recorder keeps writing through the
   // workstation's); a file it cannot open is said in the window, which then lists nothing.
-  // With `trainee`, the trainee's own history: only that trainee's sessions, and no grading.
+  // With `trainee`, the trainee's own history: only that trainee's sessions (the store lists no
+  // others), and no grading. Otherwise every session, graded by `grader`, the instructor who
+  // logged in (without one, nothing can be graded).
   explicit SessionReviewWindow(const QString& databaseFile,
                                const std::optional<QString>& trainee = std::nullopt,
+                               const std::optional<Instructor>& grader = std::nullopt,
                                QWidget* parent = nullptr);
   ~SessionReviewWindow() override;
 
@@ -67,9 +70,10 @@ class SessionReviewWindow : public QWidget {
   QStringList eventLines() const;  // as listed: time, kind, detail
   QString gradesText() const;      // the grades saved so far, oldest first
 
-  // The grade form; saveGrade stores it (with the rubric's score) and shows it under the earlier
-  // ones. False, saying why, without an instructor name or a grade, or when the database refuses.
-  void setGradeForm(const QString& instructor, const QString& grade, const QString& comment);
+  // The grade form (graded by the instructor who logged in); saveGrade stores it (with the
+  // rubric's score) and shows it under the earlier ones. False, saying why, for a trainee, without
+  // an instructor or a grade, or when the database refuses.
+  void setGradeForm(const QString& grade, const QString& comment);
   bool saveGrade();
 
   // The opened session as CSV files in `folder` (session-N-frames.csv, -events.csv,
@@ -93,6 +97,7 @@ class SessionReviewWindow : public QWidget {
   std::vector<std::optional<double>> scores_;  // per session of sessions_
   QString filter_;
   std::optional<QString> trainee_;
+  std::optional<Instructor> grader_;
   std::optional<std::int64_t> opened_;
   bool traceRead_ = false;
   int readingDialogDelayMs_ = kSessionReadingDialogDelayMs;

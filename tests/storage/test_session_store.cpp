@@ -233,10 +233,12 @@ TEST(SessionStore, GradesAndCommentsAreKeptPerSessionAndReadBackAfterReopening) 
   const SessionGrade second{"Dr. O'Neil", 1'700'000'100'000, std::nullopt, "pass", ""};
   {
     SqliteSessionStore store(file);
+    store.set_password_cost_for_testing(kCheapPasswordCostForTesting);
     a = store.begin_session(start_of("Dr. O'Neil", "{}"));
     b = store.begin_session(start_of("Trainee B", "{}"));
-    store.store_grade(a, first);
-    store.store_grade(a, second);
+    const Instructor oneil = store.add_instructor_account("Dr. O'Neil", "a long password", nullptr);
+    store.store_grade(oneil, a, first);
+    store.store_grade(oneil, a, second);
     EXPECT_TRUE(store.grades(b).empty());
   }
   SqliteSessionStore reopened(file, SqliteSessionStore::Access::read_only);
@@ -270,15 +272,17 @@ int user_version(const fs::path& file) {
 // the migration to the current version, and a session added after has everything the current
 // version stores.
 TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
-  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 3) << "add a file of the version before";
+  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 4) << "add a file of the version before";
   struct Earlier {
     int version;
     double peak_force_n;
     std::string event_detail, grade_comment;
     std::optional<double> mapping_scale;
+    std::int64_t frame_count = 202;
   };
   for (const Earlier& earlier : {Earlier{1, 0.75, "probe", "v1 grade", std::nullopt},
-                                 Earlier{2, 0.5, "scalpel", "v2 grade", 2.0}}) {
+                                 Earlier{2, 0.5, "scalpel", "v2 grade", 2.0},
+                                 Earlier{3, 0.25, "forceps", "v3 grade", 3.0, 201}}) {
     const std::string name = "sessions-v" + std::to_string(earlier.version) + ".sqlite";
     SCOPED_TRACE(name);
     const fs::path file = fresh_database("migrated-from-v" + std::to_string(earlier.version));
@@ -314,10 +318,10 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     EXPECT_EQ(store.integrity_check(), "ok");
     const std::vector<SessionSummary> sessions = store.sessions();
     ASSERT_EQ(sessions.size(), 2u);
-    // The earlier version's session: complete, its 202 frames, metric, event and grade.
+    // The earlier version's session: complete, its frames, metric, event and grade.
     EXPECT_EQ(sessions[0].status, SessionStatus::complete);
-    EXPECT_EQ(sessions[0].frame_count, 202);
-    EXPECT_EQ(store.frames(sessions[0].id).size(), 202u);
+    EXPECT_EQ(sessions[0].frame_count, earlier.frame_count);
+    EXPECT_EQ(static_cast<std::int64_t>(store.frames(sessions[0].id).size()), earlier.frame_count);
     EXPECT_EQ(sessions[0].mapping.has_value(), earlier.mapping_scale.has_value());
     if (sessions[0].mapping) EXPECT_EQ(sessions[0].mapping->scale, *earlier.mapping_scale);
     EXPECT_EQ(store.metrics(sessions[0].id),
@@ -326,6 +330,8 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     EXPECT_EQ(store.events(sessions[0].id)[0].detail, earlier.event_detail);
     ASSERT_EQ(store.grades(sessions[0].id).size(), 1u);
     EXPECT_EQ(store.grades(sessions[0].id)[0].comment, earlier.grade_comment);
+    // Grades of earlier versions stay, but their instructors have no account yet.
+    EXPECT_FALSE(SqliteSessionStore(file).has_instructor_accounts());
     // Recorded before replays: nothing to replay, and said so (no setup), not an error.
     EXPECT_FALSE(store.replay_setup(sessions[0].id));
     EXPECT_TRUE(store.inputs(sessions[0].id).empty());
@@ -653,6 +659,121 @@ TEST(SessionRecorder, AFullDiskStopsTheRecordingAndKeepsWhatWasCommitted) {
   const std::vector<ServoFrame> read = reader.frames(recorder.session());
   ASSERT_EQ(static_cast<std::int64_t>(read.size()), kept);
   expect_same_frames(read, std::vector<ServoFrame>(frames.begin(), frames.begin() + kept));
+}
+
+// Roles: instructor passwords are kept only as salted Argon2id hashes; what only instructors may
+// do needs one who logged in; a trainee's history lists no one else's sessions.
+TEST(InstructorAccounts, PasswordsAreKeptOnlyAsSaltedSlowHashes) {
+  const fs::path file = fresh_database("accounts-hashes");
+  {
+    SqliteSessionStore store(file);
+    EXPECT_FALSE(store.has_instructor_accounts());
+    const Instructor grey = store.add_instructor_account("Dr. Grey", "correct horse", nullptr);
+    store.add_instructor_account("Dr. Rossi", "correct horse", &grey);  // the same password
+    EXPECT_TRUE(store.has_instructor_accounts());
+  }
+  // The file holds no password, and equal passwords give different hashes (salted), each an
+  // Argon2id string at least as costly as libsodium's interactive level.
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* rows = nullptr;
+  ASSERT_EQ(
+      sqlite3_prepare_v2(db, "SELECT password_hash FROM instructor_accounts", -1, &rows, nullptr),
+      SQLITE_OK);
+  std::vector<std::string> hashes;
+  while (sqlite3_step(rows) == SQLITE_ROW)
+    hashes.emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(rows, 0)));
+  sqlite3_finalize(rows);
+  sqlite3_close(db);
+  ASSERT_EQ(hashes.size(), 2u);
+  EXPECT_NE(hashes[0], hashes[1]);
+  for (const std::string& hash : hashes) {
+    EXPECT_EQ(hash.rfind("$argon2id$", 0), 0u) << hash;
+    EXPECT_NE(hash.find("m=65536,t=2"), std::string::npos) << hash;  // 64 MiB, 2 passes
+    EXPECT_EQ(hash.find("correct horse"), std::string::npos);
+  }
+  std::ifstream bytes(file, std::ios::binary);
+  const std::string content((std::istreambuf_iterator<char>(bytes)), {});
+  EXPECT_EQ(content.find("correct horse"), std::string::npos);
+}
+
+TEST(InstructorAccounts, EachForbiddenActionIsRefused) {
+  const fs::path file = fresh_database("accounts-forbidden");
+  SqliteSessionStore store(file);
+  store.set_password_cost_for_testing(kCheapPasswordCostForTesting);
+  const std::int64_t mine = store.begin_session(start_of("Trainee A", "{}"));
+  const std::int64_t theirs = store.begin_session(start_of("Trainee B", "{}"));
+  store.commit();
+
+  // A password too short for a new account, and an account without a name.
+  EXPECT_THROW(store.add_instructor_account("Dr. Grey", "short", nullptr), std::invalid_argument);
+  EXPECT_THROW(store.add_instructor_account("", "long enough", nullptr), std::invalid_argument);
+  const Instructor grey = store.add_instructor_account("Dr. Grey", "long enough", nullptr);
+  // Once there is an account, nobody who has not logged in adds one.
+  EXPECT_THROW(store.add_instructor_account("Trainee A", "trainee's own", nullptr), AccessDenied);
+  EXPECT_THROW(store.add_instructor_account("Dr. Grey", "another one", &grey),
+               std::invalid_argument);  // the name is taken
+  // A wrong password, and a name without an account, log no one in.
+  EXPECT_FALSE(store.log_in_instructor("Dr. Grey", "long enougH"));
+  EXPECT_FALSE(store.log_in_instructor("Trainee A", "long enough"));
+  EXPECT_FALSE(store.log_in_instructor("Dr. Grey", ""));
+  const std::optional<Instructor> logged_in = store.log_in_instructor("Dr. Grey", "long enough");
+  ASSERT_TRUE(logged_in);
+  EXPECT_EQ(logged_in->name(), "Dr. Grey");
+  store.store_grade(*logged_in, mine, {"ignored", 1, std::nullopt, "pass", ""});
+  ASSERT_EQ(store.grades(mine).size(), 1u);
+  EXPECT_EQ(store.grades(mine)[0].instructor, "Dr. Grey");  // who logged in, not what was typed
+
+  // An instructor of another database grades nothing here.
+  const fs::path other_file = fresh_database("accounts-other");
+  SqliteSessionStore other(other_file);
+  other.set_password_cost_for_testing(kCheapPasswordCostForTesting);
+  other.add_instructor_account("Dr. Elsewhere", "long enough", nullptr);
+  const std::optional<Instructor> elsewhere =
+      other.log_in_instructor("Dr. Elsewhere", "long enough");
+  ASSERT_TRUE(elsewhere);
+  EXPECT_THROW(store.store_grade(*elsewhere, theirs, {"", 2, std::nullopt, "fail", ""}),
+               AccessDenied);
+  EXPECT_THROW(store.add_instructor_account("Dr. Mallory", "long enough", &*elsewhere),
+               AccessDenied);
+  EXPECT_TRUE(store.grades(theirs).empty());
+
+  // A trainee's history holds their sessions only.
+  const std::vector<SessionSummary> own = store.sessions_of_trainee("Trainee A");
+  ASSERT_EQ(own.size(), 1u);
+  EXPECT_EQ(own[0].id, mine);
+  EXPECT_TRUE(store.sessions_of_trainee("Trainee C").empty());
+  EXPECT_EQ(store.sessions().size(), 2u);
+}
+
+// Names and comments are data, never SQL: every statement binds its values. Hostile text is
+// stored and read back exactly, and the tables are all still there.
+TEST(InstructorAccounts, HostileNamesAndCommentsAreStoredAsData) {
+  const fs::path file = fresh_database("hostile");
+  SqliteSessionStore store(file);
+  store.set_password_cost_for_testing(kCheapPasswordCostForTesting);
+  const std::string trainee = "Robert'); DROP TABLE sessions; --";
+  const std::string instructor = "x' OR '1'='1";
+  const std::string comment = "\"; DELETE FROM grades; /* */ --\n' OR 1=1 --";
+  const std::int64_t session = store.begin_session(start_of(trainee, "{\"title\": \"'; --\"}"));
+  store.commit();
+  const Instructor hostile = store.add_instructor_account(instructor, "' OR ''='", nullptr);
+  // A log-in with SQL for a name or a password matches nothing.
+  EXPECT_FALSE(store.log_in_instructor("' OR 1=1 --", "anything"));
+  EXPECT_FALSE(store.log_in_instructor(instructor, "' OR 1=1 --"));
+  ASSERT_TRUE(store.log_in_instructor(instructor, "' OR ''='"));
+  store.store_grade(hostile, session, {"", 3, 50.0, "B'; --", comment});
+  EXPECT_EQ(store.sessions_of_trainee(trainee).size(), 1u);
+  EXPECT_TRUE(store.sessions_of_trainee("' OR '1'='1").empty());
+  EXPECT_TRUE(store.sessions_of_trainee("%").empty());  // no pattern matching either
+  const std::vector<SessionGrade> grades = store.grades(session);
+  ASSERT_EQ(grades.size(), 1u);
+  EXPECT_EQ(grades[0].instructor, instructor);
+  EXPECT_EQ(grades[0].grade, "B'; --");
+  EXPECT_EQ(grades[0].comment, comment);
+  EXPECT_EQ(store.sessions().at(0).trainee, trainee);
+  EXPECT_EQ(store.integrity_check(), "ok");
+  EXPECT_EQ(store.schema_version(), SqliteSessionStore::kSchemaVersion);
 }
 
 // The store itself says a full file is full, as a kind the workstation gives advice for.

@@ -379,8 +379,10 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   ASSERT_NE(history, nullptr);
   EXPECT_EQ(history->listedSessionCount(), 1);
   ASSERT_TRUE(history->openSession(session));
-  history->setGradeForm("Me", "A+", "");
+  history->setGradeForm("A+", "");
   EXPECT_FALSE(history->saveGrade()) << "a trainee cannot grade";
+  // Nor review everyone's sessions, nor replay another trainee's.
+  EXPECT_EQ(window_->openSessionReview(), nullptr);
   QSettings().setValue("sessions/trainee", "Someone Else");
   EXPECT_EQ(window_->traineeName(), "Someone Else");
   history->close();
@@ -389,11 +391,21 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   history = window_->findChild<SessionReviewWindow*>("traineeHistoryWindow");
   ASSERT_NE(history, nullptr);
   EXPECT_EQ(history->listedSessionCount(), 0);
+  EXPECT_FALSE(history->openSession(session));
   history->close();
+  EXPECT_FALSE(window_->replaySession(session)) << "another trainee's session was replayed";
+  EXPECT_TRUE(window_->devicePanel()->statusText().contains("not yours"))
+      << window_->devicePanel()->statusText().toStdString();
 
   // The instructor's review: the session against the scenario's rubric (success, no force, task
   // time 0: every criterion passes), its force curve and events; a grade saved is there when the
   // window is opened again.
+  // The first instructor account of this database is set up at the first log-in.
+  QString why;
+  EXPECT_FALSE(window_->logInInstructor("Dr. Grey", "short", &why));
+  EXPECT_TRUE(why.contains("at least 8 characters")) << why.toStdString();
+  ASSERT_TRUE(window_->logInInstructor("Dr. Grey", "grading password", &why)) << why.toStdString();
+  EXPECT_TRUE(window_->instructorMode());
   QAction* reviewAction = window_->findChild<QAction*>("reviewSessionsAction");
   ASSERT_NE(reviewAction, nullptr);
   reviewAction->trigger();
@@ -416,9 +428,9 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   const QString markLine = review->eventLines().filter("lesion_marked").value(0);
   EXPECT_TRUE(markLine.contains(QString(" at (%1, ").arg(marks[0].x() * 1e3, 0, 'f', 1)))
       << markLine.toStdString();
-  review->setGradeForm("", "pass", "");
-  EXPECT_FALSE(review->saveGrade()) << "a grade needs the instructor";
-  review->setGradeForm("Dr. Grey", "pass", "Found it at the first attempt.");
+  review->setGradeForm("", "");
+  EXPECT_FALSE(review->saveGrade()) << "a grade needs the grade";
+  review->setGradeForm("pass", "Found it at the first attempt.");
   ASSERT_TRUE(review->saveGrade());
   review->close();  // deleted on close
   QCoreApplication::sendPostedEvents(nullptr, QEvent::DeferredDelete);

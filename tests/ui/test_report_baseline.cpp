@@ -113,8 +113,11 @@ std::int64_t writeSession(const QString& database, const std::string& scenario_t
       {"resected_volume_mm3", 0.0}};
   store.store_metrics(session, metrics);
   // Graded at the rubric's score: 2 of its 7 weights passed.
-  store.store_grade(session, {"Dr. Rossi", 1'795'000'600'000, 100.0 * 2.0 / 7.0, "fail",
-                              "Breached the tumour: keep 10 mm from it."});
+  store.set_password_cost_for_testing(kCheapPasswordCostForTesting);
+  const Instructor rossi = store.add_instructor_account("Dr. Rossi", "report password", nullptr);
+  store.store_grade(rossi, session,
+                    {"Dr. Rossi", 1'795'000'600'000, 100.0 * 2.0 / 7.0, "fail",
+                     "Breached the tumour: keep 10 mm from it."});
   return session;
 }
 
@@ -160,7 +163,11 @@ TEST(InstructorReportBaseline, TheReviewOfASessionMatchesTheBaseline) {
   const QString database = folder.filePath("sessions.sqlite");
   const std::int64_t session = writeSession(database, text, reading.scenario->title);
 
-  SessionReviewWindow window(database);
+  // Reviewed by the instructor who graded it, logged in.
+  const std::optional<Instructor> rossi =
+      SqliteSessionStore(database.toStdString()).log_in_instructor("Dr. Rossi", "report password");
+  ASSERT_TRUE(rossi);
+  SessionReviewWindow window(database, std::nullopt, rossi);
   window.setAttribute(Qt::WA_DontShowOnScreen);
   window.resize(kWindowWidth, kWindowHeight);
   window.show();

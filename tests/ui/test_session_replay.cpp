@@ -156,7 +156,9 @@ TEST_F(SessionReplayWindowTest, ACutThroughTheLesionIsRecordedAndReplaysToTheSam
               std::filesystem::path(QFileInfo(kSmallScenario).absolutePath().toStdString()));
   }
 
-  // The instructor's review opens the replay.
+  // The instructor's review (after the first instructor's log-in) opens the replay.
+  QString why;
+  ASSERT_TRUE(window_->logInInstructor("Dr. Grey", "replay password", &why)) << why.toStdString();
   SessionReviewWindow* review = window_->openSessionReview();
   ASSERT_NE(review, nullptr);
   ASSERT_TRUE(review->openSession(session));

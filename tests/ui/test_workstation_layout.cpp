@@ -7,6 +7,7 @@
 #include <QDoubleSpinBox>
 #include <QSettings>
 #include <QSignalSpy>
+#include <QTemporaryDir>
 #include <QTest>
 #include <QToolBar>
 
@@ -14,6 +15,7 @@
 #include <limits>
 #include <memory>
 
+#include "instructor_login_dialog.h"
 #include "liversim/core/default_scene.h"
 #include "main_window.h"
 #include "material_panel.h"
@@ -71,18 +73,48 @@ TEST(Workstation, TheToolbarAndTheModesOfferWhatEachUserMayDo) {
   action(*window, "ambientOcclusionAction")->trigger();
   EXPECT_TRUE(window->scene().ambient_occlusion());
 
+  // Instructor mode asks for a log-in: on a database without accounts, the first account's form.
+  QTemporaryDir folder;
+  ASSERT_TRUE(window->setSessionsDatabase(folder.filePath("sessions.sqlite")));
   action(*window, "instructorModeAction")->trigger();
-  EXPECT_TRUE(window->instructorMode());
-  EXPECT_TRUE(action(*window, "scenarioEditorAction")->isVisible());
-  EXPECT_TRUE(action(*window, "reviewSessionsAction")->isVisible());
-  EXPECT_FALSE(modulus->isReadOnly());
-
-  // The mode is remembered.
-  window.reset();
-  window = openWindow();
+  EXPECT_FALSE(window->instructorMode());
+  EXPECT_FALSE(action(*window, "instructorModeAction")->isChecked());
+  auto* login = window->findChild<InstructorLoginDialog*>("instructorLoginDialog");
+  ASSERT_NE(login, nullptr);
+  EXPECT_EQ(login->purpose(), InstructorLoginDialog::Purpose::create_first_account);
+  login->submit("Dr. Grey", "long enough", "long enougH");
+  EXPECT_TRUE(login->errorText().contains("differ")) << login->errorText().toStdString();
+  EXPECT_FALSE(window->instructorMode());
+  login->submit("Dr. Grey", "long enough", "long enough");
   EXPECT_TRUE(window->instructorMode());
   EXPECT_TRUE(action(*window, "instructorModeAction")->isChecked());
-  EXPECT_TRUE(window->scene().ambient_occlusion());  // remembered too
+  EXPECT_TRUE(action(*window, "scenarioEditorAction")->isVisible());
+  EXPECT_TRUE(action(*window, "reviewSessionsAction")->isVisible());
+  EXPECT_TRUE(action(*window, "addInstructorAction")->isVisible());
+  EXPECT_FALSE(modulus->isReadOnly());
+  // Turning it off logs out; turning it on again asks for the password, and a wrong one is
+  // refused in the form.
+  action(*window, "instructorModeAction")->trigger();
+  EXPECT_FALSE(window->instructorMode());
+  EXPECT_FALSE(window->instructor().has_value());
+  EXPECT_TRUE(modulus->isReadOnly());
+  QCoreApplication::sendPostedEvents(nullptr, QEvent::DeferredDelete);  // the first form goes
+  action(*window, "instructorModeAction")->trigger();
+  login = window->findChild<InstructorLoginDialog*>("instructorLoginDialog");
+  ASSERT_NE(login, nullptr);
+  EXPECT_EQ(login->purpose(), InstructorLoginDialog::Purpose::log_in);
+  login->submit("Dr. Grey", "not the password");
+  EXPECT_EQ(login->errorText(), "Wrong name or password.");
+  EXPECT_FALSE(window->instructorMode());
+  login->submit("Dr. Grey", "long enough");
+  EXPECT_TRUE(window->instructorMode());
+
+  // A new start is a trainee's: the mode is not remembered, the view is.
+  window.reset();
+  window = openWindow();
+  EXPECT_FALSE(window->instructorMode());
+  EXPECT_FALSE(action(*window, "instructorModeAction")->isChecked());
+  EXPECT_TRUE(window->scene().ambient_occlusion());
 }
 
 TEST(Workstation, TheWindowLayoutIsRememberedBetweenStarts) {
@@ -122,7 +154,10 @@ TEST(Workstation, TheWindowLayoutIsRememberedBetweenStarts) {
 TEST(Workstation, TheMaterialPanelChangesTheRunningLiversTissue) {
   QSettings().clear();
   auto window = openWindow();
-  window->setInstructorMode(true);
+  QTemporaryDir folder;
+  ASSERT_TRUE(window->setSessionsDatabase(folder.filePath("sessions.sqlite")));
+  QString why;
+  ASSERT_TRUE(window->logInInstructor("Dr. Grey", "long enough", &why)) << why.toStdString();
   ASSERT_TRUE(QTest::qWaitFor([&] { return simulatedTime(*window) > 0.0; }, kTimeoutMs));
   const SimModel& original = window->simulation().model();
   const double stepBefore_s = original.stable_time_step_s;

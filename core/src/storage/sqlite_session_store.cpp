@@ -6,6 +6,7 @@
 #include <sqlite3.h>
 
 #include <array>
+#include <chrono>
 #include <iterator>
 
 namespace liversim {
@@ -122,7 +123,17 @@ CREATE TABLE input_chunks (
 ) WITHOUT ROWID;
 )sql";
 
-constexpr std::array<const char*, 3> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3};
+// Version 4: instructor accounts. The password is kept only as an Argon2id hash
+// (password_hash.h); grading needs an instructor who logged in with it.
+constexpr const char* kSchemaV4 = R"sql(
+CREATE TABLE instructor_accounts (
+  person_id INTEGER PRIMARY KEY REFERENCES people (id),
+  password_hash TEXT NOT NULL,
+  created_unix_ms INTEGER NOT NULL
+);
+)sql";
+
+constexpr std::array<const char*, 4> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3, kSchemaV4};
 static_assert(kMigrations.size() == SqliteSessionStore::kSchemaVersion);
 
 enum StatementId {
@@ -144,6 +155,10 @@ enum StatementId {
   kStoreMetric,
   kMetrics,
   kStoreGrade,
+  kAccountCount,
+  kFindAccount,
+  kAddAccount,
+  kCheckGrader,
   kGrades,
   kAddReplay,
   kInputCount,
@@ -600,9 +615,81 @@ std::vector<MetricValue> SqliteSessionStore::metrics(std::int64_t session) {
   return result;
 }
 
-void SqliteSessionStore::store_grade(std::int64_t session, const SessionGrade& grade) {
+bool SqliteSessionStore::has_instructor_accounts() {
+  return prepared(kAccountCount, "SELECT count(*) FROM instructor_accounts")
+             .single_integer("counting instructor accounts") > 0;
+}
+
+std::optional<std::pair<std::int64_t, std::string>> SqliteSessionStore::account_of(
+    std::string_view name) {
+  Statement& find = prepared(kFindAccount,
+                             "SELECT p.id, a.password_hash FROM instructor_accounts a "
+                             "JOIN people p ON p.id = a.person_id "
+                             "WHERE p.name = ?1 AND p.role = 'instructor'");
+  find.bind(1, name);
+  std::optional<std::pair<std::int64_t, std::string>> account;
+  if (find.step("looking up the instructor account")) account = {find.integer(0), find.text(1)};
+  find.reset();
+  return account;
+}
+
+std::int64_t SqliteSessionStore::checked_instructor(const Instructor& instructor) {
+  const std::int64_t accounts =
+      prepared(kCheckGrader,
+               "SELECT count(*) FROM instructor_accounts a JOIN people p ON p.id = a.person_id "
+               "WHERE a.person_id = ?1 AND p.name = ?2")
+          .bind(1, instructor.id())
+          .bind(2, std::string_view(instructor.name()))
+          .single_integer("checking the instructor");
+  if (accounts != 1)
+    throw AccessDenied("\"" + instructor.name() + "\" has no instructor account in " +
+                       file_.string());
+  return instructor.id();
+}
+
+Instructor SqliteSessionStore::add_instructor_account(std::string_view name,
+                                                      std::string_view password,
+                                                      const Instructor* added_by) {
+  if (name.empty()) throw std::invalid_argument("an instructor account needs a name");
+  check_new_password(password);
+  if (has_instructor_accounts()) {
+    if (added_by == nullptr)
+      throw AccessDenied("only an instructor who has logged in can add instructor accounts");
+    checked_instructor(*added_by);
+  }
+  if (account_of(name))
+    throw std::invalid_argument("there is already an instructor account named \"" +
+                                std::string(name) + "\"");
+  const std::string hash = hash_password(password, password_cost_);  // slow: before the write
   begin_if_needed();
-  const std::int64_t instructor = person(grade.instructor, "instructor");
+  const std::int64_t id = person(name, "instructor");
+  prepared(kAddAccount,
+           "INSERT INTO instructor_accounts (person_id, password_hash, created_unix_ms) "
+           "VALUES (?1, ?2, ?3)")
+      .bind(1, id)
+      .bind(2, std::string_view(hash))
+      .bind(3, static_cast<std::int64_t>(std::chrono::duration_cast<std::chrono::milliseconds>(
+                                             std::chrono::system_clock::now().time_since_epoch())
+                                             .count()))
+      .run("adding the instructor account");
+  commit();
+  return vouch_for(id, std::string(name));
+}
+
+std::optional<Instructor> SqliteSessionStore::log_in_instructor(std::string_view name,
+                                                                std::string_view password) {
+  const auto account = account_of(name);
+  // An unknown name costs a verification too, so that the time does not tell names apart.
+  static const std::string unknown_name_hash = hash_password("no such account");
+  const bool matches = password_matches(password, account ? account->second : unknown_name_hash);
+  if (!account || !matches) return std::nullopt;
+  return vouch_for(account->first, std::string(name));
+}
+
+void SqliteSessionStore::store_grade(const Instructor& by, std::int64_t session,
+                                     const SessionGrade& grade) {
+  const std::int64_t instructor = checked_instructor(by);
+  begin_if_needed();
   Statement& store = prepared(
       kStoreGrade,
       "INSERT INTO grades (session_id, instructor_id, graded_unix_ms, score, grade, comment) "
@@ -639,6 +726,15 @@ std::vector<SessionGrade> SqliteSessionStore::grades(std::int64_t session) {
 }
 
 std::vector<SessionSummary> SqliteSessionStore::sessions() {
+  return list_sessions(std::nullopt);
+}
+
+std::vector<SessionSummary> SqliteSessionStore::sessions_of_trainee(std::string_view trainee) {
+  return list_sessions(trainee);
+}
+
+std::vector<SessionSummary> SqliteSessionStore::list_sessions(
+    std::optional<std::string_view> trainee) {
   Statement& rows = prepared(
       kSessions,
       "SELECT s.id, p.name, c.title, c.sha256, s.device, s.started_unix_ms, s.ended_unix_ms, "
@@ -648,7 +744,8 @@ std::vector<SessionSummary> SqliteSessionStore::sessions() {
       "s.mapping_scale, s.mapping_rotation_w, s.mapping_rotation_x, s.mapping_rotation_y, "
       "s.mapping_rotation_z, s.mapping_offset_x_m, s.mapping_offset_y_m, s.mapping_offset_z_m "
       "FROM sessions s JOIN people p ON p.id = s.trainee_id "
-      "JOIN scenarios c ON c.id = s.scenario_id ORDER BY s.id");
+      "JOIN scenarios c ON c.id = s.scenario_id WHERE ?1 IS NULL OR p.name = ?1 ORDER BY s.id");
+  if (trainee) rows.bind(1, *trainee);  // unbound: NULL, every trainee's
   std::vector<SessionSummary> result;
   while (rows.step("listing sessions")) {
     SessionSummary s;

@@ -155,6 +155,26 @@ std::vector<std::uint8_t> encode_input_chunk(std::span<const SimulationInput> in
 // Throws StorageError when the bytes are not a layout-1 input chunk, naming what is wrong.
 std::vector<SimulationInput> decode_input_chunk(std::span<const std::uint8_t> bytes);
 
+// A role's limit: what was asked is not the asker's to do (a trainee grading, a wrong password).
+class AccessDenied : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Proof that an instructor logged in with their password: only a store makes one
+// (SessionStore::log_in_instructor), and what only instructors may do takes one.
+class Instructor {
+ public:
+  std::int64_t id() const { return id_; }
+  const std::string& name() const { return name_; }
+
+ private:
+  friend class SessionStore;
+  Instructor(std::int64_t id, std::string name) : id_(id), name_(std::move(name)) {}
+  std::int64_t id_;
+  std::string name_;
+};
+
 // Reading a long session's frames (ten minutes at 1 kHz are 600 000): frames read so far and in
 // the session, after each chunk. Returning false stops the reading (ReadingCancelled).
 using ReadingProgress = std::function<bool(std::size_t frames_read, std::size_t frames_total)>;
@@ -183,12 +203,28 @@ class SessionStore {
   // The session's metrics, computed at its end (a name stored again replaces its value); commits.
   virtual void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) = 0;
 
-  // An instructor's grade and comment (the instructor is added to the people if new); commits.
-  // A session may be graded more than once: each grade is kept.
-  virtual void store_grade(std::int64_t session, const SessionGrade& grade) = 0;
+  // Instructor accounts: a name and a password kept as an Argon2id hash (password_hash.h).
+  // The first account may be added by anyone (setting up a new workstation); later ones only by
+  // an instructor who logged in (AccessDenied otherwise). A name taken, or a password that breaks
+  // the rule (check_new_password), is refused naming why. Commits.
+  virtual Instructor add_instructor_account(std::string_view name, std::string_view password,
+                                            const Instructor* added_by) = 0;
+  virtual bool has_instructor_accounts() = 0;
+  // The instructor, when the name has an account and the password is its own; nullopt for a
+  // wrong name or password alike (after the same work, so the answer's time tells nothing).
+  virtual std::optional<Instructor> log_in_instructor(std::string_view name,
+                                                      std::string_view password) = 0;
+
+  // The grade and comment of the instructor who logged in (grade.instructor is theirs; the
+  // Instructor must be of this store's accounts, AccessDenied otherwise); commits. A session may
+  // be graded more than once: each grade is kept.
+  virtual void store_grade(const Instructor& by, std::int64_t session,
+                           const SessionGrade& grade) = 0;
   virtual std::vector<SessionGrade> grades(std::int64_t session) = 0;  // oldest first
 
   virtual std::vector<SessionSummary> sessions() = 0;
+  // Only the sessions of the trainee of that name: what a trainee's own history shows.
+  virtual std::vector<SessionSummary> sessions_of_trainee(std::string_view trainee) = 0;
   virtual std::vector<MetricValue> metrics(std::int64_t session) = 0;  // by name
   std::vector<ServoFrame> frames(std::int64_t session) { return frames(session, {}); }
   virtual std::vector<ServoFrame> frames(std::int64_t session, const ReadingProgress& progress) = 0;
@@ -198,6 +234,12 @@ class SessionStore {
   virtual std::vector<SimulationInput> inputs(std::int64_t session) = 0;
   // The exact scenario text the session ran.
   virtual std::string scenario_text(std::int64_t session) = 0;
+
+ protected:
+  // For a store that has checked the password.
+  static Instructor vouch_for(std::int64_t id, std::string name) {
+    return Instructor(id, std::move(name));
+  }
 };
 
 }  // namespace liversim

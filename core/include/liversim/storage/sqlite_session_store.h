@@ -4,6 +4,7 @@
 // (liversim_storage) so that the engine itself needs no database.
 
 #include "liversim/core/session_log.h"
+#include "liversim/storage/password_hash.h"
 
 #include <filesystem>
 #include <memory>
@@ -17,7 +18,7 @@ class SqliteSessionStore final : public SessionStore {
   enum class Access { read_write, read_only };
 
   // The schema version this build writes; files at older versions are migrated on opening.
-  static constexpr int kSchemaVersion = 3;
+  static constexpr int kSchemaVersion = 4;
 
   // Opens the file, creating it (read_write) if it does not exist. Throws StorageError naming the
   // file when it cannot be opened, is not a LiverSim database, is damaged, is read-only while
@@ -46,9 +47,18 @@ class SqliteSessionStore final : public SessionStore {
 
   void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) override;
 
-  void store_grade(std::int64_t session, const SessionGrade& grade) override;
+  Instructor add_instructor_account(std::string_view name, std::string_view password,
+                                    const Instructor* added_by) override;
+  bool has_instructor_accounts() override;
+  std::optional<Instructor> log_in_instructor(std::string_view name,
+                                              std::string_view password) override;
+  // How costly new password hashes are (tests make them cheap; logins check any cost).
+  void set_password_cost_for_testing(const PasswordHashCost& cost) { password_cost_ = cost; }
+
+  void store_grade(const Instructor& by, std::int64_t session, const SessionGrade& grade) override;
   std::vector<SessionGrade> grades(std::int64_t session) override;
   std::vector<SessionSummary> sessions() override;
+  std::vector<SessionSummary> sessions_of_trainee(std::string_view trainee) override;
   std::vector<MetricValue> metrics(std::int64_t session) override;
   using SessionStore::frames;
   std::vector<ServoFrame> frames(std::int64_t session, const ReadingProgress& progress) override;
@@ -74,11 +84,18 @@ class SqliteSessionStore final : public SessionStore {
                               std::size_t total = 0);
   // The id of the person of that name and role ("trainee", "instructor"), added if new.
   std::int64_t person(std::string_view name, std::string_view role);
+  // The instructor account of that name: its person id and password hash.
+  std::optional<std::pair<std::int64_t, std::string>> account_of(std::string_view name);
+  // The instructor's person id, if they have an account here (AccessDenied otherwise).
+  std::int64_t checked_instructor(const Instructor& instructor);
+  // The sessions, all (no trainee) or one trainee's.
+  std::vector<SessionSummary> list_sessions(std::optional<std::string_view> trainee);
 
   std::filesystem::path file_;
   sqlite3* db_ = nullptr;
   bool in_transaction_ = false;
   std::vector<std::unique_ptr<Statement>> statements_;
+  PasswordHashCost password_cost_ = kInteractivePasswordCost;
 };
 
 }  // namespace liversim
