@@ -1159,6 +1159,14 @@ The scene that was running goes on.</source>
         <source>Reviewing every trainee&apos;s sessions is for instructors: log in first (Settings ▸ Instructor Mode).</source>
         <translation>查看所有学员的会话仅限教师：请先登录（设置 ▸ 教师模式）。</translation>
     </message>
+    <message>
+        <source>Authoring scenarios is for instructors: log in first (Settings ▸ Instructor Mode).</source>
+        <translation>编写场景仅限教师：请先登录（设置 ▸ 教师模式）。</translation>
+    </message>
+    <message>
+        <source>Changing the tissue is for instructors: log in first (Settings ▸ Instructor Mode).</source>
+        <translation>修改组织仅限教师：请先登录（设置 ▸ 教师模式）。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::MaterialPanel</name>

@@ -691,6 +691,11 @@ void MainWindow::setSeeThrough(bool on) {
 }
 
 ScenarioEditor* MainWindow::openScenarioEditor() {
+  if (!instructor_) {  // the action is hidden in trainee mode; this holds for any caller
+    statusBar()->showMessage(
+        tr("Authoring scenarios is for instructors: log in first (Settings ▸ Instructor Mode)."));
+    return nullptr;
+  }
   if (!editor_) {
     editor_ = new ScenarioEditor(this);
     editor_->setWindowFlag(Qt::Window);
@@ -769,6 +774,12 @@ bool MainWindow::applyTissue(const TissueSpec& tissue) {
     return true;
   }
   if (busyBuilding()) return false;
+  if (!instructor_) {  // the panel is read-only in trainee mode; this holds for any caller
+    materialPanel_->showError(
+        tr("Changing the tissue is for instructors: log in first "
+           "(Settings ▸ Instructor Mode)."));
+    return false;
+  }
   Scenario described = describedScenario();
   described.parenchyma = tissue;
   std::vector<RegionMaterial> regions = region_materials(described);

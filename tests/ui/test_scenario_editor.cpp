@@ -449,6 +449,12 @@ TEST(ScenarioEditorInTheWorkstation, TryItRunsTheEditedScenarioAndTheEditorStart
   MainWindow window(default_scene(1000));
   window.show();
   ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  // Authoring is an instructor's: refused to a trainee, offered after the log-in.
+  EXPECT_EQ(window.openScenarioEditor(), nullptr);
+  QTemporaryDir folder;
+  ASSERT_TRUE(window.setSessionsDatabase(folder.filePath("sessions.sqlite")));
+  QString why;
+  ASSERT_TRUE(window.logInInstructor("Dr. Grey", "long enough", &why)) << why.toStdString();
   ScenarioEditor* editor = window.openScenarioEditor();
   ASSERT_TRUE(editor);
   ASSERT_TRUE(QTest::qWaitForWindowExposed(editor));

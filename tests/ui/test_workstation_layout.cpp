@@ -62,6 +62,10 @@ TEST(Workstation, TheToolbarAndTheModesOfferWhatEachUserMayDo) {
   auto* modulus = window->findChild<QDoubleSpinBox*>("materialYoungsModulus");
   ASSERT_NE(modulus, nullptr);
   EXPECT_TRUE(modulus->isReadOnly());
+  // Nor does a call change it: the rule holds below the interface too.
+  EXPECT_FALSE(window->applyTissue(window->materialPanel()->tissueInUse()));
+  EXPECT_TRUE(window->materialPanel()->errorText().contains("for instructors"))
+      << window->materialPanel()->errorText().toStdString();
   const double before = modulus->value();
   modulus->setFocus();
   QTest::keyClick(modulus, Qt::Key_Up);  // a read-only spin box does not step
