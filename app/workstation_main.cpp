@@ -1,4 +1,5 @@
 // liversim: the workstation. Builds the default scene (or a scenario's) and opens the main window.
+#include "device_panel.h"
 #include "main_window.h"
 #include "translations.h"
 #include "vtk_viewport.h"
@@ -33,6 +34,7 @@ struct Options {
   std::string scenario_file;
   std::string scenario_text;  // its exact content
   QString sessions_database;  // empty: sessions.sqlite in the user's data directory
+  QString trajectory_file;    // the scripted device's trajectory, driving the tool from the start
   QString language;           // empty: the setting, else the system's
 };
 
@@ -96,6 +98,14 @@ Options parse_options(int argc, char** argv) {
                                   "in the user's data directory)."),
       "file");
   parser.addOption(database);
+  const QCommandLineOption trajectory(
+      "trajectory",
+      QCoreApplication::translate(
+          "main",
+          "Drive the tool from the start with the scripted device playing this trajectory file "
+          "(a line per point: time_s x_mm y_mm z_mm [buttons]); its session is recorded."),
+      "file");
+  parser.addOption(trajectory);
   const QCommandLineOption language_option(
       "language",
       QCoreApplication::translate("main",
@@ -153,6 +163,7 @@ Options parse_options(int argc, char** argv) {
     options.scenario_text.assign(std::istreambuf_iterator<char>(in), {});
   }
   if (parser.isSet(database)) options.sessions_database = parser.value(database);
+  if (parser.isSet(trajectory)) options.trajectory_file = parser.value(trajectory);
   if (parser.isSet(language_option)) {
     options.language = parser.value(language_option);
     if (!liversim::availableLanguages().contains(options.language)) {
@@ -219,6 +230,12 @@ int main(int argc, char** argv) {
     if (!window.setSessionsDatabase(database))
       std::cerr << "liversim: " << window.sessionsProblem().toStdString() << '\n';
     window.show();
+    if (!options.trajectory_file.isEmpty() &&
+        !window.useDevice(liversim::DeviceChoice::scripted, options.trajectory_file)) {
+      std::cerr << "liversim: cannot play the trajectory " << options.trajectory_file.toStdString()
+                << ": " << window.devicePanel()->statusText().toStdString() << '\n';
+      return 2;
+    }
     if (options.quit_after_s)
       QTimer::singleShot(static_cast<int>(std::lround(*options.quit_after_s * 1e3)), &app,
                          &QApplication::quit);

@@ -64,6 +64,10 @@
         <source>Open it with the newer LiverSim that wrote it, or start this one with another file (liversim --database FILE).</source>
         <translation>请用写入它的较新版 LiverSim 打开，或用另一个文件启动本程序（liversim --database FILE）。</translation>
     </message>
+    <message>
+        <source>Start LiverSim again to make a new sessions database there, or restore the file from a backup. Until then, sessions are not recorded.</source>
+        <translation>请重新启动 LiverSim 以在该位置新建会话数据库，或从备份恢复该文件。在此之前，会话不会被录制。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::AccuracyPanel</name>
@@ -1166,6 +1170,10 @@ The scene that was running goes on.</source>
     <message>
         <source>Changing the tissue is for instructors: log in first (Settings ▸ Instructor Mode).</source>
         <translation>修改组织仅限教师：请先登录（设置 ▸ 教师模式）。</translation>
+    </message>
+    <message>
+        <source>Recording stopped: this session is no longer being saved (what was saved before is kept). %1</source>
+        <translation>录制已停止：此会话不再保存（之前已保存的内容会保留）。%1</translation>
     </message>
 </context>
 <context>
@@ -2574,6 +2582,10 @@ Start LiverSim from a terminal to see its messages; liversim --help lists its op
         <translation>无法打开主窗口：%1
 
 请从终端启动 LiverSim 以查看其消息；liversim --help 列出其选项（更小的肝脏：--tets N；另一个场景：--scenario FILE）。</translation>
+    </message>
+    <message>
+        <source>Drive the tool from the start with the scripted device playing this trajectory file (a line per point: time_s x_mm y_mm z_mm [buttons]); its session is recorded.</source>
+        <translation>启动后即由播放此轨迹文件的脚本设备驱动器械（每行一个点：time_s x_mm y_mm z_mm [按钮]）；其会话会被录制。</translation>
     </message>
 </context>
 </TS>

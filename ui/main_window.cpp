@@ -1063,7 +1063,22 @@ void MainWindow::showTool(const std::optional<Tool>& tool) {
 }
 
 void MainWindow::showNewestSnapshot() {
-  if (recorder_) recorder_->record_inputs(simulation_->take_input_log());
+  if (recorder_) {
+    recorder_->record_inputs(simulation_->take_input_log());
+    // Said when it happens, not at the session's end: the trainee is told the session is no
+    // longer being saved (what was committed before stays).
+    if (!recordingFailureShown_) {
+      if (const std::optional<StorageError> failure = recorder_->failure()) {
+        recordingFailureShown_ = true;
+        sessionsProblem_ = storageProblemText(
+            tr("Recording stopped: this session is no longer being saved (what was saved before "
+               "is kept). %1"),
+            *failure);
+        statusBar()->showMessage(sessionsProblem_);
+        devicePanel_->showStatus(sessionsProblem_, true);
+      }
+    }
+  }
   if (simulation_->update_snapshot()) {
     const SimulationSnapshot& snapshot = simulation_->snapshot();
     const bool cut = snapshot.topology_version != shownTopology_ && snapshot.model;
@@ -1369,6 +1384,7 @@ void MainWindow::beginRecording() {
   while (servo->next_logged_frame(earlier)) {
   }
   droppedBeforeRecording_ = servo->dropped_log_frames();
+  recordingFailureShown_ = false;
   try {
     recorder_ = std::make_unique<SessionRecorder>(
         *sessions_, start, [servo](ServoFrame& frame) { return servo->next_logged_frame(frame); });

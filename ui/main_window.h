@@ -282,6 +282,7 @@ class MainWindow : public QMainWindow {
   AccuracyPanel* accuracyPanel_ = nullptr;
   QPointer<AccuracyStudyDialog> accuracyStudy_;
   std::optional<Instructor> instructor_;  // who logged in, in instructor mode
+  bool recordingFailureShown_ = false;    // the recorder's storage failure, said once
   QPointer<InstructorLoginDialog> loginDialog_;
   QAction* addInstructorAction_ = nullptr;
   ToolPanel* toolPanel_ = nullptr;

@@ -38,6 +38,10 @@ QString storageAdvice(StorageProblem problem) {
       return tr(
           "Open it with the newer LiverSim that wrote it, or start this one with another "
           "file (liversim --database FILE).");
+    case StorageProblem::deleted:
+      return tr(
+          "Start LiverSim again to make a new sessions database there, or restore the file "
+          "from a backup. Until then, sessions are not recorded.");
     case StorageProblem::other:
       break;
   }

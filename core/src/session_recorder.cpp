@@ -41,6 +41,12 @@ std::string SessionRecorder::error() const {
   return error_;
 }
 
+std::optional<StorageError> SessionRecorder::failure() const {
+  std::lock_guard lock(mutex_);
+  if (error_.empty()) return std::nullopt;
+  return StorageError(error_, error_problem_);
+}
+
 void SessionRecorder::stop_writer() {
   {
     std::lock_guard lock(mutex_);
@@ -59,6 +65,7 @@ bool SessionRecorder::finish(std::int64_t ended_unix_ms, const SessionServoFigur
   } catch (const StorageError& e) {
     std::lock_guard lock(mutex_);
     error_ = e.what();
+    error_problem_ = e.problem();
     return false;
   }
   return true;
@@ -81,6 +88,7 @@ bool SessionRecorder::write_waiting() {
   } catch (const StorageError& e) {
     std::lock_guard lock(mutex_);
     error_ = e.what();
+    error_problem_ = e.problem();
     return false;
   }
   frames_written_ += static_cast<std::int64_t>(frame_batch_.size());

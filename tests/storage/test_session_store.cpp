@@ -50,6 +50,21 @@ std::vector<ServoFrame> synthetic_frames(std::size_t count, unsigned seed) {
   return frames;
 }
 
+// Frames a recorder takes only as the test releases them (as a servo queues them over time).
+struct ReleasedFrames {
+  std::vector<ServoFrame> frames;
+  std::size_t next = 0;
+  std::atomic<std::size_t> released{0};
+  SessionRecorder::FrameSource source() {
+    return [this](ServoFrame& frame) {
+      if (next >= released.load()) return false;
+      frame = frames[next++];
+      return true;
+    };
+  }
+  void release(std::size_t count) { released = std::min(frames.size(), released.load() + count); }
+};
+
 void expect_same_frames(const std::vector<ServoFrame>& read,
                         const std::vector<ServoFrame>& written) {
   ASSERT_EQ(read.size(), written.size());
@@ -627,24 +642,16 @@ TEST(SessionRecorder, AFullDiskStopsTheRecordingAndKeepsWhatWasCommitted) {
   const fs::path file = fresh_database("full-disk");
   SqliteSessionStore store(file);
   const std::vector<ServoFrame> frames = synthetic_frames(200'000, 6);
-  std::size_t next = 0;
+  ReleasedFrames source{frames};
   SessionRecorder::Options options;
   options.commit_period_s = 0.01;
   // 500 frames a commit, until the file is full.
-  std::atomic<std::size_t> released{0};
-  SessionRecorder recorder(
-      store, start_of("Trainee A", "{}"),
-      [&](ServoFrame& frame) {
-        if (next >= released.load()) return false;
-        frame = frames[next++];
-        return true;
-      },
-      options);
+  SessionRecorder recorder(store, start_of("Trainee A", "{}"), source.source(), options);
   store.limit_pages_for_testing(64);  // 256 KiB at 4 KiB pages
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while (recorder.error().empty() && std::chrono::steady_clock::now() < deadline &&
-         released.load() < frames.size()) {
-    released = std::min(frames.size(), released.load() + 500);
+         source.released.load() < frames.size()) {
+    source.release(500);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   const std::string error = recorder.error();
@@ -774,6 +781,62 @@ TEST(InstructorAccounts, HostileNamesAndCommentsAreStoredAsData) {
   EXPECT_EQ(store.sessions().at(0).trainee, trainee);
   EXPECT_EQ(store.integrity_check(), "ok");
   EXPECT_EQ(store.schema_version(), SqliteSessionStore::kSchemaVersion);
+}
+
+// The file deleted while a session is recorded: the recorder stops at its next commit with a
+// message naming the file and what happened, instead of writing into a file that is gone; the
+// next start makes a new database there.
+TEST(SessionRecorder, ADatabaseDeletedWhileRecordingIsNamedAndTheNextStartRecovers) {
+  const fs::path file = fresh_database("deleted-while-recording");
+  bool deleted = false;
+  {
+    SqliteSessionStore store(file);
+    SessionRecorder::Options options;
+    options.commit_period_s = 0.01;
+    ReleasedFrames source{synthetic_frames(200'000, 8)};
+    SessionRecorder recorder(store, start_of("Trainee A", "{}"), source.source(), options);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    auto release_some = [&] {  // 100 frames every 5 ms
+      source.release(100);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    };
+    while (recorder.frames_written() < 500 && std::chrono::steady_clock::now() < deadline)
+      release_some();
+    ASSERT_GE(recorder.frames_written(), 500) << recorder.error();
+    for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(file.string() + suffix);
+    deleted = true;
+    while (recorder.error().empty() && std::chrono::steady_clock::now() < deadline) release_some();
+    const std::string error = recorder.error();
+    ASSERT_FALSE(error.empty()) << "the deletion went unnoticed";
+    EXPECT_NE(error.find(file.string()), std::string::npos) << error;
+    EXPECT_NE(error.find("deleted"), std::string::npos) << error;
+    EXPECT_FALSE(recorder.finish(0, {}));
+  }
+  EXPECT_TRUE(deleted);
+  // The next start: a new, empty database where the old one was.
+  SqliteSessionStore next(file);
+  EXPECT_EQ(next.integrity_check(), "ok");
+  EXPECT_TRUE(next.sessions().empty());
+  const std::int64_t session = next.begin_session(start_of("Trainee A", "{}"));
+  next.append_frames(session, synthetic_frames(10, 9));
+  next.commit();
+  EXPECT_EQ(next.frames(session).size(), 10u);
+}
+
+// A store's own commit refuses a file deleted or replaced under it, with its kind.
+TEST(SessionStore, ACommitToADeletedOrReplacedFileIsRefused) {
+  const fs::path file = fresh_database("replaced");
+  SqliteSessionStore store(file);
+  const std::int64_t session = store.begin_session(start_of("Trainee A", "{}"));
+  fs::rename(file, file.string() + ".moved");
+  { SqliteSessionStore other(file); }  // another file now has the name
+  try {
+    store.append_frames(session, synthetic_frames(10, 10));
+    store.commit();
+    ADD_FAILURE() << "the commit went to a file that is no longer there";
+  } catch (const StorageError& e) {
+    EXPECT_EQ(e.problem(), StorageProblem::deleted) << e.what();
+  }
 }
 
 // The store itself says a full file is full, as a kind the workstation gives advice for.

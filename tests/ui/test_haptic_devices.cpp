@@ -274,6 +274,45 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   EXPECT_NE(window_->servo(), nullptr) << "the device runs without recording";
 }
 
+// The sessions database deleted while a device session is recorded: the trainee is told at once
+// that the session is no longer saved and what to do, the simulation goes on, and the next start
+// (the database opened again at its path) records anew.
+TEST_F(DeviceTest, ADatabaseDeletedMidSessionIsSaidAtOnceAndTheNextStartRecords) {
+  openWindow();
+  const QString database = folder_.filePath("sessions.sqlite");
+  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
+  const QString file = writeTrajectory(
+      {{0.0, Eigen::Vector3d(5.0, 6.0, 40.0), 0}, {600.0, Eigen::Vector3d(15.0, 6.0, 40.0), 0}});
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
+  ASSERT_TRUE(window_->recordingSession().has_value()) << window_->sessionsProblem().toStdString();
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 300; }, kTimeoutMs));
+  for (const char* suffix : {"", "-wal", "-shm"}) QFile::remove(database + suffix);
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] { return window_->devicePanel()->statusText().contains("Recording stopped"); },
+      kTimeoutMs))
+      << window_->devicePanel()->statusText().toStdString();
+  const QString said = window_->devicePanel()->statusText();
+  EXPECT_TRUE(said.contains("deleted")) << said.toStdString();
+  EXPECT_TRUE(said.contains(storageAdvice(StorageProblem::deleted))) << said.toStdString();
+  const double time_s = snapshot().time_s;
+  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().time_s > time_s + 0.05; }, kTimeoutMs))
+      << "the simulation stopped with the recording";
+  // The next start: a new database at the same path, and a new session recorded whole.
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
+  ASSERT_TRUE(window_->recordingSession().has_value());
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 300; }, kTimeoutMs));
+  QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
+  ASSERT_TRUE(metricsStored.wait(kTimeoutMs));
+  EXPECT_TRUE(metricsStored.first().at(1).toBool()) << window_->sessionsProblem().toStdString();
+  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
+  ASSERT_EQ(store.sessions().size(), 1u);
+  EXPECT_EQ(store.sessions()[0].status, SessionStatus::complete);
+  EXPECT_GT(store.sessions()[0].frame_count, 0);
+}
+
 // The simulation's events reach the session: scripted forceps closing on the top of the liver
 // (the device's button), holding, and opening again record a grasp, then a release.
 TEST_F(DeviceTest, AGraspAndReleaseByTheDeviceAreSessionEvents) {
@@ -582,6 +621,8 @@ Function fakeHook(const char* name) {
 TEST_F(DeviceTest, TheOmniIsOfferedWhenItOpensAndAFatalFaultHandsTheToolBackToTheMouse) {
   qputenv("LIVERSIM_OPENHAPTICS_LIBRARY", LIVERSIM_FAKE_HD_LIBRARY);
   openWindow();
+  const QString database = folder_.filePath("sessions.sqlite");
+  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
   DevicePanel* panel = window_->devicePanel();
   ASSERT_TRUE(panel->openHapticsOffered()) << panel->openHapticsToolTip().toStdString();
   window_->toolPanel()->setTool(ToolKind::probe);
@@ -603,6 +644,20 @@ TEST_F(DeviceTest, TheOmniIsOfferedWhenItOpensAndAFatalFaultHandsTheToolBackToTh
   double force_n[3];
   last_force(force_n);
   EXPECT_EQ(Eigen::Vector3d(force_n[0], force_n[1], force_n[2]), Eigen::Vector3d::Zero());
+  // The session of the unplugged device ended with what it recorded until then, and the fault.
+  {
+    SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
+    const std::vector<SessionSummary> sessions = store.sessions();
+    ASSERT_EQ(sessions.size(), 1u);
+    EXPECT_EQ(sessions[0].status, SessionStatus::complete);
+    EXPECT_GT(sessions[0].frame_count, 200);
+    EXPECT_EQ(static_cast<std::int64_t>(store.frames(sessions[0].id).size()),
+              sessions[0].frame_count);
+    const std::vector<SessionEvent> events = store.events(sessions[0].id);
+    EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const SessionEvent& e) {
+      return e.kind == SessionEventKind::device_fault && !e.detail.empty();
+    })) << "the fault is not among the session's events";
+  }
   // Plugged in again: choosing it opens it anew.
   ASSERT_TRUE(window_->useDevice(DeviceChoice::openhaptics)) << panel->statusText().toStdString();
   EXPECT_TRUE(panel->openHapticsOffered());

@@ -4,6 +4,7 @@
 #include "liversim/core/sha256.h"
 
 #include <sqlite3.h>
+#include <sys/stat.h>
 
 #include <array>
 #include <chrono>
@@ -261,6 +262,11 @@ SqliteSessionStore::SqliteSessionStore(const std::filesystem::path& file, Access
     throw error("cannot open it (" + message + ")", StorageProblem::unreachable);
   }
   statements_.resize(kStatementCount);
+  if (struct stat opened{}; stat(file.c_str(), &opened) == 0) {
+    file_device_ = opened.st_dev;
+    file_inode_ = opened.st_ino;
+    file_identity_known_ = true;
+  }
   try {
     sqlite3_extended_result_codes(db_, 1);
     sqlite3_busy_timeout(db_, 2000);
@@ -380,13 +386,30 @@ void SqliteSessionStore::limit_pages_for_testing(std::int64_t pages) {
 
 void SqliteSessionStore::begin_if_needed() {
   if (in_transaction_) return;
+  check_file_is_still_there();
   if (sqlite3_exec(db_, "BEGIN", nullptr, nullptr, nullptr) != SQLITE_OK)
     fail("starting a transaction");
   in_transaction_ = true;
 }
 
+void SqliteSessionStore::check_file_is_still_there() {
+  // A deleted file stays open and takes every write, which is then lost with it; a file put in
+  // its place shares its journal's name, so the connection would read another database's.
+  struct stat now {};
+  if (!file_identity_known_ ||
+      (stat(file_.c_str(), &now) == 0 && now.st_dev == file_device_ && now.st_ino == file_inode_))
+    return;
+  if (in_transaction_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  in_transaction_ = false;
+  throw error(
+      "the file was deleted or replaced while it was in use; what is recorded now cannot be "
+      "saved in it",
+      StorageProblem::deleted);
+}
+
 void SqliteSessionStore::commit() {
   if (!in_transaction_) return;
+  check_file_is_still_there();
   if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
     const std::string doing = "committing";
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);

@@ -32,6 +32,7 @@ enum class StorageProblem {
   damaged,         // the file is corrupt
   not_a_database,  // not a (LiverSim) database
   newer_version,   // written by a newer LiverSim
+  deleted,         // deleted or replaced while in use
 };
 
 class StorageError : public std::runtime_error {

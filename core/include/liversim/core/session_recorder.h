@@ -10,6 +10,7 @@
 #include <condition_variable>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -48,6 +49,8 @@ class SessionRecorder {
 
   // Empty while storage works; else what failed, naming the database.
   std::string error() const;
+  // The storage failure that stopped the writer, with its kind; none while it writes.
+  std::optional<StorageError> failure() const;
   std::int64_t frames_written() const { return frames_written_.load(); }
 
  private:
@@ -69,6 +72,7 @@ class SessionRecorder {
   std::vector<SessionEvent> events_;
   std::vector<SimulationInput> inputs_;
   std::string error_;
+  StorageProblem error_problem_ = StorageProblem::other;
   bool stop_ = false;
   std::atomic<std::int64_t> frames_written_{0};
   std::thread writer_;

@@ -71,6 +71,8 @@ class SqliteSessionStore final : public SessionStore {
   class Statement;
   void execute(const char* sql, const char* doing);
   void begin_if_needed();
+  // Throws (StorageProblem::deleted) when the file opened is no longer at its path.
+  void check_file_is_still_there();
   // An error about this file: "sessions database FILE: what".
   StorageError error(const std::string& what, StorageProblem problem = StorageProblem::other) const;
   [[noreturn]] void fail(const std::string& doing);
@@ -96,6 +98,10 @@ class SqliteSessionStore final : public SessionStore {
   bool in_transaction_ = false;
   std::vector<std::unique_ptr<Statement>> statements_;
   PasswordHashCost password_cost_ = kInteractivePasswordCost;
+  // The file opened (device, inode): a commit refuses to write to a file deleted or replaced.
+  std::uint64_t file_device_ = 0;
+  std::uint64_t file_inode_ = 0;
+  bool file_identity_known_ = false;
 };
 
 }  // namespace liversim
