@@ -223,12 +223,10 @@ bool AccuracyStudyDialog::start() {
     setStatus(tr("Check at least one integrator to study."), true);
     return false;
   }
-  if (worker_.joinable()) worker_.join();
   runOptions_ = options;
   result_.reset();
   fillTable();
   cancelRequested_ = false;
-  finished_ = false;
   setRunning(true);
   setStatus(tr("Starting…"), false);
   worker_ = std::thread([this, options] {
@@ -286,7 +284,7 @@ bool AccuracyStudyDialog::saveCsv(const QString& path) {
 }
 
 void AccuracyStudyDialog::showProgress(const StudyProgressReport& report) {
-  if (finished_ || cancelRequested_) return;  // a report posted before the end or the cancel
+  if (cancelRequested_) return;  // a report posted before the cancel
   const double runs = report.runs_done + report.fraction_of_run;
   progress_->setValue(
       report.runs_total > 0 ? static_cast<int>(runs / report.runs_total * kProgressSteps) : 0);
@@ -299,8 +297,7 @@ void AccuracyStudyDialog::showProgress(const StudyProgressReport& report) {
 
 void AccuracyStudyDialog::finish(std::optional<AccuracyStudyResult> result, const QString& error,
                                  bool wasCancelled) {
-  if (worker_.joinable()) worker_.join();
-  finished_ = true;
+  worker_.join();  // its last act was to post this
   setRunning(false);
   if (wasCancelled) {
     progress_->setValue(0);

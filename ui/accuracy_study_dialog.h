@@ -38,7 +38,8 @@ class AccuracyStudyDialog : public QDialog {
   // checked. finished() follows, or cancelled() after cancel().
   bool start();
   void cancel();
-  bool running() const { return worker_.joinable() && !finished_; }
+  // Until finish() has taken the worker's result and joined it.
+  bool running() const { return worker_.joinable(); }
 
   const std::optional<AccuracyStudyResult>& result() const { return result_; }
   // The status line: progress, the outcome, or what went wrong.
@@ -76,7 +77,6 @@ class AccuracyStudyDialog : public QDialog {
   AccuracyStudyOptions runOptions_;
   std::optional<AccuracyStudyResult> result_;
   std::atomic<bool> cancelRequested_{false};
-  bool finished_ = true;
   // Last: joined first when the dialog goes, while the object its reports are posted to lives.
   std::thread worker_;
 };

@@ -1283,15 +1283,12 @@ bool MainWindow::replaySession(std::int64_t session) {
                                              : sessionsProblem_);
   std::vector<ServoFrame> frames;
   try {
-    if (!instructor_) {
-      const std::vector<SessionSummary> own =
-          sessions_->sessions_of_trainee(traineeName().toStdString());
-      if (std::none_of(own.begin(), own.end(),
-                       [&](const SessionSummary& s) { return s.id == session; }))
-        return refuse(tr("Session %1 is not yours to replay: trainees replay their own sessions "
-                         "(an instructor may replay any).")
-                          .arg(session));
-    }
+    const std::vector<SessionSummary> replayable = replayableSessions();
+    if (std::none_of(replayable.begin(), replayable.end(),
+                     [&](const SessionSummary& s) { return s.id == session; }))
+      return refuse(tr("Session %1 is not yours to replay: trainees replay their own sessions "
+                       "(an instructor may replay any).")
+                        .arg(session));
     std::optional<std::vector<ServoFrame>> read = readSessionFrames(*sessions_, session, this);
     if (!read)
       return refuse(tr("Session %1 is not replayed: reading it was cancelled.").arg(session));
@@ -1309,13 +1306,16 @@ bool MainWindow::replaySession(std::int64_t session) {
   return useDevice(DeviceChoice::replay);
 }
 
+std::vector<SessionSummary> MainWindow::replayableSessions() {
+  // A trainee replays their own sessions only.
+  return instructor_ ? sessions_->sessions()
+                     : sessions_->sessions_of_trainee(traineeName().toStdString());
+}
+
 void MainWindow::chooseSessionToReplay() {
   std::vector<SessionSummary> sessions;
   try {
-    // A trainee replays their own sessions only.
-    if (sessions_)
-      sessions = instructor_ ? sessions_->sessions()
-                             : sessions_->sessions_of_trainee(traineeName().toStdString());
+    if (sessions_) sessions = replayableSessions();
   } catch (const StorageError& e) {
     sessionsProblem_ = storageProblemText(QStringLiteral("%1"), e);
   }
@@ -1487,8 +1487,8 @@ SessionReviewWindow* MainWindow::showSessionsWindow(QPointer<SessionReviewWindow
     return nullptr;
   }
   if (!window) {
-    window =
-        new SessionReviewWindow(sessionsFile_, trainee, trainee ? std::nullopt : instructor_, this);
+    // The instructor logged in grades; a trainee's history takes no grader.
+    window = new SessionReviewWindow(sessionsFile_, trainee, instructor_, this);
     window->setAttribute(Qt::WA_DeleteOnClose);
   } else {
     window->refresh();

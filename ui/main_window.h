@@ -203,6 +203,8 @@ class MainWindow : public QMainWindow {
 
  private:
   void applyMode(bool instructor);
+  // The sessions the user may replay: all for an instructor, a trainee's own otherwise.
+  std::vector<SessionSummary> replayableSessions();
   // A panel docked on the right, movable, floatable and closable (View ▸ Panels).
   QDockWidget* addPanelDock(const QString& title, const char* name, QWidget* panel);
   // The window's size, docks and toolbar as the user left them (saveState).

@@ -38,13 +38,12 @@ void SessionRecorder::record_inputs(std::vector<SimulationInput> inputs) {
 
 std::string SessionRecorder::error() const {
   std::lock_guard lock(mutex_);
-  return error_;
+  return failure_ ? failure_->what() : std::string();
 }
 
 std::optional<StorageError> SessionRecorder::failure() const {
   std::lock_guard lock(mutex_);
-  if (error_.empty()) return std::nullopt;
-  return StorageError(error_, error_problem_);
+  return failure_;
 }
 
 void SessionRecorder::stop_writer() {
@@ -64,8 +63,7 @@ bool SessionRecorder::finish(std::int64_t ended_unix_ms, const SessionServoFigur
     store_.end_session(session_, ended_unix_ms, servo);
   } catch (const StorageError& e) {
     std::lock_guard lock(mutex_);
-    error_ = e.what();
-    error_problem_ = e.problem();
+    failure_ = e;
     return false;
   }
   return true;
@@ -87,8 +85,7 @@ bool SessionRecorder::write_waiting() {
     if (!frame_batch_.empty() || !event_batch_.empty() || !input_batch_.empty()) store_.commit();
   } catch (const StorageError& e) {
     std::lock_guard lock(mutex_);
-    error_ = e.what();
-    error_problem_ = e.problem();
+    failure_ = e;
     return false;
   }
   frames_written_ += static_cast<std::int64_t>(frame_batch_.size());

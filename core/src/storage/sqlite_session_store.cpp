@@ -656,7 +656,7 @@ std::optional<std::pair<std::int64_t, std::string>> SqliteSessionStore::account_
   return account;
 }
 
-std::int64_t SqliteSessionStore::checked_instructor(const Instructor& instructor) {
+void SqliteSessionStore::require_account(const Instructor& instructor) {
   const std::int64_t accounts =
       prepared(kCheckGrader,
                "SELECT count(*) FROM instructor_accounts a JOIN people p ON p.id = a.person_id "
@@ -667,7 +667,6 @@ std::int64_t SqliteSessionStore::checked_instructor(const Instructor& instructor
   if (accounts != 1)
     throw AccessDenied("\"" + instructor.name() + "\" has no instructor account in " +
                        file_.string());
-  return instructor.id();
 }
 
 Instructor SqliteSessionStore::add_instructor_account(std::string_view name,
@@ -678,7 +677,7 @@ Instructor SqliteSessionStore::add_instructor_account(std::string_view name,
   if (has_instructor_accounts()) {
     if (added_by == nullptr)
       throw AccessDenied("only an instructor who has logged in can add instructor accounts");
-    checked_instructor(*added_by);
+    require_account(*added_by);
   }
   if (account_of(name))
     throw std::invalid_argument("there is already an instructor account named \"" +
@@ -711,7 +710,8 @@ std::optional<Instructor> SqliteSessionStore::log_in_instructor(std::string_view
 
 void SqliteSessionStore::store_grade(const Instructor& by, std::int64_t session,
                                      const SessionGrade& grade) {
-  const std::int64_t instructor = checked_instructor(by);
+  require_account(by);
+  const std::int64_t instructor = by.id();
   begin_if_needed();
   Statement& store = prepared(
       kStoreGrade,

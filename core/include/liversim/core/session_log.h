@@ -21,8 +21,6 @@
 
 namespace liversim {
 
-// A storage failure: names the database file and what is wrong with it (read-only, damaged, full,
-// written by a newer version...).
 // What kind of trouble a storage error is, so that an interface can say what to do about it.
 enum class StorageProblem {
   other,
@@ -35,6 +33,8 @@ enum class StorageProblem {
   deleted,         // deleted or replaced while in use
 };
 
+// A storage failure: names the database file and what is wrong with it (read-only, damaged, full,
+// written by a newer version...), and its kind.
 class StorageError : public std::runtime_error {
  public:
   explicit StorageError(const std::string& what, StorageProblem problem = StorageProblem::other)

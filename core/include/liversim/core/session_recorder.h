@@ -67,12 +67,11 @@ class SessionRecorder {
   std::vector<SessionEvent> event_batch_;
   std::vector<SimulationInput> input_batch_;
 
-  mutable std::mutex mutex_;  // guards events_, inputs_, error_, stop_
+  mutable std::mutex mutex_;  // guards events_, inputs_, failure_, stop_
   std::condition_variable wake_;
   std::vector<SessionEvent> events_;
   std::vector<SimulationInput> inputs_;
-  std::string error_;
-  StorageProblem error_problem_ = StorageProblem::other;
+  std::optional<StorageError> failure_;
   bool stop_ = false;
   std::atomic<std::int64_t> frames_written_{0};
   std::thread writer_;

@@ -88,8 +88,8 @@ class SqliteSessionStore final : public SessionStore {
   std::int64_t person(std::string_view name, std::string_view role);
   // The instructor account of that name: its person id and password hash.
   std::optional<std::pair<std::int64_t, std::string>> account_of(std::string_view name);
-  // The instructor's person id, if they have an account here (AccessDenied otherwise).
-  std::int64_t checked_instructor(const Instructor& instructor);
+  // AccessDenied unless the instructor has an account here.
+  void require_account(const Instructor& instructor);
   // The sessions, all (no trainee) or one trainee's.
   std::vector<SessionSummary> list_sessions(std::optional<std::string_view> trainee);
 
