@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The two commands of README for a new user on Debian 12:
 #   packaging/liversim.sh run    install what is missing, build, start the workstation
-#   packaging/liversim.sh test   install what is missing, build, run the whole test suite
+#   packaging/liversim.sh test   install what is missing, build, run the whole test suite, then
+#                                fuzz each reader briefly (the fuzz preset: docs/fuzzing.md)
 # Without a display, "run" says so and runs the headless demo instead (a short simulation and a
 # screenshot written to liversim-demo.png in the current directory).
 set -euo pipefail
@@ -26,7 +27,12 @@ cmake --build --preset "$preset" --parallel "$(nproc)"
 
 if [ "$command" = test ]; then
   # GUI and rendering tests need an X server: Xvfb provides one whether or not a display exists.
-  exec "${xvfb[@]}" ctest --preset "$preset" --parallel "$(nproc)" --timeout 300
+  "${xvfb[@]}" ctest --preset "$preset" --parallel "$(nproc)" --timeout 300
+  # Then each fuzz target fuzzed briefly: a clang build of what they need, with libFuzzer and the
+  # sanitizers (docs/fuzzing.md).
+  cmake --preset fuzz >/dev/null
+  cmake --build --preset fuzz --parallel "$(nproc)"
+  exec ctest --preset fuzz --parallel "$(nproc)"
 fi
 
 if [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; then

@@ -4,33 +4,29 @@
 
 #include "liversim/core/surface_import.h"
 
-#include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
-#include <cmath>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace liversim::detail {
 
 // The file's triangles (points and lines dropped), post-processed with `steps`. Throws
 // SurfaceImportError naming the file when the unit is not a positive number, the file is
-// missing, or assimp cannot read it as `what`.
-inline const aiScene* read_assimp_scene(Assimp::Importer& importer,
-                                        const std::filesystem::path& file, double metres_per_unit,
-                                        unsigned steps, const std::string& what) {
-  const std::string name = file.string();
-  if (!(metres_per_unit > 0.0) || !std::isfinite(metres_per_unit))
-    throw SurfaceImportError(name + ": the length unit must be a positive number of metres");
-  if (!std::filesystem::exists(file)) throw SurfaceImportError(name + ": no such file");
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(name, steps);
-  if (scene == nullptr)
-    throw SurfaceImportError(name + ": cannot read it as " + what + ": " +
-                             importer.GetErrorString());
-  return scene;
-}
+// missing, assimp cannot read it as `what`, it is a damaged PLY file (ply_problem) or binary glTF
+// file (glb_problem), or a face has no corners, too many, or a corner that is no vertex.
+const aiScene* read_assimp_scene(Assimp::Importer& importer, const std::filesystem::path& file,
+                                 double metres_per_unit, unsigned steps, const std::string& what);
+
+// What is wrong with a PLY file (a file starting with "ply", in any case, which is how assimp
+// knows one), in its header or its data against the header, and where; none for a sound PLY file
+// or another format.
+std::optional<std::string> ply_problem(const std::filesystem::path& file);
+
+// What is wrong with the lengths of a binary glTF file (a .glb, or a file starting with "glTF");
+// none for sound lengths or another format.
+std::optional<std::string> glb_problem(const std::filesystem::path& file);
 
 }  // namespace liversim::detail

@@ -10,12 +10,28 @@
 
 #include <assimp/Importer.hpp>
 
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <array>
+#include <cerrno>
+#include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstring>
 #include <map>
 #include <mutex>
 #include <sstream>
 #include <unordered_map>
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#include <sanitizer/common_interface_defs.h>
+#endif
+#endif
 
 namespace liversim {
 namespace {
@@ -193,8 +209,10 @@ bool is_surface_file(const std::filesystem::path& file) {
   return std::find(known.begin(), known.end(), extension) != known.end();
 }
 
-TriangleSurface read_surface_file(const std::filesystem::path& file, double metres_per_unit) {
-  const std::string name = file.string();
+namespace {
+
+// The triangles of the file, read here, in this process.
+TriangleSurface read_surface_here(const std::filesystem::path& file, double metres_per_unit) {
   Assimp::Importer importer;
   const aiScene* scene = detail::read_assimp_scene(
       importer, file, metres_per_unit,
@@ -224,6 +242,152 @@ TriangleSurface read_surface_file(const std::filesystem::path& file, double metr
       if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;  // welded to nothing
       surface.triangles.push_back(t);
     }
+  }
+  return surface;
+}
+
+// The reader's answer on the pipe: 'S', then the vertex count (u64), the vertices (3 doubles
+// each), the triangle count (u64) and the triangles (3 int32 each); or 'E' and a message.
+bool write_all(int fd, const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, bytes, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    bytes += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+[[noreturn]] void answer_and_exit(int fd, const std::filesystem::path& file,
+                                  double metres_per_unit) {
+  std::string message;
+  try {
+    const TriangleSurface surface = read_surface_here(file, metres_per_unit);
+    const std::uint64_t vertices = surface.vertices_m.size(), triangles = surface.triangles.size();
+    bool ok = write_all(fd, "S", 1) && write_all(fd, &vertices, sizeof vertices);
+    for (const Eigen::Vector3d& v : surface.vertices_m)
+      ok = ok && write_all(fd, v.data(), 3 * sizeof(double));
+    ok = ok && write_all(fd, &triangles, sizeof triangles) &&
+         write_all(fd, surface.triangles.data(), triangles * sizeof surface.triangles[0]);
+    ::_exit(ok ? 0 : 3);
+  } catch (const std::exception& e) {
+    message = e.what();
+  } catch (...) {
+    message = file.string() + ": cannot read it as a surface model";
+  }
+  write_all(fd, "E", 1);
+  write_all(fd, message.data(), message.size());
+  ::_exit(0);
+}
+
+}  // namespace
+
+// Read in a child process: Debian's assimp 5.2 crashes, corrupts its heap, hangs or allocates
+// without bound on damaged files in several of its readers (fuzzing found it in the PLY and glTF
+// ones, docs/fuzzing.md). A child that dies or overruns its time is an error of the file; the
+// workstation goes on. The checks that need no assimp run here first, with their own messages.
+// The GUI calling this has other threads: after fork only this one runs in the child. glibc keeps
+// malloc usable in a forked child; any other lock a thread held at the fork leaves the child
+// hanging, which the time limit turns into the same error.
+TriangleSurface read_surface_file(const std::filesystem::path& file, double metres_per_unit) {
+  const std::string name = file.string();
+  if (!(metres_per_unit > 0.0) || !std::isfinite(metres_per_unit))
+    throw SurfaceImportError(name + ": the length unit must be a positive number of metres");
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw SurfaceImportError(name + ": no such file");
+  const auto refused = [&](const std::string& why) {
+    return SurfaceImportError(name + ": cannot read it as a surface model: " + why);
+  };
+  if (auto problem = detail::ply_problem(file); problem || (problem = detail::glb_problem(file)))
+    throw refused(*problem);
+  // Time enough for any sound model: assimp reads tens of megabytes a second.
+  const auto bytes = std::filesystem::file_size(file, ec);
+  const auto allowed = std::chrono::seconds(5) + std::chrono::milliseconds(ec ? 0 : bytes / 500);
+  const auto deadline = std::chrono::steady_clock::now() + allowed;
+
+  int channel[2];
+  if (::pipe2(channel, O_CLOEXEC) != 0)
+    throw refused(std::string("cannot start its reader: ") + std::strerror(errno));
+  const pid_t child = ::fork();
+  if (child < 0) {
+    const int error = errno;
+    ::close(channel[0]);
+    ::close(channel[1]);
+    throw refused(std::string("cannot start its reader: ") + std::strerror(error));
+  }
+  if (child == 0) {
+    ::close(channel[0]);
+    // Quiet, and dying of its own faults rather than reporting them as this program's (a
+    // sanitizer build reports and records a crash of the parent).
+    if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, STDERR_FILENO);
+    for (int signal : {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT}) std::signal(signal, SIG_DFL);
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+    __sanitizer_set_death_callback(nullptr);
+#endif
+#endif
+    answer_and_exit(channel[1], file, metres_per_unit);
+  }
+  ::close(channel[1]);
+  std::string answer;
+  bool overran = false;
+  for (std::array<char, 1 << 16> buffer;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    pollfd ready{channel[0], POLLIN, 0};
+    const int polled = ::poll(&ready, 1, static_cast<int>(std::max<long long>(0, left.count())));
+    if (polled < 0 && errno == EINTR) continue;
+    if (polled == 0) {
+      overran = true;
+      break;
+    }
+    const ssize_t n = ::read(channel[0], buffer.data(), buffer.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    answer.append(buffer.data(), static_cast<std::size_t>(n));
+  }
+  ::close(channel[0]);
+  if (overran) ::kill(child, SIGKILL);
+  int status = 0;
+  while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (overran)
+    throw refused(
+        "its reader (assimp) took longer than " +
+        std::to_string(std::chrono::duration_cast<std::chrono::seconds>(allowed).count()) +
+        " s and was stopped (a damaged file?)");
+  if (!answer.empty() && answer[0] == 'E') throw SurfaceImportError(answer.substr(1));
+
+  TriangleSurface surface;
+  std::size_t at = 1;
+  const auto take = [&](void* out, std::size_t size) {
+    if (answer.size() - at < size) return false;
+    if (size > 0) std::memcpy(out, answer.data() + at, size);  // no triangles: `out` is null
+    at += size;
+    return true;
+  };
+  std::uint64_t vertices = 0, triangles = 0;
+  bool whole = !answer.empty() && answer[0] == 'S' && take(&vertices, sizeof vertices) &&
+               vertices <= answer.size() / (3 * sizeof(double));
+  if (whole) {
+    surface.vertices_m.resize(vertices);
+    for (Eigen::Vector3d& v : surface.vertices_m)
+      whole = whole && take(v.data(), 3 * sizeof(double));
+    whole = whole && take(&triangles, sizeof triangles) &&
+            triangles <= answer.size() / sizeof surface.triangles[0];
+  }
+  if (whole) {
+    surface.triangles.resize(triangles);
+    whole = take(surface.triangles.data(), triangles * sizeof surface.triangles[0]) &&
+            at == answer.size();
+  }
+  if (!whole) {
+    const std::string how = WIFSIGNALED(status)
+                                ? std::string("crashed (") + ::strsignal(WTERMSIG(status)) + ")"
+                                : "stopped without an answer";
+    throw refused("its reader (assimp) " + how + " on it (a damaged file?)");
   }
   if (surface.triangles.empty()) throw SurfaceImportError(name + ": the file holds no triangles");
   for (const Eigen::Vector3d& v : surface.vertices_m)

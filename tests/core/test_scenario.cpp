@@ -281,6 +281,36 @@ TEST(ScenarioFile, SeveralFaultsAreAllReported) {
                                           "task.safe_force_n"}));
 }
 
+// Found by fuzzing (docs/fuzzing.md): a number beyond a double's range escaped the reader as the
+// JSON library's out_of_range exception and ended the program. It is an error of the text, at its
+// line and column, like any other.
+TEST(ScenarioFile, ANumberBeyondADoublesRangeIsAnErrorOfTheTextNotACrash) {
+  for (const std::string number : {"1e506", "-2.5E+400"}) {
+    const ScenarioReading reading = read_scenario(
+        "{\n  \"format\": \"liversim-scenario\",\n  \"version\": " + number + "\n}\n");
+    EXPECT_FALSE(reading.scenario);
+    ASSERT_EQ(reading.errors.size(), 1u);
+    EXPECT_EQ(reading.errors[0].text(), "not valid JSON at line 3, column 14: the number " +
+                                            number +
+                                            " is out of range: expected at most about 1.8e308 "
+                                            "in size");
+  }
+}
+
+// Found by fuzzing (docs/fuzzing.md): a direction written not of unit length is normalised on
+// reading, and normalising the saved unit vector again moved it by an ulp, so a saved scenario did
+// not read back equal to the one saved. Once read, it is a fixed point of saving and reading.
+TEST(ScenarioFile, ANormalisedDirectionIsSavedAndReadBackExactly) {
+  Scenario s = every_field_set();
+  s.task.planned_plane->normal = {1.0, 2.0, 0.0};
+  s.parenchyma.fibres->direction = {0.0, 3.0, 7.0};
+  const ScenarioReading first = read_scenario(write_scenario(s));
+  ASSERT_TRUE(first.scenario) << (first.errors.empty() ? "" : first.errors[0].text());
+  EXPECT_NEAR(first.scenario->task.planned_plane->normal[0], 1.0 / std::sqrt(5.0), 1e-15);
+  EXPECT_EQ(round_trip(*first.scenario), *first.scenario);
+  EXPECT_EQ(round_trip(round_trip(*first.scenario)), *first.scenario);
+}
+
 // The shipped scenarios read cleanly and build a model with the effects and lesions they ask for.
 TEST(ShippedScenario, EachBuildsTheModelItDescribes) {
   int count = 0;

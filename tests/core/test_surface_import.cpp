@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 
@@ -207,6 +208,176 @@ TEST_F(SurfaceImportTest, BrokenSurfacesAreRefusedNamingTheProblemAndWhere) {
   std::ofstream(points) << "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   EXPECT_THROW(read_surface_file(points, 1e-3), SurfaceImportError);
   EXPECT_THROW(read_surface_file(points, std::nan("")), SurfaceImportError);
+}
+
+// Found by fuzzing (docs/fuzzing.md): a PLY face that lists no corners made assimp's own steps
+// crash (its primitive sort) or abort (its triangulation), one of 293 840 corners took them 100 s;
+// and assimp hands on a corner past the vertices unchecked. Each is refused before those steps,
+// naming the face.
+TEST_F(SurfaceImportTest, FacesWithoutCornersOrWithCornersPastTheVerticesAreRefused) {
+  // A tetrahedron, 10 mm, its faces outward, and `extra` faces after them.
+  const auto error_of = [&](const std::string& name, const std::vector<std::string>& extra) {
+    const fs::path file = folder_ / name;
+    std::ofstream ply(file);
+    ply << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        << "property float z\nelement face " << 4 + extra.size()
+        << "\nproperty list int int vertex_index\nend_header\n"
+        << "0 0 0\n10 0 0\n0 10 0\n0 0 10\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    for (const std::string& face : extra) ply << face << "\n";
+    ply.close();
+    try {
+      read_surface_file(file, 1e-3);
+    } catch (const SurfaceImportError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of("whole.ply", {}), "");
+  EXPECT_EQ(error_of("no-corners.ply", {"0"}),
+            (folder_ / "no-corners.ply").string() +
+                ": cannot read it as a surface model: face 5 of mesh 1 has no corners");
+  EXPECT_EQ(error_of("corner-past.ply", {"3 1 2 9"}),
+            (folder_ / "corner-past.ply").string() +
+                ": cannot read it as a surface model: face 5 of mesh 1 has a corner at vertex 10, "
+                "but the mesh has 4 vertices");
+  // A damaged count makes a face of a huge number of corners, which assimp's steps would take
+  // minutes over (time growing with its square).
+  std::string huge = "5000";
+  for (int k = 0; k < 5000; ++k) huge += k % 2 ? " 1" : " 2";
+  EXPECT_EQ(error_of("huge-face.ply", {huge}),
+            (folder_ / "huge-face.ply").string() +
+                ": cannot read it as a surface model: face 5 of mesh 1 has 5000 corners, more "
+                "than the 4096 a model's face may have (a damaged file?)");
+}
+
+// Found by fuzzing (docs/fuzzing.md): Debian's assimp 5.2 reads a PLY header that never ends (a
+// cut-short file, or one with a blank line before "ply") forever, corrupts its heap on an element
+// declared twice, reads forever for a count the file cannot hold, and asks for gigabytes for a
+// damaged list count. A PLY file's header
+// and its data against the header are checked before assimp sees it.
+TEST_F(SurfaceImportTest, APlyFileWithADamagedHeaderIsRefusedBeforeAssimpReadsIt) {
+  const auto error_of = [&](const std::string& name, const std::string& text) {
+    const fs::path file = folder_ / name;
+    std::ofstream(file, std::ios::binary) << text;
+    try {
+      read_surface_file(file, 1e-3);
+    } catch (const SurfaceImportError& e) {
+      const std::string prefix = file.string() + ": cannot read it as a surface model: ";
+      const std::string what = e.what();
+      return what.starts_with(prefix) ? what.substr(prefix.size()) : what;
+    }
+    return std::string();
+  };
+  const std::string tetrahedron_body =
+      "0 0 0\n10 0 0\n0 10 0\n0 0 10\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 4\nproperty list uchar int vertex_index\n";
+  EXPECT_EQ(error_of("sound.ply", header + "end_header\n" + tetrahedron_body), "");
+  // assimp takes "ply" after blank lines too, and reads any .ply file as PLY.
+  EXPECT_EQ(error_of("blank-first.ply", "\n" + header),
+            "line 1 of its PLY header is '', not 'ply' (the first line of a PLY file)");
+  EXPECT_EQ(error_of("not-ply.ply", "solid cube\nendsolid cube\n"),
+            "line 1 of its PLY header is 'solid cube', not 'ply' (the first line of a PLY file)");
+  EXPECT_EQ(error_of("cut-short.ply", header),
+            "its PLY header has no end_header line (a cut-short file?)");
+  EXPECT_EQ(
+      error_of("element-twice.ply",
+               header + "element vertex 8\nproperty float x\nend_header\n" + tetrahedron_body),
+      "line 9 of its PLY header declares the element 'vertex' a second time");
+  EXPECT_EQ(error_of("count-beyond.ply",
+                     "ply\nformat binary_little_endian 1.0\nelement vertex 2000000000\n"
+                     "property float x\nend_header\n" +
+                         std::string(4, '\0')),
+            "its PLY header declares 2000000000 of the element 'vertex', more than the 4 bytes "
+            "after the header hold (a damaged file?)");
+  // The data against the header: a list count beyond its type made assimp ask for gigabytes.
+  EXPECT_EQ(error_of("count-past-type.ply", header + "end_header\n" +
+                                                "0 0 0\n10 0 0\n0 10 0\n0 0 10\n3 0 2 1\n"
+                                                "3 0 1 3\n3 0 3 2\n999999999999 1 2 3\n"),
+            "line 17 (face 4 of 4): the count of its list 'vertex_index' is '999999999999', "
+            "expected 0 to 255");
+  EXPECT_EQ(error_of("binary-cut.ply",
+                     "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+                     "property list uchar int vertex_index\nend_header\n\xc8" +
+                         std::string(8, '\0')),
+            "its PLY data ends inside face 1 of 1");
+  EXPECT_EQ(error_of("short-line.ply",
+                     header + "end_header\n" +
+                         "0 0 0\n10 0\n0 10 0\n0 0 10\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"),
+            "line 11 (vertex 2 of 4): 2 numbers, too few for its properties");
+  EXPECT_EQ(error_of("bad-line.ply", "ply\nformat ascii 1.0\nelement face 5\x02ply\nend_header\n"),
+            "line 3 of its PLY header is 'element face 5?ply': expected 'element', a name and a "
+            "count");
+}
+
+// Found by fuzzing (docs/fuzzing.md): Debian's assimp 5.2 allocates what a binary glTF's chunk
+// length says before reading it (3.5 GB for a damaged 10 kB file). The lengths are checked first.
+TEST_F(SurfaceImportTest, ABinaryGltfChunkLongerThanItsFileIsRefused) {
+  TriangleSurface tetrahedron;
+  tetrahedron.vertices_m = {{0, 0, 0}, {0.01, 0, 0}, {0, 0.01, 0}, {0, 0, 0.01}};
+  tetrahedron.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  const fs::path file = folder_ / "tetrahedron.glb";
+  export_surface(tetrahedron, 1000.0, "glb2", file);
+  EXPECT_EQ(read_surface_file(file, 1e-3).triangles.size(), 4u);
+  std::string bytes;
+  {
+    std::ifstream in(file, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_GT(bytes.size(), 20u);
+  bytes.replace(12, 4, std::string("\x8c\x04\x00\xd3", 4));  // chunk 1: 3 539 993 740 bytes
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+  try {
+    read_surface_file(file, 1e-3);
+    ADD_FAILURE() << "a chunk longer than its file was read";
+  } catch (const SurfaceImportError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              file.string() +
+                  ": cannot read it as a surface model: its binary glTF chunk 1 gives a length of "
+                  "3539993740 bytes, more than the " +
+                  std::to_string(bytes.size() - 20) + " left in the file");
+  }
+}
+
+// Found by fuzzing (docs/fuzzing.md): damaged files that crash Debian's assimp 5.2 inside its
+// readers (here its glTF 2 reader dereferences a null pointer). The model is read in a child
+// process, so that such a file is an error naming it, and the program goes on.
+TEST_F(SurfaceImportTest, AModelThatCrashesAssimpIsAnErrorNotACrash) {
+  // The fuzzer's input: its first byte picked the format (.glb), the file follows.
+  const fs::path input = fs::path(LIVERSIM_TEST_DATA_DIR) / ".." / "fuzz" / "regressions" /
+                         "surface_import" / "glb-crashes-assimp-found.glb";
+  std::ifstream in(input, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  ASSERT_GT(bytes.size(), 1u) << input;
+  const fs::path file = folder_ / "crashes-assimp.glb";
+  std::ofstream(file, std::ios::binary) << bytes.substr(1);
+  try {
+    read_surface_file(file, 1e-3);
+    ADD_FAILURE() << "the damaged file was read";
+  } catch (const SurfaceImportError& e) {
+    EXPECT_EQ(std::string(e.what()), file.string() +
+                                         ": cannot read it as a surface model: its reader "
+                                         "(assimp) crashed (Segmentation fault) on it (a damaged "
+                                         "file?)");
+  }
+  // And the next model reads as ever.
+  const fs::path cube = fs::path(LIVERSIM_TEST_DATA_DIR) / "cube-40mm.obj";
+  EXPECT_EQ(read_surface_file(cube, 1e-3).triangles.size(), 192u);
+}
+
+// Found by fuzzing (docs/fuzzing.md), in the reading in a child process: a model whose triangles
+// all fall away (its vertices not numbers, welded into one) came back as no triangles, copied from
+// a null pointer. It is the error it always was.
+TEST_F(SurfaceImportTest, AModelWithNoTrianglesLeftIsAnError) {
+  const fs::path file = folder_ / "no-numbers.obj";
+  std::ofstream(file) << "v 0 0 0\nv nan 0 0\nv 0 nan 0\nf 1 2 3\nv 0 0 0\n";
+  try {
+    read_surface_file(file, 1e-3);
+    ADD_FAILURE() << "a model without triangles was read";
+  } catch (const SurfaceImportError& e) {
+    EXPECT_EQ(std::string(e.what()), file.string() + ": the file holds no triangles");
+  }
 }
 
 // A scenario with a surface model: written and read back equal, and built at its element count
