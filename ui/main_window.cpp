@@ -19,6 +19,7 @@
 #include "liversim/core/emulated_devices.h"
 #include "liversim/core/integrator.h"
 #include "liversim/core/openhaptics_device.h"
+#include "liversim/core/session_recording.h"
 #include "liversim/core/session_replay.h"
 #include "liversim/core/surface.h"
 #include "liversim/storage/sqlite_session_store.h"
@@ -57,7 +58,6 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
-#include <numbers>
 #include <sstream>
 #include <string_view>
 
@@ -980,13 +980,7 @@ void MainWindow::endGrab() {
 }
 
 Eigen::Quaterniond MainWindow::toolOrientationFromView() const {
-  const Eigen::Quaterniond view = deviceAxesFromView();
-  const Eigen::Vector3d toward_viewer = view * Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d view_up = view * Eigen::Vector3d::UnitY();
-  constexpr double kTiltRad = 35.0 * std::numbers::pi / 180.0;
-  const Eigen::Vector3d shaft_direction =
-      (std::cos(kTiltRad) * toward_viewer + std::sin(kTiltRad) * view_up).normalized();
-  return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), shaft_direction);
+  return tool_orientation_from_view(deviceAxesFromView());
 }
 
 // The mouse is a device like the others (ManualDevice, through the servo, recorded): a press puts
@@ -1190,29 +1184,12 @@ Eigen::Quaterniond MainWindow::deviceAxesFromView() const {
   vtkCamera* camera = scene_->renderer()->GetActiveCamera();
   camera->GetDirectionOfProjection(direction);
   camera->GetViewUp(up);
-  const Eigen::Vector3d toward_user =
-      -Eigen::Vector3d(direction[0], direction[1], direction[2]).normalized();
-  const Eigen::Vector3d up_m(up[0], up[1], up[2]);
-  const Eigen::Vector3d view_up = (up_m - toward_user.dot(up_m) * toward_user).normalized();
-  Eigen::Matrix3d axes;
-  axes.col(0) = view_up.cross(toward_user);  // right
-  axes.col(1) = view_up;
-  axes.col(2) = toward_user;
-  return Eigen::Quaterniond(axes).normalized();
+  return device_axes_from_view(-Eigen::Vector3d(direction[0], direction[1], direction[2]),
+                               Eigen::Vector3d(up[0], up[1], up[2]));
 }
 
 Eigen::Vector3d MainWindow::deviceHome_m() const {
-  Eigen::AlignedBox3d box;
-  const NodeArray& position = simulation_->snapshot().position_m;
-  for (std::size_t n = 0; n < position.size(); ++n) box.extend(position.at(n));
-  // From the centre toward the viewer, out of the box, and a centimetre further.
-  const Eigen::Vector3d toward_user = deviceAxesFromView() * Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d half = box.sizes() / 2.0;
-  double out_m = std::numeric_limits<double>::infinity();
-  for (int axis = 0; axis < 3; ++axis)
-    if (std::abs(toward_user[axis]) > 1e-9)
-      out_m = std::min(out_m, half[axis] / std::abs(toward_user[axis]));
-  return box.center() + (out_m + 0.01) * toward_user;
+  return device_home_m(simulation_->snapshot().position_m, deviceAxesFromView());
 }
 
 std::optional<DeviceToolSettings> MainWindow::deviceToolSettings() const {
@@ -1355,8 +1332,7 @@ void MainWindow::beginRecording() {
   } else {
     // Free practice has no file: the text names the scene it ran.
     start.scenario_title = tr("Free practice").toStdString();
-    start.scenario_text = "free practice on the built-in liver, " +
-                          std::to_string(setup_.mesh.tet_count()) + " tetrahedra";
+    start.scenario_text = free_practice_text(setup_.mesh.tet_count());
     if (tissueChangedInFreePractice_) {
       const Scenario described = describedScenario();
       start.scenario_text +=
@@ -1378,12 +1354,7 @@ void MainWindow::beginRecording() {
   if (scenario_ || (setup_.built_in_liver_tets && !tissueChangedInFreePractice_))
     start.replay = replay;
   ServoLoop* servo = servo_.get();
-  // The servo has queued frames since it started (the mouse's, until its first press): the
-  // session's are those from now on.
-  ServoFrame earlier;
-  while (servo->next_logged_frame(earlier)) {
-  }
-  droppedBeforeRecording_ = servo->dropped_log_frames();
+  droppedBeforeRecording_ = skip_earlier_servo_frames(*servo);
   recordingFailureShown_ = false;
   try {
     recorder_ = std::make_unique<SessionRecorder>(
@@ -1397,45 +1368,15 @@ void MainWindow::beginRecording() {
   // The session starts from rest, its simulation's input logged, so that it can be replayed.
   restartFromRest();
   // Damage, lift and resection need the simulation: tracked while the session runs.
-  std::optional<Eigen::Vector3d> lift_point_m;
-  if (scenario_ && scenario_->scenario.task.kind == TaskKind::retract_lobe) {
-    const Millimetres3& mm = scenario_->scenario.task.grasp_point_mm;
-    lift_point_m = to_metres(mm);
-  }
-  // The scenario's grading thresholds (free practice: the defaults).
-  const TaskSpec task = scenario_ ? scenario_->scenario.task : TaskSpec{};
-  OutcomeSettings outcome;
-  outcome.damage_tension_strain = task.damage_tension_strain;
-  outcome.damage_compression_strain = task.damage_compression_strain;
-  simulation_->track_outcome(lift_point_m, outcome);
-  eventDetector_.emplace(task.safe_force_n);
-  breachedLesions_.clear();
+  const Scenario* running = scenario_ ? &scenario_->scenario : nullptr;
+  track_session_outcome(*simulation_, running);
+  eventWatch_.emplace(running);
 }
 
 void MainWindow::recordSimulationEvents(const SimulationSnapshot& snapshot, bool cut) {
-  if (!recorder_ || !servo_ || !eventDetector_) return;
-  const double now_s = servo_->now_s();
+  if (!recorder_ || !servo_ || !eventWatch_) return;
   std::vector<SessionEvent> events;
-  const RealtimeStats stats = simulation_->stats();
-  eventDetector_->observe(
-      now_s,
-      {snapshot.tool_grasping, snapshot.topology_version, snapshot.tool_force_n.norm(),
-       stats.rollbacks, snapshot.resected_volume_m3},
-      events);
-  // A cut into a lesion: checked against the whole cut surface, each lesion reported once.
-  if (cut && scenario_ && snapshot.model) {
-    const auto surface = cut_surface_at_rest_m(*snapshot.model);
-    for (const LesionSpec& lesion : scenario_->scenario.lesions) {
-      if (breachedLesions_.count(lesion.name)) continue;
-      const Ellipsoid ellipsoid = lesion_ellipsoid(lesion);
-      if (std::any_of(surface.begin(), surface.end(), [&](const auto& triangle) {
-            return triangle_meets_ellipsoid(triangle, ellipsoid);
-          })) {
-        breachedLesions_.insert(lesion.name);
-        events.push_back({now_s, SessionEventKind::lesion_breach, lesion.name});
-      }
-    }
-  }
+  eventWatch_->observe(servo_->now_s(), snapshot, simulation_->stats(), cut, events);
   for (const SessionEvent& event : events) recorder_->record_event(event);
 }
 
@@ -1563,7 +1504,7 @@ void MainWindow::endRecording() {
   const ServoStats stats = servo_ ? servo_->stats() : ServoStats{};
   const std::uint64_t dropped = servo_ ? servo_->dropped_log_frames() - droppedBeforeRecording_ : 0;
   const std::int64_t session = recorder_->session();
-  eventDetector_.reset();
+  eventWatch_.reset();
   std::optional<OutcomeTracking> outcome;
   if (simulation_) {
     outcome = simulation_->outcome();
@@ -1596,22 +1537,8 @@ void MainWindow::computeSessionMetrics(std::int64_t session, std::optional<Outco
     QString problem;
     try {
       SqliteSessionStore store{std::filesystem::path(file)};
-      const std::vector<SessionEvent> events = store.events(session);
-      const std::vector<ServoFrame> frames = store.frames(session);
-      TraceMetricSettings trace;
-      trace.safe_force_n = scenario ? scenario->task.safe_force_n : TaskSpec{}.safe_force_n;
-      if (!frames.empty())
-        values = trace_metric_values(
-            compute_trace_metrics(frames, tool_intervals(events), mapping, trace));
-      if (outcome) {
-        const Scenario* run = scenario ? &*scenario : nullptr;
-        const std::vector<MetricValue> simulated = outcome_metric_values(
-            compute_outcome_metrics(*outcome->initial_model, *outcome->model, outcome->tracker, run,
-                                    lesion_marks(events)),
-            run);
-        values.insert(values.end(), simulated.begin(), simulated.end());
-      }
-      if (!values.empty()) store.store_metrics(session, values);
+      values =
+          store_session_metrics(store, session, outcome, scenario ? &*scenario : nullptr, mapping);
     } catch (const StorageError& e) {
       problem = storageProblemText(tr("The session's metrics were not stored: %1"), e);
     } catch (const std::exception& e) {
@@ -1692,11 +1619,8 @@ bool MainWindow::useDevice(DeviceChoice choice, const QString& trajectoryFile) {
   }
   const bool mouse = choice == DeviceChoice::mouse;
   if (!mouse && !haptics_.mapping_set) {
-    // First use: the device's axes the screen's, its origin just in front of the liver, and
-    // its workspace (about 16 cm across for an Omni) over the liver's 25 cm.
-    haptics_.mapping.rotation = deviceAxesFromView();
-    haptics_.mapping.scale = 1.5;
-    haptics_.mapping.offset_m = deviceHome_m();
+    // First use: the device's axes the screen's, its origin just in front of the liver.
+    haptics_.mapping = first_use_mapping(simulation_->snapshot().position_m, deviceAxesFromView());
     haptics_.mapping_set = true;
   }
   std::unique_ptr<ServoLoop> servo;

@@ -15,8 +15,8 @@
 #include "liversim/core/realtime_simulation.h"
 #include "liversim/core/scenario.h"
 #include "liversim/core/servo_loop.h"
-#include "liversim/core/session_events.h"
 #include "liversim/core/session_recorder.h"
+#include "liversim/core/session_recording.h"
 
 #include <QElapsedTimer>
 #include <QMainWindow>
@@ -31,7 +31,6 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 #include <thread>
 
@@ -336,13 +335,12 @@ class MainWindow : public QMainWindow {
 
   std::unique_ptr<SessionStore> sessions_;
   QString sessionsFile_;
-  // While recording: the events the display frames show, and the lesions a cut has breached.
-  std::optional<SessionEventDetector> eventDetector_;
+  // While recording: the events the display frames show, the lesions a cut has breached too.
+  std::optional<SessionEventWatch> eventWatch_;
   std::thread metricsWorker_;
   int pendingMetrics_ = 0;
   void computeSessionMetrics(std::int64_t session, std::optional<OutcomeTracking> outcome,
                              const WorkspaceMapping& mapping);
-  std::set<std::string> breachedLesions_;
   void recordSimulationEvents(const SimulationSnapshot& snapshot, bool cut);
   SessionReviewWindow* showSessionsWindow(QPointer<SessionReviewWindow>& window,
                                           const std::optional<QString>& trainee);

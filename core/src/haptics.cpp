@@ -2,9 +2,12 @@
 #include "validation_message.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
 
 namespace liversim {
 namespace {
@@ -206,6 +209,54 @@ Eigen::Vector3d HapticRenderer::command(double now_s, const DeviceSample& sample
   last_force_n_ = force;
   stats_.max_force_n = std::max(stats_.max_force_n, force.norm());
   return force;
+}
+
+Eigen::Quaterniond device_axes_from_view(const Eigen::Vector3d& toward_viewer,
+                                         const Eigen::Vector3d& view_up) {
+  const Eigen::Vector3d z = toward_viewer.normalized();
+  const Eigen::Vector3d y = (view_up - z.dot(view_up) * z).normalized();
+  Eigen::Matrix3d axes;
+  axes.col(0) = y.cross(z);  // right
+  axes.col(1) = y;
+  axes.col(2) = z;
+  return Eigen::Quaterniond(axes).normalized();
+}
+
+Eigen::Vector3d opening_view_camera_offset_m() {
+  return {0.05, 0.12, 0.55};
+}
+
+Eigen::Quaterniond opening_view_device_axes() {
+  return device_axes_from_view(opening_view_camera_offset_m(), Eigen::Vector3d::UnitY());
+}
+
+Eigen::Vector3d device_home_m(const NodeArray& position_m, const Eigen::Quaterniond& axes) {
+  Eigen::AlignedBox3d box;
+  for (std::size_t n = 0; n < position_m.size(); ++n) box.extend(position_m.at(n));
+  const Eigen::Vector3d toward_viewer = axes * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d half = box.sizes() / 2.0;
+  double out_m = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis)
+    if (std::abs(toward_viewer[axis]) > 1e-9)
+      out_m = std::min(out_m, half[axis] / std::abs(toward_viewer[axis]));
+  return box.center() + (out_m + 0.01) * toward_viewer;
+}
+
+WorkspaceMapping first_use_mapping(const NodeArray& position_m, const Eigen::Quaterniond& axes) {
+  WorkspaceMapping mapping;
+  mapping.rotation = axes;
+  mapping.scale = 1.5;
+  mapping.offset_m = device_home_m(position_m, axes);
+  return mapping;
+}
+
+Eigen::Quaterniond tool_orientation_from_view(const Eigen::Quaterniond& axes) {
+  const Eigen::Vector3d toward_viewer = axes * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d view_up = axes * Eigen::Vector3d::UnitY();
+  constexpr double kTiltRad = 35.0 * std::numbers::pi / 180.0;
+  const Eigen::Vector3d shaft_direction =
+      (std::cos(kTiltRad) * toward_viewer + std::sin(kTiltRad) * view_up).normalized();
+  return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), shaft_direction);
 }
 
 LocalForceModel tool_force_model(std::span<const NodeSpring> springs, const NodeArray& position_m,

@@ -347,6 +347,39 @@ TEST(DeviceTool, TheDevicePointIsTheToolsOriginAndItsActionButtonClosesTheJawsOr
   EXPECT_TRUE(closed.blade_armed);
 }
 
+// A device not calibrated yet (the workstation's first use, liversim-cli record): its axes are
+// the view's, its home just in front of the organ, the tool's shaft toward the viewer tilted up.
+TEST(DeviceFromView, AxesHomeAndToolFollowTheView) {
+  // Looking along -z with an up that leans toward the viewer: right, up and toward the viewer
+  // are x, y and z.
+  const Eigen::Quaterniond axes =
+      device_axes_from_view(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 1, 0.3));
+  EXPECT_TRUE((axes * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitX(), 1e-12));
+  EXPECT_TRUE((axes * Eigen::Vector3d::UnitY()).isApprox(Eigen::Vector3d::UnitY(), 1e-12));
+  EXPECT_TRUE((axes * Eigen::Vector3d::UnitZ()).isApprox(Eigen::Vector3d::UnitZ(), 1e-12));
+  // The opening view looks from its camera offset.
+  EXPECT_TRUE((opening_view_device_axes() * Eigen::Vector3d::UnitZ())
+                  .isApprox(opening_view_camera_offset_m().normalized(), 1e-12));
+
+  // An organ 0.2 m across centred at (0.1, 0, 0): its front face is 0.1 m toward the viewer.
+  NodeArray position_m;
+  position_m.resize(2);
+  position_m.set(0, Eigen::Vector3d(0.0, -0.1, -0.1));
+  position_m.set(1, Eigen::Vector3d(0.2, 0.1, 0.1));
+  const Eigen::Vector3d home_m = device_home_m(position_m, axes);
+  EXPECT_TRUE(home_m.isApprox(Eigen::Vector3d(0.1, 0.0, 0.11), 1e-12)) << home_m.transpose();
+  const WorkspaceMapping mapping = first_use_mapping(position_m, axes);
+  EXPECT_EQ(mapping.scale, 1.5);
+  EXPECT_TRUE(mapping.rotation.isApprox(axes));
+  EXPECT_TRUE(mapping.offset_m.isApprox(home_m));
+  EXPECT_FALSE(validate(mapping).has_value());
+
+  const double tilt_rad = 35.0 * std::numbers::pi / 180.0;
+  const Eigen::Vector3d shaft = tool_orientation_from_view(axes) * Eigen::Vector3d::UnitZ();
+  EXPECT_TRUE(shaft.isApprox(Eigen::Vector3d(0.0, std::sin(tilt_rad), std::cos(tilt_rad)), 1e-12))
+      << shaft.transpose();
+}
+
 TEST(SpscRing, DeliversInOrderAndDropsWhenFullWithoutBlocking) {
   SpscRing<int> ring(4);
   for (int i = 0; i < 6; ++i) ring.push(i);

@@ -2,6 +2,7 @@
 // scripted device driving the tool at 1 kHz), it loses at most the last commit period; the next
 // start marks the session incomplete, keeps every frame committed, and runs on.
 // Runs the real `liversim` binary under the X server of the test run (xvfb-run in CI).
+#include "crash_support.h"
 #include "liversim/storage/sqlite_session_store.h"
 
 #include <gtest/gtest.h>
@@ -17,7 +18,6 @@
 #include <fstream>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 extern char** environ;
@@ -26,14 +26,8 @@ namespace liversim {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-
-fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "crash" / name;
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
-}
+using crash::fresh_folder;
+using crash::wait_for;
 
 // The workstation's settings go to the test's folder, not the user's.
 pid_t start_workstation(const fs::path& folder, const std::vector<std::string>& arguments) {
@@ -49,24 +43,6 @@ pid_t start_workstation(const fs::path& folder, const std::vector<std::string>& 
   return child;
 }
 
-int wait_for(pid_t child) {
-  int status = 0;
-  waitpid(child, &status, 0);
-  return status;
-}
-
-// The session's frame count as committed so far (the file read as another process would).
-std::optional<std::int64_t> committed_frames(const fs::path& database) {
-  try {
-    SqliteSessionStore store(database, SqliteSessionStore::Access::read_only);
-    const std::vector<SessionSummary> sessions = store.sessions();
-    if (sessions.empty()) return std::nullopt;
-    return sessions.front().frame_count;
-  } catch (const StorageError&) {
-    return std::nullopt;  // not created yet, or mid-migration
-  }
-}
-
 TEST(WorkstationKilled, MidSessionItLosesNothingCommittedAndTheNextStartRecovers) {
   ASSERT_NE(std::getenv("DISPLAY"), nullptr) << "run under xvfb-run: the workstation needs X";
   const fs::path folder = fresh_folder("killed-mid-session");
@@ -79,39 +55,18 @@ TEST(WorkstationKilled, MidSessionItLosesNothingCommittedAndTheNextStartRecovers
       {"--tets", "1000", "--database", database.string(), "--trajectory", trajectory.string()});
   ASSERT_GT(workstation, 0);
   // Recording: at least half a second of frames committed.
-  const auto deadline = Clock::now() + std::chrono::seconds(90);
-  std::optional<std::int64_t> before;
-  while (Clock::now() < deadline) {
-    before = committed_frames(database);
-    if (before && *before >= 500) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
+  const std::optional<std::int64_t> before =
+      crash::wait_for_committed(database, 500, std::chrono::seconds(90));
   ASSERT_TRUE(before && *before >= 500) << "the workstation recorded no session";
-  ASSERT_EQ(kill(workstation, SIGKILL), 0);
-  const int status = wait_for(workstation);
-  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
-
   // The next start (opening for writing): the session is over, not lost.
-  {
-    SqliteSessionStore store(database);
-    EXPECT_EQ(store.integrity_check(), "ok");
-    const std::vector<SessionSummary> sessions = store.sessions();
-    ASSERT_EQ(sessions.size(), 1u);
-    EXPECT_EQ(sessions[0].status, SessionStatus::incomplete);
-    EXPECT_GE(sessions[0].frame_count, *before) << "frames committed before the kill were lost";
-    const std::vector<ServoFrame> frames = store.frames(sessions[0].id);
-    ASSERT_EQ(static_cast<std::int64_t>(frames.size()), sessions[0].frame_count);
-    for (std::size_t i = 1; i < frames.size(); ++i)
-      ASSERT_GT(frames[i].time_s, frames[i - 1].time_s) << "frame " << i;
-  }
+  crash::kill_and_expect_recovery(workstation, database, *before);
+  if (HasFatalFailure()) return;
   // And the workstation itself starts on that file and records again.
   const pid_t next =
       start_workstation(folder, {"--tets", "1000", "--database", database.string(), "--trajectory",
                                  trajectory.string(), "--quit-after", "3"});
   ASSERT_GT(next, 0);
-  const int next_status = wait_for(next);
-  ASSERT_TRUE(WIFEXITED(next_status)) << "the next start crashed";
-  EXPECT_EQ(WEXITSTATUS(next_status), 0);
+  EXPECT_EQ(wait_for(next), 0) << "the next start crashed or failed";
   SqliteSessionStore store(database, SqliteSessionStore::Access::read_only);
   const std::vector<SessionSummary> sessions = store.sessions();
   ASSERT_EQ(sessions.size(), 2u);

@@ -5,6 +5,7 @@
 
 #include "liversim/core/cutting.h"
 #include "liversim/core/data_paths.h"
+#include "liversim/core/haptics.h"
 #include "liversim/core/surface_import.h"
 
 #include <vtkActor.h>
@@ -531,7 +532,10 @@ void LiverScene::update_positions(const NodeArray& position_m) {
 void LiverScene::reset_camera(double aspect) {
   vtkCamera* camera = renderer_->GetActiveCamera();
   camera->SetFocalPoint(0.0, 0.0, 0.0);
-  camera->SetPosition(0.05, 0.12, 0.55);  // anterior, slightly from above and the left
+  // Anterior, slightly from above and the left: a device not yet calibrated takes its axes from
+  // this view (haptics.h), the headless recorder's too.
+  const Eigen::Vector3d camera_m = opening_view_camera_offset_m();
+  camera->SetPosition(camera_m.x(), camera_m.y(), camera_m.z());
   camera->SetViewUp(0.0, 1.0, 0.0);
   camera->SetViewAngle(30.0);
   renderer_->ResetCamera(polydata_->GetBounds());
@@ -551,6 +555,13 @@ double LiverScene::opacity() const {
 }
 
 void LiverScene::set_ambient_occlusion(bool on) {
+  // A pass taken off keeps its framebuffer and textures until told to release them (the window
+  // releases only the passes its renderers hold): released here, or they leak.
+  if (!on && renderer_->GetPass() == occlusion_pass_.Get())
+    if (vtkRenderWindow* window = renderer_->GetRenderWindow()) {
+      window->MakeCurrent();
+      occlusion_pass_->ReleaseGraphicsResources(window);
+    }
   // No pass: the renderer's own default passes, as before.
   renderer_->SetPass(on ? occlusion_pass_.Get() : nullptr);
   // VTK 9.1's occlusion pass reads every pixel's view position, which the gradient background's

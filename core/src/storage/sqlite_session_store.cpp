@@ -7,7 +7,9 @@
 #include <sys/stat.h>
 
 #include <array>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <iterator>
 
 namespace liversim {
@@ -325,29 +327,77 @@ StorageError SqliteSessionStore::error(const std::string& what, StorageProblem p
   return StorageError("sessions database " + file_.string() + ": " + what, problem);
 }
 
-void SqliteSessionStore::fail(const std::string& doing) {
-  const int code = sqlite3_extended_errcode(db_);
-  std::string what = sqlite3_errmsg(db_);
+namespace {
+
+// The errno of the last failed system call on a file of the connection, which SQLite keeps with
+// the file: `file_pointer` SQLITE_FCNTL_JOURNAL_POINTER for its WAL (a commit writes there),
+// SQLITE_FCNTL_FILE_POINTER for the database. sqlite3_system_errno does not always have it
+// (SQLite 3.40 leaves it 0 when COMMIT fails writing the WAL).
+int file_errno(sqlite3* db, int file_pointer) {
+  sqlite3_file* file = nullptr;
+  int error = 0;
+  if (sqlite3_file_control(db, "main", file_pointer, &file) != SQLITE_OK || file == nullptr ||
+      file->pMethods == nullptr ||
+      file->pMethods->xFileControl(file, SQLITE_FCNTL_LAST_ERRNO, &error) != SQLITE_OK)
+    return 0;
+  return error;
+}
+
+}  // namespace
+
+SqliteSessionStore::Failure SqliteSessionStore::last_failure() const {
+  Failure failure;
+  failure.code = sqlite3_extended_errcode(db_);
+  failure.message = sqlite3_errmsg(db_);
+  failure.system_errno = sqlite3_system_errno(db_);
+  for (const int which : {SQLITE_FCNTL_JOURNAL_POINTER, SQLITE_FCNTL_FILE_POINTER}) {
+    if (const int error = file_errno(db_, which);
+        error == EROFS || error == ENOSPC || error == EDQUOT) {
+      failure.system_errno = error;
+      break;
+    }
+  }
+  return failure;
+}
+
+void SqliteSessionStore::fail(const std::string& doing, const Failure& failure) const {
+  const int primary = failure.code & 0xff;
+  int kind = primary;
+  std::string cause = failure.message;
+  // A write the system refused: SQLite calls it an I/O error (or read-only, or cannot open); the
+  // errno says which trouble it is, and is named before SQLite's message.
+  constexpr int kReadOnlyFileSystem = -1;
+  const int system_errno = failure.system_errno;
+  if ((primary == SQLITE_IOERR || primary == SQLITE_READONLY || primary == SQLITE_CANTOPEN) &&
+      (system_errno == EROFS || system_errno == ENOSPC || system_errno == EDQUOT)) {
+    kind = system_errno == EROFS ? kReadOnlyFileSystem : SQLITE_FULL;
+    cause = std::string(std::strerror(system_errno)) + "; " + cause;
+  }
+  std::string what = cause;
   StorageProblem problem = StorageProblem::other;
-  switch (code & 0xff) {
+  switch (kind) {
+    case kReadOnlyFileSystem:
+      what = "the file is read-only: its file system was made read-only (" + cause + ")";
+      problem = StorageProblem::read_only;
+      break;
     case SQLITE_FULL:
-      what = "the disk or the database is full (" + what + ")";
+      what = "the disk or the database is full (" + cause + ")";
       problem = StorageProblem::disk_full;
       break;
     case SQLITE_CORRUPT:
-      what = "the file is damaged (" + what + ")";
+      what = "the file is damaged (" + cause + ")";
       problem = StorageProblem::damaged;
       break;
     case SQLITE_NOTADB:
-      what = "not a database file (" + what + ")";
+      what = "not a database file (" + cause + ")";
       problem = StorageProblem::not_a_database;
       break;
     case SQLITE_READONLY:
-      what = "the file is read-only (" + what + ")";
+      what = "the file is read-only (" + cause + ")";
       problem = StorageProblem::read_only;
       break;
     case SQLITE_IOERR:
-      what = "the file could not be read or written (" + what + ")";
+      what = "the file could not be read or written (" + cause + ")";
       problem = StorageProblem::unreachable;
       break;
     case SQLITE_CANTOPEN:
@@ -411,10 +461,12 @@ void SqliteSessionStore::commit() {
   if (!in_transaction_) return;
   check_file_is_still_there();
   if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
-    const std::string doing = "committing";
+    // Read before the rollback, which reports its own result (SQLite may have rolled back
+    // already: "no transaction is active").
+    const Failure failure = last_failure();
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     in_transaction_ = false;
-    fail(doing);
+    fail("committing", failure);
   }
   in_transaction_ = false;
 }

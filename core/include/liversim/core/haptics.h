@@ -45,6 +45,28 @@ struct WorkspaceMapping {
 // The problem with the mapping, if any (naming the field, its value and what is expected).
 std::optional<std::string> validate(const WorkspaceMapping& mapping);
 
+// A device not calibrated yet is set up from the view of the scene: the workstation's camera, or
+// for a headless recording (liversim-cli record) the workstation's opening view.
+// The device's axes in the scene: x to the right of the view, y up, z toward the viewer.
+// `toward_viewer` points from the scene to the camera; `view_up` is the camera's up (made
+// orthogonal to it here).
+Eigen::Quaterniond device_axes_from_view(const Eigen::Vector3d& toward_viewer,
+                                         const Eigen::Vector3d& view_up);
+// The workstation's opening view (LiverScene::reset_camera looks from here at the organ's centre,
+// y up): from the front, slightly from above and the left.
+Eigen::Vector3d opening_view_camera_offset_m();
+// The device's axes in that view.
+Eigen::Quaterniond opening_view_device_axes();
+// Where such a device's origin goes: from the organ's centre (the box of `position_m`) toward the
+// viewer (the axes' z), out of the box and a centimetre further, just in front of the organ.
+Eigen::Vector3d device_home_m(const NodeArray& position_m, const Eigen::Quaterniond& axes);
+// The mapping of a device at its first use: its axes the view's, its origin at device_home_m, and
+// its workspace (about 16 cm across for an Omni) over the liver's 25 cm (scale 1.5).
+WorkspaceMapping first_use_mapping(const NodeArray& position_m, const Eigen::Quaterniond& axes);
+// How a tool is held in that view: its shaft toward the viewer, tilted up by 35° (as a
+// laparoscopic instrument comes in through a port, and so that it shows).
+Eigen::Quaterniond tool_orientation_from_view(const Eigen::Quaterniond& axes);
+
 // The force on the tool near where it was, in the scene frame (SI units).
 struct LocalForceModel {
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();  // F0: at x0 moving at v0

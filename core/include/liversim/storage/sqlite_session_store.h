@@ -75,7 +75,17 @@ class SqliteSessionStore final : public SessionStore {
   void check_file_is_still_there();
   // An error about this file: "sessions database FILE: what".
   StorageError error(const std::string& what, StorageProblem problem = StorageProblem::other) const;
-  [[noreturn]] void fail(const std::string& doing);
+  // What SQLite reported last: its extended result code, its message and the errno of the system
+  // call behind it (a write refused by a read-only file system is an I/O error with EROFS; a
+  // full disk, ENOSPC).
+  struct Failure {
+    int code = 0;
+    std::string message;
+    int system_errno = 0;
+  };
+  Failure last_failure() const;
+  [[noreturn]] void fail(const std::string& doing) const { fail(doing, last_failure()); }
+  [[noreturn]] void fail(const std::string& doing, const Failure& failure) const;
   Statement& prepared(int which, const char* sql);
   // The session's chunks of `items` ("frames", "inputs") from `chunks` (first item, layout, data,
   // in order), decoded and joined; a gap or a layout this version cannot read is named. With

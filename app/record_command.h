@@ -1,0 +1,22 @@
+#pragma once
+// liversim-cli record: a session recorded headless as the workstation records one. A scripted
+// trajectory device drives the tool through the 1 kHz haptic servo on a scenario's scene (or free
+// practice on the built-in liver) for a set wall time; frames, events, the simulation's input log
+// and, at the end, the servo's figures and the metrics go to a sessions database. For unattended
+// soaks (memory, rate), demonstrations and the crash-safety tests.
+
+#include <functional>
+#include <optional>
+
+namespace CLI {
+class App;
+}
+
+namespace liversim::cli {
+
+// Adds `record` to the app. After parsing, the returned function runs it and returns the exit
+// code (nothing when `record` was not on the command line): 0 for a session recorded to its end
+// or ended by SIGINT or SIGTERM, 1 when storage failed (what was committed stays), 2 for bad input.
+std::function<std::optional<int>()> add_record_command(CLI::App& app);
+
+}  // namespace liversim::cli
