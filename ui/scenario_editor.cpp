@@ -867,23 +867,23 @@ void ScenarioEditor::showRubric() {
     rubricTable_->setCellWidget(row, 1, weight);
     rubricTable_->setCellWidget(row, 2, rule);
     rubricTable_->setCellWidget(row, 3, threshold);
-    connect(metric, &QComboBox::currentTextChanged, this, [=](const QString& name) {
+    connect(metric, &QComboBox::currentTextChanged, this, [=, this](const QString& name) {
       editRow(row, tr("Change a criterion's metric"), kNoMerge,
               [&](RubricCriterion& r) { r.metric = name.toStdString(); });
       shownRubric_.reset();  // the unit of the threshold changes with it
       QMetaObject::invokeMethod(
           this, [this] { showRubric(); }, Qt::QueuedConnection);
     });
-    connect(weight, &QDoubleSpinBox::valueChanged, this, [=](double v) {
+    connect(weight, &QDoubleSpinBox::valueChanged, this, [=, this](double v) {
       editRow(row, tr("Change a criterion's weight"), kRubricWeight + row,
               [&](RubricCriterion& r) { r.weight = v; });
     });
-    connect(rule, &QComboBox::currentIndexChanged, this, [=](int index) {
+    connect(rule, &QComboBox::currentIndexChanged, this, [=, this](int index) {
       const auto pass = PassRule(rule->itemData(index).toInt());
       editRow(row, tr("Change a criterion's rule"), kNoMerge,
               [&](RubricCriterion& r) { r.rule = pass; });
     });
-    connect(threshold, &QDoubleSpinBox::valueChanged, this, [=](double v) {
+    connect(threshold, &QDoubleSpinBox::valueChanged, this, [=, this](double v) {
       editRow(row, tr("Change a criterion's threshold"), kRubricThreshold + row,
               [&](RubricCriterion& r) { r.threshold = v; });
     });

@@ -364,7 +364,9 @@ TEST(CuttingRobustness, ThousandsOfRandomCutsThroughTheLiverKeepItSound) {
           "sequence " + std::to_string(sequence) + ", cut " + std::to_string(k);
       ASSERT_TRUE(elements_are_sound(*model, state)) << where;
       ASSERT_TRUE(boundary_is_manifold(*model)) << where;
-      if (cuts_made % 10 == 0) ASSERT_TRUE(surfaces_agree(*model)) << where;
+      if (cuts_made % 10 == 0) {
+        ASSERT_TRUE(surfaces_agree(*model)) << where;
+      }
       // No mass lost: what is left and what came off add up to the liver.
       ASSERT_NEAR(total_mass_kg(*model) + removed_mass, total_mass_kg(liver),
                   1e-9 * total_mass_kg(liver))
@@ -396,7 +398,9 @@ TEST(Cutting, AStrokeDrawnInSmallStepsCutsWhatOneSweepCuts) {
     const double y = -0.01 + 0.001 * k;
     stroke.add({Eigen::Vector3d(x, y, 0.06), Eigen::Vector3d(x, y, 0.005)});
     CutResult cut = cut_tissue(*current, state, stroke, cut_anything());
-    if (k == 5) EXPECT_FALSE(cut.cut());  // 5 mm in: no element passed yet
+    if (k == 5) {
+      EXPECT_FALSE(cut.cut());  // 5 mm in: no element passed yet
+    }
     if (!cut.cut()) continue;
     current = cut.model;
     state = std::move(cut.state);

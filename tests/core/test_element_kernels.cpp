@@ -129,7 +129,9 @@ TEST(ElementKernels, EachInstructionSetBuildFollowsTheLaws) {
           EXPECT_LE((balance + h.rowwise().sum()).norm(), 1e-13 * scale);
         }
         EXPECT_NEAR(seen.min_volume_ratio, min_j, 1e-14);
-        if (fibres) EXPECT_GT(seen.max_fibre_modulus_pa, 1e20);  // the guarded element: k1·e⁵⁰·…
+        if (fibres) {
+          EXPECT_GT(seen.max_fibre_modulus_pa, 1e20);  // the guarded element: k1·e⁵⁰·…
+        }
       }
 }
 
