@@ -1,5 +1,6 @@
 // liversim: the workstation. Builds the default scene (or a scenario's) and opens the main window.
 #include "device_panel.h"
+#include "leak_check.h"
 #include "main_window.h"
 #include "translations.h"
 #include "vtk_viewport.h"
@@ -239,7 +240,9 @@ int main(int argc, char** argv) {
     if (options.quit_after_s)
       QTimer::singleShot(static_cast<int>(std::lround(*options.quit_after_s * 1e3)), &app,
                          &QApplication::quit);
-    return QApplication::exec();
+    const int result = QApplication::exec();
+    liversim::checkLeaksWhileTheDisplayIsOpen();
+    return result;
   } catch (const std::exception& e) {
     QMessageBox::critical(
         nullptr, QApplication::translate("main", "LiverSim cannot start"),

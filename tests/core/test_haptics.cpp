@@ -5,10 +5,12 @@
 #include "liversim/core/haptics.h"
 #include "liversim/core/servo_loop.h"
 #include "liversim/core/spsc_ring.h"
+#include "liversim/core/triple_buffer.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -174,8 +176,9 @@ TEST(HapticRenderer, AdversarialModelsNeverGetPastTheCapsOrTheRateLimitOrGiveANa
     ASSERT_LE(force.norm(), safety.force_cap_n * (1.0 + 1e-12)) << "tick " << tick;
     // A NaN sample drops the force to zero at once (there is nowhere to push); otherwise dF is
     // limited.
-    if (sample.position_mm.allFinite())
+    if (sample.position_mm.allFinite()) {
       ASSERT_LE((force - previous).norm(), rate_limit_per_tick_n * (1.0 + 1e-9)) << "tick " << tick;
+    }
     previous = force;
     largest = std::max(largest, force.norm());
   }
@@ -244,7 +247,9 @@ TEST(HapticRenderer, TheWatchdogRampsTheForceToZeroWhenTheModelGoesStale) {
       ASSERT_NEAR(force, 1.5, 1e-12) << "ramped down before the model was stale";
     }
     if (force == 0.0 && zero_at_s < 0.0) zero_at_s = now_s;
-    if (zero_at_s >= 0.0) ASSERT_EQ(force, 0.0) << "came back without a fresh model";
+    if (zero_at_s >= 0.0) {
+      ASSERT_EQ(force, 0.0) << "came back without a fresh model";
+    }
   }
   ASSERT_GE(zero_at_s, 0.0);
   EXPECT_LE(zero_at_s, zero_by_s);
@@ -398,9 +403,45 @@ TEST(SpscRing, DeliversInOrderAndDropsWhenFullWithoutBlocking) {
       while (!shared.push(i)) std::this_thread::yield();
   });
   int next = 0;
-  while (next < kCount)
-    if (shared.pop(value)) ASSERT_EQ(value, next++);
+  while (next < kCount) {
+    if (shared.pop(value)) {
+      ASSERT_EQ(value, next++);
+    }
+  }
   producer.join();
+}
+
+// The servo's and the UI's snapshot exchange: a reader on another thread only ever sees one whole
+// published value, never an older one than it saw before, and in the end the last one. (Under the
+// tsan preset this is also the check that the exchange's memory ordering is enough.)
+TEST(TripleBuffer, AReaderSeesWholeValuesNeverOlderAndFinallyTheLast) {
+  struct Snapshot {
+    std::array<std::uint64_t, 32> words{};  // every word is the sequence number of its write
+  };
+  TripleBuffer<Snapshot> exchange(Snapshot{});
+  constexpr std::uint64_t kWrites = 200'000;
+  std::atomic<bool> done{false};
+  std::thread producer([&] {
+    for (std::uint64_t sequence = 1; sequence <= kWrites; ++sequence) {
+      exchange.back().words.fill(sequence);
+      exchange.publish();
+    }
+    done.store(true, std::memory_order_release);
+  });
+  std::uint64_t newest_seen = 0, updates = 0;
+  auto read = [&] {
+    if (!exchange.update()) return;
+    ++updates;
+    const Snapshot& snapshot = exchange.front();
+    for (std::uint64_t word : snapshot.words) ASSERT_EQ(word, snapshot.words[0]);
+    ASSERT_GT(snapshot.words[0], newest_seen);
+    newest_seen = snapshot.words[0];
+  };
+  while (!done.load(std::memory_order_acquire)) read();
+  producer.join();
+  read();
+  EXPECT_EQ(newest_seen, kWrites);
+  EXPECT_GT(updates, 0u);
 }
 
 TEST(Trajectory, FilesRoundTripAndBadLinesAreNamed) {

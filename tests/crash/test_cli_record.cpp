@@ -425,13 +425,32 @@ class ReadOnlyFileSystem {
       if (ioctl(listener_, SECCOMP_IOCTL_NOTIF_RECV, request) != 0) continue;
       std::fill(response_bytes.begin(), response_bytes.end(), std::byte{0});
       response->id = request->id;
-      if (refuse_) {
+      if (refuse_ && on_the_file_system(*request)) {
         response->error = -EROFS;
       } else {
         response->flags = SECCOMP_USER_NOTIF_FLAG_CONTINUE;
       }
       ioctl(listener_, SECCOMP_IOCTL_NOTIF_SEND, response);
     }
+  }
+
+  // Whether the notified call touches the file system: a call on a descriptor does when it names
+  // a file (a pipe, socket or eventfd stays writable on a read-only file system; AddressSanitizer
+  // probes memory through a pipe), a call on a path always does.
+  bool on_the_file_system(const seccomp_notif& request) const {
+    const auto call = static_cast<long>(request.data.nr);
+    const bool on_a_descriptor = call == SYS_write || call == SYS_writev || call == SYS_pwrite64 ||
+                                 call == SYS_pwritev || call == SYS_pwritev2 ||
+                                 call == SYS_ftruncate || call == SYS_fallocate;
+    if (!on_a_descriptor) return true;
+    const std::string link = "/proc/" + std::to_string(request.pid) + "/fd/" +
+                             std::to_string(static_cast<int>(request.data.args[0]));
+    char target[512] = {};
+    const ssize_t length = readlink(link.c_str(), target, sizeof(target) - 1);
+    // The answer holds only while the call is still waiting (the descriptor may be reused after).
+    std::uint64_t id = request.id;
+    if (ioctl(listener_, SECCOMP_IOCTL_NOTIF_ID_VALID, &id) != 0) return false;
+    return length > 0 && target[0] == '/';
   }
 
   int listener_ = -1;

@@ -316,6 +316,45 @@ TEST_F(RenderBaselineTest, SeeThroughShowsTheLesionInsideTheLiver) {
   expectMatchesBaseline(with, "see_through_lesion");
 }
 
+// A cut through a lesion and back (a replay seeking to its start): each model moves the lesion
+// by its own embedding, never by the other's (whose nodes the other mesh may not have).
+TEST_F(RenderBaselineTest, ALesionFollowsTheCutModelAndTheUncutOneAgain) {
+  Scenario scenario;
+  const SceneSetup setup = wedgeResectionScene(scenario);
+  const std::vector<LesionShape> lesions = visible_lesions(scenario);
+  ASSERT_EQ(lesions.size(), 1u);
+  const SimModel model = build_model(setup.mesh, setup.model_options);
+  // An upright blade drawn from the front to the lesion's centre: a slit, nothing cut off.
+  Eigen::AlignedBox3d box;
+  for (std::size_t i = 0; i < model.node_count; ++i) box.extend(model.rest_position_m.at(i));
+  const Eigen::Vector3d centre_m = lesions[0].centre_m;
+  BladeStroke stroke;
+  for (double z = box.max().z() + 0.01; z >= centre_m.z(); z -= 0.002)
+    stroke.add({Eigen::Vector3d(centre_m.x(), box.max().y() + 0.01, z),
+                Eigen::Vector3d(centre_m.x(), box.min().y() - 0.01, z)});
+  CuttingSettings anything;
+  anything.cutting_stress_pa = 0.0;
+  const CutResult cut = cut_tissue(model, make_rest_state(model), stroke, anything);
+  ASSERT_TRUE(cut.cut());
+  ASSERT_GT(cut.model->node_count, model.node_count) << "the cut split no node";
+
+  LiverScene scene(setup.mesh, setup.visual);
+  scene.set_opacity(kSeeThroughOpacity);
+  scene.show_lesions(lesions);
+  const std::size_t whole_lesion = scene.shown_lesion_triangle_count();
+  const fs::path before = screenshot(scene, "lesion_before_cut");
+  scene.show_cut_model(*cut.model, cut.state.position_m);
+  EXPECT_GT(scene.shown_lesion_triangle_count(), 0u);
+  const fs::path cut_picture = screenshot(scene, "lesion_cut");
+  EXPECT_GT(changedPixels(before, cut_picture), 100) << "the cut does not show";
+  scene.show_uncut(make_rest_state(model).position_m);
+  EXPECT_EQ(scene.shown_lesion_triangle_count(), whole_lesion);
+  const fs::path back = screenshot(scene, "lesion_uncut_again");
+  // The same scene drawn again by the same renderer.
+  EXPECT_EQ(changedPixels(before, back), 0);
+  for (const fs::path& file : {before, cut_picture, back}) fs::remove(file);
+}
+
 TEST_F(RenderBaselineTest, ACutShowsItsFacesAndTheScalpel) {
   const SceneSetup setup = default_scene();
   const SimModel model = build_model(setup.mesh, setup.model_options);

@@ -1,4 +1,5 @@
 // main() of the GUI test programs: a QApplication (with VTK's OpenGL format) around GoogleTest.
+#include "leak_check.h"
 #include "vtk_viewport.h"
 
 #include <gtest/gtest.h>
@@ -7,13 +8,6 @@
 #include <QSettings>
 
 #include <iostream>
-
-#if defined(__SANITIZE_ADDRESS__)
-// D-Bus and Mesa leak at exit, after the driver is unloaded: not ours to fix.
-extern "C" const char* __asan_default_options() {
-  return "detect_leaks=0";
-}
-#endif
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
@@ -35,6 +29,7 @@ int main(int argc, char** argv) {
           .filePath(QStringLiteral("liversim-gui-tests-%1").arg(app.applicationPid()));
   QSettings::setPath(QSettings::IniFormat, QSettings::UserScope, settings_dir);
   const int result = RUN_ALL_TESTS();
+  liversim::checkLeaksWhileTheDisplayIsOpen();
   QDir(settings_dir).removeRecursively();
   return result;
 }

@@ -34,12 +34,13 @@
 #include "session_review_window.h"
 #include "storage_messages.h"
 #include "tool_panel.h"
+#include "wait_limits.h"
 
 namespace liversim {
 namespace {
 
 constexpr int kTetCount = 1500;
-constexpr int kTimeoutMs = 90'000;
+constexpr int kTimeoutMs = liversim::test::waitLimitMs(90'000);
 
 TEST(HapticPreferences, SurviveARestartAndADamagedValueGivesTheDefault) {
   QTemporaryDir folder;

@@ -28,12 +28,13 @@
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
 #include "session_review_window.h"
+#include "wait_limits.h"
 
 namespace liversim {
 namespace {
 
 constexpr int kTetCount = 3841;  // the running scene, as the other window tests
-constexpr int kTimeoutMs = 120'000;
+constexpr int kTimeoutMs = liversim::test::waitLimitMs(120'000);
 constexpr int kBestColumn = 7;
 
 std::unique_ptr<MainWindow> openWindow() {

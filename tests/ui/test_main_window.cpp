@@ -40,6 +40,7 @@
 #include "tool_panel.h"
 #include "viewport_input.h"
 #include "vtk_viewport.h"
+#include "wait_limits.h"
 
 namespace liversim {
 namespace {
@@ -48,8 +49,8 @@ namespace {
 constexpr int kTetCount = 3841;
 // Wall-clock bounds of the waits: Xvfb with llvmpipe on a loaded machine is slow, and simulated
 // time then runs slower than real time.
-constexpr int kStartTimeoutMs = 30'000;
-constexpr int kSimulatedTimeTimeoutMs = 90'000;
+constexpr int kStartTimeoutMs = liversim::test::waitLimitMs(30'000);
+constexpr int kSimulatedTimeTimeoutMs = liversim::test::waitLimitMs(90'000);
 // The drag, in widget pixels: to the right and up.
 const QPoint kDrag(80, -40);
 constexpr int kDragMoves = 10;

@@ -33,11 +33,12 @@
 #include "scenario_editor.h"
 #include "viewport_input.h"
 #include "vtk_viewport.h"
+#include "wait_limits.h"
 
 namespace liversim {
 namespace {
 
-constexpr int kTimeoutMs = 60'000;
+constexpr int kTimeoutMs = liversim::test::waitLimitMs(60'000);
 
 class ScenarioEditorTest : public ::testing::Test {
  protected:

@@ -31,13 +31,14 @@
 #include "recent_scenarios.h"
 #include "scenario_panel.h"
 #include "tool_panel.h"
+#include "wait_limits.h"
 
 namespace liversim {
 namespace {
 
-constexpr int kStartTimeoutMs = 30'000;
-constexpr int kBuildTimeoutMs = 60'000;
-constexpr int kSimulatedTimeTimeoutMs = 90'000;
+constexpr int kStartTimeoutMs = liversim::test::waitLimitMs(30'000);
+constexpr int kBuildTimeoutMs = liversim::test::waitLimitMs(60'000);
+constexpr int kSimulatedTimeTimeoutMs = liversim::test::waitLimitMs(90'000);
 
 const QString kSmallScenario =
     QStringLiteral(LIVERSIM_TEST_DATA_DIR) + "/scenario-small-resection.json";

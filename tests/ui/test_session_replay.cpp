@@ -15,6 +15,7 @@
 #include "tool_panel.h"
 #include "viewport_input.h"
 #include "vtk_viewport.h"
+#include "wait_limits.h"
 
 #include <gtest/gtest.h>
 
@@ -33,7 +34,7 @@
 namespace liversim {
 namespace {
 
-constexpr int kTimeoutMs = 90'000;
+constexpr int kTimeoutMs = liversim::test::waitLimitMs(90'000);
 const QString kSmallScenario =
     QStringLiteral(LIVERSIM_TEST_DATA_DIR) + "/scenario-small-resection.json";
 

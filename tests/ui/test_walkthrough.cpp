@@ -28,11 +28,12 @@
 #include "palpation_points.h"
 #include "scenario_panel.h"
 #include "tool_panel.h"
+#include "wait_limits.h"
 
 namespace liversim {
 namespace {
 
-constexpr int kTimeoutMs = 90'000;
+constexpr int kTimeoutMs = liversim::test::waitLimitMs(90'000);
 
 // Answers the next file dialog with `file` (Qt's own dialog: the test asks for no native one).
 void answerNextFileDialogWith(const QString& file) {

@@ -19,12 +19,13 @@
 #include "liversim/core/default_scene.h"
 #include "main_window.h"
 #include "material_panel.h"
+#include "wait_limits.h"
 
 namespace liversim {
 namespace {
 
 constexpr int kTetCount = 3841;  // as the other window tests: small enough for Xvfb
-constexpr int kTimeoutMs = 60'000;
+constexpr int kTimeoutMs = liversim::test::waitLimitMs(60'000);
 
 std::unique_ptr<MainWindow> openWindow() {
   auto window = std::make_unique<MainWindow>(default_scene(kTetCount));

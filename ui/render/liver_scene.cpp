@@ -424,19 +424,15 @@ void LiverScene::show_cut_model(const SimModel& model, const NodeArray& position
   }
   VisualSurface visual = embed_visual_surface(mesh, surface, vertex_rest);
   const auto cut_faces = cut_face_flags(model, visual.surface);
+  // The lesions are embedded in the new mesh before set_surface moves them: the old embedding
+  // names nodes of the old mesh.
+  if (!lesion_rest_m_.empty()) show_lesion_embedding(embed_points(mesh, lesion_rest_m_));
   set_surface(std::move(visual), cut_faces, mesh.rest_position_m, position_m);
-  if (!lesion_rest_m_.empty()) {
-    show_lesion_embedding(embed_points(mesh, lesion_rest_m_));
-    update_lesion_positions(position_m);
-  }
 }
 
 void LiverScene::show_uncut(const NodeArray& position_m) {
+  if (!lesion_rest_m_.empty()) show_lesion_embedding(uncut_lesion_embedding_);
   set_surface(uncut_visual_, {}, uncut_mesh_.rest_position_m, position_m);
-  if (!lesion_rest_m_.empty()) {
-    show_lesion_embedding(uncut_lesion_embedding_);
-    update_lesion_positions(position_m);
-  }
 }
 
 void LiverScene::show_lesions(const std::vector<LesionShape>& lesions) {
