@@ -21,16 +21,23 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <mutex>
 #include <sstream>
 #include <unordered_map>
 
-#if defined(__has_feature)
+#if defined(__SANITIZE_ADDRESS__)  // GCC; clang says so by __has_feature
+#define LIVERSIM_ADDRESS_SANITIZER 1
+#elif defined(__has_feature)
 #if __has_feature(address_sanitizer)
-#include <sanitizer/common_interface_defs.h>
+#define LIVERSIM_ADDRESS_SANITIZER 1
 #endif
+#endif
+#if defined(LIVERSIM_ADDRESS_SANITIZER)
+#include <sanitizer/common_interface_defs.h>
 #endif
 
 namespace liversim {
@@ -282,15 +289,50 @@ bool write_all(int fd, const void* data, std::size_t size) {
   ::_exit(0);
 }
 
+// The reader child: this program run again with these variables set. It reads before main (below)
+// and exits, whichever program it is (the workstation, the CLI, a test).
+constexpr int kReaderAnswerFd = 3;
+constexpr const char* kReaderFileVariable = "LIVERSIM_SURFACE_READER_FILE";
+constexpr const char* kReaderUnitVariable = "LIVERSIM_SURFACE_READER_METRES_PER_UNIT";
+
+struct ReaderCommand {
+  ReaderCommand(const std::filesystem::path& file, double metres_per_unit) {
+    char unit[64];
+    std::snprintf(unit, sizeof unit, "%.17g", metres_per_unit);
+    strings.push_back(std::string(kReaderFileVariable) + "=" + file.string());
+    strings.push_back(std::string(kReaderUnitVariable) + "=" + unit);
+    for (char** variable = environ; *variable != nullptr; ++variable)
+      if (std::strncmp(*variable, "LIVERSIM_SURFACE_READER_", 24) != 0)
+        strings.emplace_back(*variable);
+    for (std::string& s : strings) environment.push_back(s.data());
+    environment.push_back(nullptr);
+  }
+  std::vector<std::string> strings;
+  std::vector<char*> environment;
+  std::array<char*, 2> argv{const_cast<char*>("liversim-surface-reader"), nullptr};
+};
+
+[[gnu::constructor]] void run_as_surface_reader() {
+  const char* file = std::getenv(kReaderFileVariable);
+  const char* unit = std::getenv(kReaderUnitVariable);
+  if (file == nullptr || unit == nullptr) return;
+  // Dying of its own faults rather than reporting them: a crash is the parent's answer.
+  for (int signal : {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT}) std::signal(signal, SIG_DFL);
+#if defined(LIVERSIM_ADDRESS_SANITIZER)
+  __sanitizer_set_death_callback(nullptr);
+#endif
+  answer_and_exit(kReaderAnswerFd, file, std::strtod(unit, nullptr));
+}
+
 }  // namespace
 
 // Read in a child process: Debian's assimp 5.2 crashes, corrupts its heap, hangs or allocates
 // without bound on damaged files in several of its readers (fuzzing found it in the PLY and glTF
 // ones, docs/fuzzing.md). A child that dies or overruns its time is an error of the file; the
 // workstation goes on. The checks that need no assimp run here first, with their own messages.
-// The GUI calling this has other threads: after fork only this one runs in the child. glibc keeps
-// malloc usable in a forked child; any other lock a thread held at the fork leaves the child
-// hanging, which the time limit turns into the same error.
+// The child runs this program again (exec) rather than reading in the forked copy: the GUI calling
+// this has other threads, and a lock one of them held at the fork (AddressSanitizer's allocator
+// did, docs/sanitizers.md) would leave the copy hanging on a sound file.
 TriangleSurface read_surface_file(const std::filesystem::path& file, double metres_per_unit) {
   const std::string name = file.string();
   if (!(metres_per_unit > 0.0) || !std::isfinite(metres_per_unit))
@@ -307,6 +349,7 @@ TriangleSurface read_surface_file(const std::filesystem::path& file, double metr
   const auto allowed = std::chrono::seconds(5) + std::chrono::milliseconds(ec ? 0 : bytes / 500);
   const auto deadline = std::chrono::steady_clock::now() + allowed;
 
+  const ReaderCommand reader(file, metres_per_unit);  // made before the fork: it allocates
   int channel[2];
   if (::pipe2(channel, O_CLOEXEC) != 0)
     throw refused(std::string("cannot start its reader: ") + std::strerror(errno));
@@ -317,18 +360,16 @@ TriangleSurface read_surface_file(const std::filesystem::path& file, double metr
     ::close(channel[1]);
     throw refused(std::string("cannot start its reader: ") + std::strerror(error));
   }
-  if (child == 0) {
+  if (child == 0) {  // async-signal-safe calls only until exec
     ::close(channel[0]);
-    // Quiet, and dying of its own faults rather than reporting them as this program's (a
-    // sanitizer build reports and records a crash of the parent).
+    // The answer goes to descriptor 3, which stays open across exec; stderr to /dev/null.
+    if (channel[1] == kReaderAnswerFd)
+      ::fcntl(kReaderAnswerFd, F_SETFD, 0);
+    else
+      ::dup2(channel[1], kReaderAnswerFd);
     if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, STDERR_FILENO);
-    for (int signal : {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT}) std::signal(signal, SIG_DFL);
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-    __sanitizer_set_death_callback(nullptr);
-#endif
-#endif
-    answer_and_exit(channel[1], file, metres_per_unit);
+    ::execve("/proc/self/exe", reader.argv.data(), reader.environment.data());
+    ::_exit(127);
   }
   ::close(channel[1]);
   std::string answer;
