@@ -345,6 +345,22 @@ TEST_F(RealtimeSteppingFixture, AScalpelDrawnThroughTheLiverCutsItWhileItRuns) {
   EXPECT_EQ(check_health(*seen.model, simulation.state()), HealthProblem::none);
 }
 
+// Waits (at most a minute of wall time) until the running simulation has simulated `duration_s`
+// more, or `done` holds; returns the last snapshot.
+template <class Done>
+SimulationSnapshot run_until(RealtimeSimulation& simulation, double duration_s, Done done) {
+  simulation.update_snapshot();
+  const double until_s = simulation.snapshot().time_s + duration_s;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    simulation.update_snapshot();
+    const SimulationSnapshot& seen = simulation.snapshot();
+    if (seen.time_s >= until_s || done(seen)) break;
+  }
+  return simulation.snapshot();
+}
+
 // Determinism (issue 10): what the running loop took (tools set from another thread at whatever
 // moments, as many steps per cycle as the wall clock gave, the springs of a grab, the cuts the
 // scalpel made) replayed in order on the same model from the same state gives the same liver to
@@ -362,13 +378,17 @@ TEST_F(RealtimeSteppingFixture, ReplayingTheLoggedInputsReproducesTheRunToTheLas
   const auto live = make();
   live->log_inputs(true);
   live->start();
+  // Waits for simulated, not wall time: a slow build (a sanitizer's) takes as many cycles.
+  const auto simulate_for = [&](double duration_s) {
+    run_until(*live, duration_s, [](const SimulationSnapshot&) { return false; });
+  };
   // A grab of the marked node pulled 5 mm out and let go, then a probe pressing the top, then
   // the scalpel drawn 6 cm through the liver.
   const NodeIndex node = anterior_marked_node(*mesh_);
   const Eigen::Vector3d marked = model->rest_position_m.at(node);
   const NodeSpring grab{node, marked + Eigen::Vector3d(0.0, 0.0, 0.005), 50.0};
   live->set_springs(std::span(&grab, 1));
-  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  simulate_for(0.150);
   live->clear_springs();
   const Eigen::AlignedBox3d box = rest_box(*model);
   Tool probe;
@@ -376,7 +396,7 @@ TEST_F(RealtimeSteppingFixture, ReplayingTheLoggedInputsReproducesTheRunToTheLas
   for (int k = 0; k < 10; ++k) {
     probe.pose.origin_m.z() -= 0.0005;
     live->set_tool(probe);
-    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+    simulate_for(0.015);
   }
   Tool scalpel;
   scalpel.kind = ToolKind::scalpel;
@@ -385,10 +405,10 @@ TEST_F(RealtimeSteppingFixture, ReplayingTheLoggedInputsReproducesTheRunToTheLas
   for (int k = 0; k <= 60; ++k) {
     scalpel.pose.origin_m = start + Eigen::Vector3d(0.001 * k, 0.0, 0.0);
     live->set_tool(scalpel);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    simulate_for(0.020);
   }
   live->set_tool(std::nullopt);
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  simulate_for(0.050);
   live->stop();
   const std::vector<SimulationInput> log = live->take_input_log();
   int cycles = 0, tools = 0, springs = 0;
@@ -425,22 +445,6 @@ TEST_F(RealtimeSteppingFixture, ReplayingTheLoggedInputsReproducesTheRunToTheLas
   other->replay(shorter);
   EXPECT_NE(other->state().step_count, live->state().step_count);
   EXPECT_FALSE(other->state().position_m.x == live->state().position_m.x);
-}
-
-// Waits (at most a minute of wall time) until the running simulation has simulated `duration_s`
-// more, or `done` holds; returns the last snapshot.
-template <class Done>
-SimulationSnapshot run_until(RealtimeSimulation& simulation, double duration_s, Done done) {
-  simulation.update_snapshot();
-  const double until_s = simulation.snapshot().time_s + duration_s;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    simulation.update_snapshot();
-    const SimulationSnapshot& seen = simulation.snapshot();
-    if (seen.time_s >= until_s || done(seen)) break;
-  }
-  return simulation.snapshot();
 }
 
 TEST_F(RealtimeSteppingFixture, AScalpelThatBrokeInCutsWhereverItIsDrawnUntilItIsDrawnOut) {
@@ -618,8 +622,10 @@ TEST_F(RealtimeSteppingFixture, AScriptedDeviceHoldsTheForcepsPullsTheLiverAndFe
   probe.pose.origin_m = marked + Eigen::Vector3d(0.0, 0.0, 0.05);
   simulation.set_tool(probe);
   simulation.start();
-  const SimulationSnapshot after = run_until(
-      simulation, 60.0, [](const SimulationSnapshot& seen) { return seen.tool.has_value(); });
+  // The first snapshots may still be the last cycle's before the stop.
+  const SimulationSnapshot after = run_until(simulation, 60.0, [](const SimulationSnapshot& seen) {
+    return seen.tool && seen.tool->kind == ToolKind::probe;
+  });
   simulation.stop();
   ASSERT_TRUE(after.tool);
   EXPECT_EQ(after.tool->kind, ToolKind::probe);

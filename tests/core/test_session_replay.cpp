@@ -173,10 +173,12 @@ class SessionReplayTest : public ::testing::Test {
       live_->set_tool(scalpel);
       wait_simulated(0.01);
     }
+    in_after_sinking_ = live_->snapshot().blade_cutting;
     for (int k = 0; k < 70; ++k) {
       scalpel.pose.origin_m.x() += 0.001;
       live_->set_tool(scalpel);
       wait_simulated(0.01);
+      if (live_->snapshot().blade_cutting) ++cycles_drawn_in_;
     }
     live_->set_tool(std::nullopt);
     wait_simulated(0.05);
@@ -204,6 +206,8 @@ class SessionReplayTest : public ::testing::Test {
 
   static SceneSetup* scene_;
   static inline bool broke_in_ = false;
+  static inline bool in_after_sinking_ = false;
+  static inline int cycles_drawn_in_ = 0;
   static RealtimeSimulation* live_;
   static std::vector<SimulationInput>* log_;
 };
@@ -215,7 +219,10 @@ std::vector<SimulationInput>* SessionReplayTest::log_ = nullptr;
 TEST_F(SessionReplayTest, TheRunCutTheLiverAndEveryCycleIsOnTheServoClock) {
   ASSERT_TRUE(broke_in_) << "the scalpel did not break in";
   live_->update_snapshot();
-  EXPECT_GT(live_->snapshot().topology_version, 0u) << "the scalpel cut nothing";
+  EXPECT_GT(live_->snapshot().topology_version, 0u)
+      << "the scalpel cut nothing; in after sinking: " << in_after_sinking_ << ", in at "
+      << cycles_drawn_in_ << " of 70 positions drawn, halted: " << live_->stats().halted
+      << ", rollbacks: " << live_->stats().rollbacks;
   double last = -1.0;
   int cycles = 0;
   for (const SimulationInput& input : *log_) {
