@@ -2,7 +2,8 @@
 # The two commands of README for a new user on Debian 12:
 #   packaging/liversim.sh run    install what is missing, build, start the workstation
 #   packaging/liversim.sh test   install what is missing, build, run the whole test suite, then
-#                                fuzz each reader briefly (the fuzz preset: docs/fuzzing.md)
+#                                fuzz each reader briefly (the fuzz preset: docs/fuzzing.md) and
+#                                run the threaded parts under ThreadSanitizer (docs/sanitizers.md)
 # Without a display, "run" says so and runs the headless demo instead (a short simulation and a
 # screenshot written to liversim-demo.png in the current directory).
 set -euo pipefail
@@ -32,7 +33,13 @@ if [ "$command" = test ]; then
   # sanitizers (docs/fuzzing.md).
   cmake --preset fuzz >/dev/null
   cmake --build --preset fuzz --parallel "$(nproc)"
-  exec ctest --preset fuzz --parallel "$(nproc)"
+  ctest --preset fuzz --parallel "$(nproc)"
+  # Then the threaded parts under ThreadSanitizer: the programs their tests need, and those tests
+  # (the whole suites under ASan and TSan take longer than CI allows: docs/sanitizers.md).
+  cmake --preset tsan >/dev/null
+  cmake --build --preset tsan --parallel "$(nproc)" --target liversim_core_tests \
+    liversim_storage_tests liversim_cli_record_tests liversim-cli liversim_session_writer_child
+  exec ctest --preset tsan-threads --parallel "$(nproc)"
 fi
 
 if [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; then
