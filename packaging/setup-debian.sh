@@ -9,6 +9,7 @@ packages=(
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev qt6-tools-dev qt6-tools-dev-tools qt6-l10n-tools
   libqt6sql6-sqlite libgl-dev libgl1-mesa-dri
   libvtk9-dev libeigen3-dev libassimp-dev libgmsh-dev libsqlite3-dev libx11-dev libsodium-dev
+  libpq-dev postgresql openssl
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev python3 python3-jsonschema
   xvfb xauth

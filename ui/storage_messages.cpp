@@ -42,6 +42,11 @@ QString storageAdvice(StorageProblem problem) {
       return tr(
           "Start LiverSim again to make a new sessions database there, or restore the file "
           "from a backup. Until then, sessions are not recorded.");
+    case StorageProblem::refused:
+      return tr(
+          "Check the login name and password in the training centre settings, or ask the "
+          "server's administrator for the permission. Sessions keep being recorded on this "
+          "workstation.");
     case StorageProblem::other:
       break;
   }

@@ -2,6 +2,7 @@
 // writer killed mid-session, and files that are damaged, foreign, newer, read-only or full.
 #include "liversim/core/session_recorder.h"
 #include "liversim/storage/sqlite_session_store.h"
+#include "storage_test_support.h"
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -16,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <regex>
 #include <thread>
 
 extern char** environ;
@@ -24,31 +26,9 @@ namespace liversim {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A fresh path in the test output directory (the file and its WAL side files removed).
-fs::path fresh_database(const std::string& name) {
-  const fs::path file = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "storage" / (name + ".sqlite");
-  fs::create_directories(file.parent_path());
-  for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(file.string() + suffix);
-  return file;
-}
-
-// Frames of a 1 kHz servo with every field distinct, not round numbers: an exact read-back
-// cannot pass by accident.
-std::vector<ServoFrame> synthetic_frames(std::size_t count, unsigned seed) {
-  std::mt19937_64 random(seed);
-  std::uniform_real_distribution<double> value(-50.0, 50.0);
-  std::vector<ServoFrame> frames(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    ServoFrame& f = frames[i];
-    f.time_s = 1e-3 * static_cast<double>(i) + 1e-7 * value(random);
-    f.sample.position_mm = {value(random), value(random), value(random)};
-    f.sample.velocity_mm_per_s = {value(random), value(random), value(random)};
-    f.force_n = {0.01 * value(random), 0.01 * value(random), 0.01 * value(random)};
-    f.sample.buttons = static_cast<std::uint32_t>(random() & 3u);
-  }
-  return frames;
-}
+using testing::expect_same_frames;
+using testing::fresh_database;
+using testing::synthetic_frames;
 
 // Frames a recorder takes only as the test releases them (as a servo queues them over time).
 struct ReleasedFrames {
@@ -64,18 +44,6 @@ struct ReleasedFrames {
   }
   void release(std::size_t count) { released = std::min(frames.size(), released.load() + count); }
 };
-
-void expect_same_frames(const std::vector<ServoFrame>& read,
-                        const std::vector<ServoFrame>& written) {
-  ASSERT_EQ(read.size(), written.size());
-  for (std::size_t i = 0; i < read.size(); ++i) {
-    ASSERT_EQ(read[i].time_s, written[i].time_s) << "frame " << i;
-    ASSERT_EQ(read[i].sample.position_mm, written[i].sample.position_mm) << "frame " << i;
-    ASSERT_EQ(read[i].sample.velocity_mm_per_s, written[i].sample.velocity_mm_per_s) << i;
-    ASSERT_EQ(read[i].force_n, written[i].force_n) << "frame " << i;
-    ASSERT_EQ(read[i].sample.buttons, written[i].sample.buttons) << "frame " << i;
-  }
-}
 
 SessionStart start_of(const std::string& trainee, const std::string& scenario_text) {
   return {trainee, "Palpation", scenario_text, "Scripted", 1'795'000'000'000, std::nullopt};
@@ -287,7 +255,7 @@ int user_version(const fs::path& file) {
 // the migration to the current version, and a session added after has everything the current
 // version stores.
 TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
-  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 4) << "add a file of the version before";
+  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 5) << "add a file of the version before";
   struct Earlier {
     int version;
     double peak_force_n;
@@ -297,7 +265,8 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
   };
   for (const Earlier& earlier : {Earlier{1, 0.75, "probe", "v1 grade", std::nullopt},
                                  Earlier{2, 0.5, "scalpel", "v2 grade", 2.0},
-                                 Earlier{3, 0.25, "forceps", "v3 grade", 3.0, 201}}) {
+                                 Earlier{3, 0.25, "forceps", "v3 grade", 3.0, 201},
+                                 Earlier{4, 0.125, "scalpel", "v4 grade", 4.0}}) {
     const std::string name = "sessions-v" + std::to_string(earlier.version) + ".sqlite";
     SCOPED_TRACE(name);
     const fs::path file = fresh_database("migrated-from-v" + std::to_string(earlier.version));
@@ -350,6 +319,11 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     // Recorded before replays: nothing to replay, and said so (no setup), not an error.
     EXPECT_FALSE(store.replay_setup(sessions[0].id));
     EXPECT_TRUE(store.inputs(sessions[0].id).empty());
+    // Version 5: every session has its own random UUID, the old one too.
+    const std::regex uuid("[0-9a-f]{8}-[0-9a-f]{4}-4[0-9a-f]{3}-[89ab][0-9a-f]{3}-[0-9a-f]{12}");
+    EXPECT_TRUE(std::regex_match(sessions[0].uuid, uuid)) << sessions[0].uuid;
+    EXPECT_TRUE(std::regex_match(sessions[1].uuid, uuid)) << sessions[1].uuid;
+    EXPECT_NE(sessions[0].uuid, sessions[1].uuid);
     // The new session keeps its mapping and its replay exactly.
     EXPECT_EQ(sessions[1].id, added);
     ASSERT_TRUE(sessions[1].mapping);

@@ -2,6 +2,7 @@
 
 #include "liversim/core/integrator.h"
 #include "liversim/core/sha256.h"
+#include "liversim/storage/session_transfer.h"
 
 #include <sqlite3.h>
 #include <sys/stat.h>
@@ -136,7 +137,36 @@ CREATE TABLE instructor_accounts (
 );
 )sql";
 
-constexpr std::array<const char*, 4> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3, kSchemaV4};
+// A random version-4 UUID in SQL, for the rows that were there before version 5.
+#define LIVERSIM_SQL_UUID                                                                    \
+  "lower(hex(randomblob(4))) || '-' || lower(hex(randomblob(2))) || '-4' || "                \
+  "substr(lower(hex(randomblob(2))), 2) || '-' || substr('89ab', 1 + abs(random()) % 4, 1) " \
+  "|| substr(lower(hex(randomblob(2))), 2) || '-' || lower(hex(randomblob(6)))"
+
+// Version 5: the training centre (docs/training-centre.md). Sessions and grades get UUIDs, so
+// that an upload done twice and a grade pulled twice are stored once; the uploads done (and
+// tried) to each server.
+constexpr const char* kSchemaV5 =
+    "ALTER TABLE sessions ADD COLUMN uuid TEXT;"
+    "UPDATE sessions SET uuid = " LIVERSIM_SQL_UUID
+    ";"
+    "CREATE UNIQUE INDEX sessions_by_uuid ON sessions (uuid);"
+    "ALTER TABLE grades ADD COLUMN uuid TEXT;"
+    "UPDATE grades SET uuid = " LIVERSIM_SQL_UUID
+    ";"
+    "CREATE UNIQUE INDEX grades_by_uuid ON grades (uuid);"
+    "CREATE TABLE session_uploads ("
+    "  session_id INTEGER NOT NULL REFERENCES sessions (id),"
+    "  server TEXT NOT NULL,"
+    "  uploaded_unix_ms INTEGER,"
+    "  attempts INTEGER NOT NULL DEFAULT 0,"
+    "  last_problem TEXT,"
+    "  PRIMARY KEY (session_id, server)"
+    ") WITHOUT ROWID;";
+#undef LIVERSIM_SQL_UUID
+
+constexpr std::array<const char*, 5> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3, kSchemaV4,
+                                                    kSchemaV5};
 static_assert(kMigrations.size() == SqliteSessionStore::kSchemaVersion);
 
 enum StatementId {
@@ -499,12 +529,13 @@ std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
       prepared(kFindScenario, "SELECT id FROM scenarios WHERE sha256 = ?1")
           .bind(1, std::string_view(hash))
           .single_integer("looking up the scenario");
-  Statement& add =
-      prepared(kAddSession,
-               "INSERT INTO sessions (trainee_id, scenario_id, device, started_unix_ms, status, "
-               "mapping_scale, mapping_rotation_w, mapping_rotation_x, mapping_rotation_y, "
-               "mapping_rotation_z, mapping_offset_x_m, mapping_offset_y_m, mapping_offset_z_m) "
-               "VALUES (?1, ?2, ?3, ?4, 'recording', ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)");
+  Statement& add = prepared(
+      kAddSession,
+      "INSERT INTO sessions (trainee_id, scenario_id, device, started_unix_ms, status, "
+      "mapping_scale, mapping_rotation_w, mapping_rotation_x, mapping_rotation_y, "
+      "mapping_rotation_z, mapping_offset_x_m, mapping_offset_y_m, mapping_offset_z_m, "
+      "uuid) VALUES (?1, ?2, ?3, ?4, 'recording', ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)");
+  add.bind(13, std::string_view(new_uuid()));
   add.bind(1, trainee)
       .bind(2, scenario)
       .bind(3, std::string_view(start.device))
@@ -767,9 +798,10 @@ void SqliteSessionStore::store_grade(const Instructor& by, std::int64_t session,
   begin_if_needed();
   Statement& store = prepared(
       kStoreGrade,
-      "INSERT INTO grades (session_id, instructor_id, graded_unix_ms, score, grade, comment) "
-      "VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+      "INSERT INTO grades (session_id, instructor_id, graded_unix_ms, score, grade, comment, "
+      "uuid) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)");
   store.bind(1, session).bind(2, instructor).bind(3, grade.graded_unix_ms);
+  store.bind(7, std::string_view(new_uuid()));
   if (grade.score_percent)
     store.bind(4, *grade.score_percent);
   else
@@ -817,8 +849,8 @@ std::vector<SessionSummary> SqliteSessionStore::list_sessions(
       "s.servo_period_p99_ms, s.servo_period_max_ms, s.missed_deadlines, s.force_clamps, "
       "s.stiffness_clamps, s.rate_limited, s.watchdog_trips, s.device_faults, s.dropped_frames, "
       "s.mapping_scale, s.mapping_rotation_w, s.mapping_rotation_x, s.mapping_rotation_y, "
-      "s.mapping_rotation_z, s.mapping_offset_x_m, s.mapping_offset_y_m, s.mapping_offset_z_m "
-      "FROM sessions s JOIN people p ON p.id = s.trainee_id "
+      "s.mapping_rotation_z, s.mapping_offset_x_m, s.mapping_offset_y_m, s.mapping_offset_z_m, "
+      "s.uuid FROM sessions s JOIN people p ON p.id = s.trainee_id "
       "JOIN scenarios c ON c.id = s.scenario_id WHERE ?1 IS NULL OR p.name = ?1 ORDER BY s.id");
   if (trainee) rows.bind(1, *trainee);  // unbound: NULL, every trainee's
   std::vector<SessionSummary> result;
@@ -860,6 +892,7 @@ std::vector<SessionSummary> SqliteSessionStore::list_sessions(
       m.offset_m = Eigen::Vector3d(rows.real(26), rows.real(27), rows.real(28));
       s.mapping = m;
     }
+    s.uuid = rows.text(29);
     result.push_back(std::move(s));
   }
   rows.reset();
@@ -952,6 +985,142 @@ std::string SqliteSessionStore::scenario_text(std::int64_t session) {
   std::string text = row.text(0);
   row.reset();
   return text;
+}
+
+std::vector<std::int64_t> SqliteSessionStore::sessions_to_upload(std::string_view server) {
+  Statement rows(*this,
+                 "SELECT s.id FROM sessions s WHERE s.status <> 'recording' AND NOT EXISTS "
+                 "(SELECT 1 FROM session_uploads u WHERE u.session_id = s.id AND u.server = ?1 "
+                 "AND u.uploaded_unix_ms IS NOT NULL) ORDER BY s.id");
+  rows.bind(1, server);
+  std::vector<std::int64_t> result;
+  while (rows.step("listing the sessions to upload")) result.push_back(rows.integer(0));
+  return result;
+}
+
+SessionTransfer SqliteSessionStore::transfer_of(std::int64_t session) {
+  SessionTransfer transfer;
+  {
+    Statement row(*this, "SELECT uuid, input_count FROM sessions WHERE id = ?1");
+    row.bind(1, session);
+    if (!row.step("reading the session"))
+      throw error("there is no session " + std::to_string(session));
+    transfer.uuid = row.text(0);
+    transfer.input_count = row.integer(1);
+  }
+  for (SessionSummary& summary : list_sessions(std::nullopt))
+    if (summary.id == session) transfer.summary = std::move(summary);
+  transfer.scenario_text = scenario_text(session);
+  transfer.replay = replay_setup(session);
+  transfer.events = events(session);
+  transfer.metrics = metrics(session);
+  const auto chunks = [this, session](const char* sql, bool timed) {
+    return [this, session, sql, timed](const ChunkSink& sink) {
+      Statement rows(*this, sql);
+      rows.bind(1, session);
+      StoredChunk chunk;
+      while (rows.step("reading the chunks to upload")) {
+        chunk.first = rows.integer(0);
+        chunk.count = rows.integer(1);
+        chunk.layout = static_cast<int>(rows.integer(2));
+        const std::span<const std::uint8_t> data = rows.blob(3);
+        chunk.data.assign(data.begin(), data.end());
+        if (timed) {
+          chunk.first_time_s = rows.real(4);
+          chunk.last_time_s = rows.real(5);
+        }
+        sink(chunk);
+      }
+    };
+  };
+  transfer.frame_chunks = chunks(
+      "SELECT first_frame, frame_count, layout, data, first_time_s, last_time_s FROM "
+      "frame_chunks WHERE session_id = ?1 ORDER BY first_frame",
+      true);
+  transfer.input_chunks = chunks(
+      "SELECT first_input, input_count, layout, data FROM input_chunks WHERE session_id = ?1 "
+      "ORDER BY first_input",
+      false);
+  return transfer;
+}
+
+void SqliteSessionStore::mark_uploaded(std::int64_t session, std::string_view server,
+                                       std::int64_t unix_ms) {
+  begin_if_needed();
+  Statement(*this,
+            "INSERT INTO session_uploads (session_id, server, uploaded_unix_ms, attempts) "
+            "VALUES (?1, ?2, ?3, 1) ON CONFLICT (session_id, server) DO UPDATE SET "
+            "uploaded_unix_ms = ?3, attempts = attempts + 1, last_problem = NULL")
+      .bind(1, session)
+      .bind(2, server)
+      .bind(3, unix_ms)
+      .run("noting the upload");
+  commit();
+}
+
+void SqliteSessionStore::note_upload_problem(std::int64_t session, std::string_view server,
+                                             std::string_view problem) {
+  begin_if_needed();
+  Statement(*this,
+            "INSERT INTO session_uploads (session_id, server, attempts, last_problem) "
+            "VALUES (?1, ?2, 1, ?3) ON CONFLICT (session_id, server) DO UPDATE SET "
+            "attempts = attempts + 1, last_problem = ?3")
+      .bind(1, session)
+      .bind(2, server)
+      .bind(3, problem)
+      .run("noting the upload's problem");
+  commit();
+}
+
+SqliteSessionStore::UploadState SqliteSessionStore::upload_state(std::int64_t session,
+                                                                 std::string_view server) {
+  Statement row(*this,
+                "SELECT uploaded_unix_ms, attempts, last_problem FROM session_uploads "
+                "WHERE session_id = ?1 AND server = ?2");
+  row.bind(1, session).bind(2, server);
+  UploadState state;
+  if (row.step("reading the upload's state")) {
+    if (!row.is_null(0)) state.uploaded_unix_ms = row.integer(0);
+    state.attempts = row.integer(1);
+    state.last_problem = row.text(2);
+  }
+  return state;
+}
+
+std::vector<std::string> SqliteSessionStore::uploaded_session_uuids(std::string_view server) {
+  Statement rows(*this,
+                 "SELECT s.uuid FROM sessions s JOIN session_uploads u ON u.session_id = s.id "
+                 "WHERE u.server = ?1 AND u.uploaded_unix_ms IS NOT NULL ORDER BY s.id");
+  rows.bind(1, server);
+  std::vector<std::string> result;
+  while (rows.step("listing the uploaded sessions")) result.push_back(rows.text(0));
+  return result;
+}
+
+int SqliteSessionStore::store_shared_grades(std::span<const SharedGrade> grades) {
+  begin_if_needed();
+  int added = 0;
+  Statement add(*this,
+                "INSERT OR IGNORE INTO grades (session_id, instructor_id, graded_unix_ms, score, "
+                "grade, comment, uuid) SELECT s.id, ?2, ?3, ?4, ?5, ?6, ?7 FROM sessions s "
+                "WHERE s.uuid = ?1");
+  for (const SharedGrade& shared : grades) {
+    const std::int64_t instructor = person(shared.grade.instructor, "instructor");
+    add.bind(1, std::string_view(shared.session_uuid))
+        .bind(2, instructor)
+        .bind(3, shared.grade.graded_unix_ms);
+    if (shared.grade.score_percent)
+      add.bind(4, *shared.grade.score_percent);
+    else
+      add.bind_null(4);
+    add.bind(5, std::string_view(shared.grade.grade))
+        .bind(6, std::string_view(shared.grade.comment))
+        .bind(7, std::string_view(shared.grade_uuid))
+        .run("storing a grade from the server");
+    added += sqlite3_changes(db_);
+  }
+  commit();
+  return added;
 }
 
 }  // namespace liversim

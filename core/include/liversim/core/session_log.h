@@ -31,6 +31,7 @@ enum class StorageProblem {
   not_a_database,  // not a (LiverSim) database
   newer_version,   // written by a newer LiverSim
   deleted,         // deleted or replaced while in use
+  refused,         // a server refused the login or the action (wrong password, no permission)
 };
 
 // A storage failure: names the database file and what is wrong with it (read-only, damaged, full,
@@ -103,6 +104,7 @@ SessionServoFigures servo_figures(const ServoStats& stats, std::uint64_t dropped
 
 struct SessionSummary {
   std::int64_t id = 0;
+  std::string uuid;  // the same on every store it was copied to (schema 5 on)
   std::string trainee;
   std::string scenario_title;
   std::string scenario_sha256;

@@ -5,6 +5,7 @@
 
 #include "liversim/core/session_log.h"
 #include "liversim/storage/password_hash.h"
+#include "liversim/storage/session_transfer.h"
 
 #include <filesystem>
 #include <memory>
@@ -18,7 +19,7 @@ class SqliteSessionStore final : public SessionStore {
   enum class Access { read_write, read_only };
 
   // The schema version this build writes; files at older versions are migrated on opening.
-  static constexpr int kSchemaVersion = 4;
+  static constexpr int kSchemaVersion = 5;
 
   // Opens the file, creating it (read_write) if it does not exist. Throws StorageError naming the
   // file when it cannot be opened, is not a LiverSim database, is damaged, is read-only while
@@ -66,6 +67,26 @@ class SqliteSessionStore final : public SessionStore {
   std::string scenario_text(std::int64_t session) override;
   std::optional<ReplaySetup> replay_setup(std::int64_t session) override;
   std::vector<SimulationInput> inputs(std::int64_t session) override;
+
+  // The training centre (session_upload.h). `server` names the server (server_name()).
+  // The sessions that ended (complete or incomplete) and are not yet on that server, oldest first.
+  std::vector<std::int64_t> sessions_to_upload(std::string_view server);
+  // The session as it is uploaded; its chunk sources read this store while they are called.
+  SessionTransfer transfer_of(std::int64_t session);
+  // The server has the session / an upload of it failed (the attempt counted, the problem kept).
+  void mark_uploaded(std::int64_t session, std::string_view server, std::int64_t unix_ms);
+  void note_upload_problem(std::int64_t session, std::string_view server, std::string_view problem);
+  struct UploadState {
+    std::optional<std::int64_t> uploaded_unix_ms;
+    std::int64_t attempts = 0;
+    std::string last_problem;
+  };
+  UploadState upload_state(std::int64_t session, std::string_view server);
+  // The UUIDs of the sessions that are on that server.
+  std::vector<std::string> uploaded_session_uuids(std::string_view server);
+  // Grades from the server, of sessions held here: each added once (by its UUID); those of
+  // sessions not held here are skipped. Returns how many were new. Commits.
+  int store_shared_grades(std::span<const SharedGrade> grades);
 
  private:
   class Statement;
