@@ -441,7 +441,7 @@ TEST_F(TrainingCentre, TheServerEnforcesTheRolesAsWellAsTheApplication) {
   EXPECT_THROW(central.store_grade(*from_other, 1, {"Dr. Grey", 0, std::nullopt, "A", ""}),
                AccessDenied)
       << "an Instructor of another store's log-in";
-  EXPECT_THROW(central.publish_scenario(*from_other, "x", "x", "{}"), AccessDenied);
+  EXPECT_THROW(central.publish_scenario(*from_other, "x", "{}"), AccessDenied);
   // A wrong password is refused by the server: a clear message, the login named, no password.
   try {
     PostgresSessionStore wrong(ws, "not the password");
@@ -462,31 +462,45 @@ TEST_F(TrainingCentre, TheServerEnforcesTheRolesAsWellAsTheApplication) {
 }
 
 // Instructors publish scenarios centrally; workstations pull them into a folder, a changed one
-// again, an unchanged one not.
+// again, an unchanged one not. A text that is no valid scenario, or a name that is no plain file
+// name, is refused.
 TEST_F(TrainingCentre, PublishedScenariosArePulledByTheWorkstations) {
   PostgresSessionStore office(server_->as("Dr. Grey"), kInstructorPassword);
   const std::optional<Instructor> grey = office.log_in_instructor("Dr. Grey", kInstructorPassword);
   ASSERT_TRUE(grey);
-  const std::string text = "{\"title\": \"Hidden lesion\", \"version\": 1}";
-  office.publish_scenario(*grey, "hidden-lesion", "Hidden lesion", text);
-  EXPECT_THROW(office.publish_scenario(*grey, "../../etc/passwd", "x", "{}"), StorageError)
-      << "a name that is no file name in the folder";
-
-  PostgresSessionStore central(workstation(), kWorkstationPassword);
-  const fs::path folder = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "training-centre" / "pulled";
-  fs::remove_all(folder);
-  EXPECT_EQ(pull_scenarios(central, folder), std::vector<std::string>{"hidden-lesion"});
   const auto read = [&](const fs::path& file) {
     std::ifstream in(file);
     std::ostringstream t;
     t << in.rdbuf();
     return t.str();
   };
+  const std::string text = read(fs::path(LIVERSIM_TEST_DATA_DIR).parent_path().parent_path() /
+                                "scenarios" / "palpation-hidden-lesion.json");
+  ASSERT_FALSE(text.empty());
+  office.publish_scenario(*grey, "hidden-lesion", text);
+  EXPECT_THROW(office.publish_scenario(*grey, "../../etc/passwd", text), StorageError)
+      << "a name that is no file name in the folder";
+  try {
+    office.publish_scenario(*grey, "broken", "{\"title\": \"no liver, no task\"}");
+    ADD_FAILURE() << "published a scenario that does not validate";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("broken"), std::string::npos) << e.what();
+  }
+
+  PostgresSessionStore central(workstation(), kWorkstationPassword);
+  ASSERT_EQ(central.published_scenarios().size(), 1u);
+  EXPECT_EQ(central.published_scenarios()[0].title, "Palpation: find the hidden lesion");
+  const fs::path folder = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "training-centre" / "pulled";
+  fs::remove_all(folder);
+  EXPECT_EQ(pull_scenarios(central, folder), std::vector<std::string>{"hidden-lesion"});
   EXPECT_EQ(read(folder / "hidden-lesion.json"), text);
   EXPECT_TRUE(pull_scenarios(central, folder).empty());
-  const std::string changed = "{\"title\": \"Hidden lesion\", \"version\": 2}";
-  office.publish_scenario(*grey, "hidden-lesion", "Hidden lesion", changed);
+  std::string changed = text;
+  const std::string title = "Palpation: find the hidden lesion";
+  changed.replace(changed.find(title), title.size(), "Palpation, second edition");
+  office.publish_scenario(*grey, "hidden-lesion", changed);
   EXPECT_EQ(central.published_scenarios().at(0).version, 2);
+  EXPECT_EQ(central.published_scenarios().at(0).title, "Palpation, second edition");
   EXPECT_EQ(central.published_scenarios().at(0).published_by, "Dr. Grey");
   EXPECT_EQ(pull_scenarios(central, folder), std::vector<std::string>{"hidden-lesion"});
   EXPECT_EQ(read(folder / "hidden-lesion.json"), changed);

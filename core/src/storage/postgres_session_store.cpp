@@ -1,19 +1,24 @@
 #include "liversim/storage/postgres_session_store.h"
 
 #include "liversim/core/integrator.h"
+#include "liversim/core/scenario.h"
 #include "liversim/core/sha256.h"
 #include "liversim/storage/password_hash.h"
+#include "stored_rows.h"
 
 #include <libpq-fe.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
-#include <chrono>
 #include <cstring>
-#include <iterator>
+#include <stdexcept>
 #include <utility>
 
 namespace liversim {
+
+using stored_rows::kMappingColumns;
+using stored_rows::kServoColumns;
 
 namespace {
 
@@ -242,12 +247,6 @@ static_assert(kServerMigrations.size() == PostgresSessionStore::kSchemaVersion);
 constexpr Oid kBoolOid = 16, kByteaOid = 17, kInt8Oid = 20, kInt4Oid = 23, kTextOid = 25,
               kFloat8Oid = 701;
 
-std::int64_t now_unix_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 template <typename T>
 T big_endian(T value) {
   if constexpr (std::endian::native == std::endian::little) {
@@ -318,6 +317,16 @@ class Result {
   Result& operator=(Result&&) = delete;
   PGresult* raw() const { return result_; }
   int rows() const { return PQntuples(result_); }
+  // Row r, as stored_rows' readers take one.
+  struct Row {
+    const Result& result;
+    int row;
+    std::int64_t integer(int column) const { return result.integer(row, column); }
+    double real(int column) const { return result.real(row, column); }
+    std::string text(int column) const { return result.text(row, column); }
+    bool is_null(int column) const { return result.is_null(row, column); }
+  };
+  Row row(int r) const { return {*this, r}; }
   bool is_null(int row, int column) const { return PQgetisnull(result_, row, column) == 1; }
   std::int64_t integer(int row, int column) const {
     const char* data = PQgetvalue(result_, row, column);
@@ -629,14 +638,6 @@ Params& add_servo(Params& p, const std::optional<SessionServoFigures>& servo) {
   return p;
 }
 
-constexpr const char* kServoColumns =
-    "servo_ticks, servo_rate_hz, servo_period_p50_ms, servo_period_p99_ms, servo_period_max_ms, "
-    "missed_deadlines, force_clamps, stiffness_clamps, rate_limited, watchdog_trips, "
-    "device_faults, dropped_frames";
-constexpr const char* kMappingColumns =
-    "mapping_scale, mapping_rotation_w, mapping_rotation_x, mapping_rotation_y, "
-    "mapping_rotation_z, mapping_offset_x_m, mapping_offset_y_m, mapping_offset_z_m";
-
 void store_replay(Connection& c, std::int64_t session, const ReplaySetup& replay) {
   const IntegratorSettings& i = replay.integrator;
   std::optional<std::int64_t> tets;
@@ -666,6 +667,31 @@ void store_events(Connection& c, std::int64_t session, std::span<const SessionEv
               .add(session_event_name(event.kind))
               .add(std::string_view(event.detail)),
           "storing an event");
+}
+
+// Counts `count` more items (column "frame_count" or "input_count") to a session and returns the
+// index of the first: one round trip, and the session named when there is none to add to.
+std::int64_t claim_items(Connection& c, std::int64_t session, const char* count_column,
+                         std::size_t count) {
+  const std::string update = std::string("UPDATE sessions SET ") + count_column + " = " +
+                             count_column + " + $2 WHERE id = $1 RETURNING " + count_column +
+                             " - $2";
+  Result first = c.run(update.c_str(), Params().add(session).add(static_cast<std::int64_t>(count)),
+                       "counting the items of session " + std::to_string(session));
+  if (first.rows() != 1)
+    throw c.error("there is no session " + std::to_string(session) + " that this login records");
+  return first.integer(0, 0);
+}
+
+// The password as the SCRAM-SHA-256 verifier the server keeps: the password itself is never sent.
+std::string scram_verifier(Connection& c, std::string_view login, std::string_view password) {
+  char* verifier = PQencryptPasswordConn(c.raw(), std::string(password).c_str(),
+                                         std::string(login).c_str(), "scram-sha-256");
+  if (verifier == nullptr)
+    throw c.error("hashing the password failed: " + trimmed(PQerrorMessage(c.raw())));
+  std::string scram(verifier);
+  PQfreemem(verifier);
+  return scram;
 }
 
 }  // namespace
@@ -723,12 +749,7 @@ void PostgresSessionStore::add_server_login(const ServerSettings& administrator,
   if (name.empty()) throw std::invalid_argument("a server login needs a name");
   check_new_password(password);
   Connection c(administrator, administrator_password);
-  char* verifier = PQencryptPasswordConn(c.raw(), std::string(password).c_str(),
-                                         std::string(name).c_str(), "scram-sha-256");
-  if (verifier == nullptr)
-    throw c.error("hashing the password failed: " + trimmed(PQerrorMessage(c.raw())));
-  const std::string scram(verifier);
-  PQfreemem(verifier);
+  const std::string scram = scram_verifier(c, name, password);
   if (kind == ServerLoginKind::instructor) {
     c.run("SELECT liversim_add_instructor($1, $2)", Params().add(name).add(std::string_view(scram)),
           "adding the instructor login");
@@ -765,10 +786,11 @@ bool PostgresSessionStore::has_session(std::string_view uuid) {
 
 bool PostgresSessionStore::receive_session(const SessionTransfer& session) {
   Connection& c = *connection_;
-  c.roll_back();
+  if (c.in_transaction())
+    throw std::logic_error("receive_session: the store has a session being written uncommitted");
   c.begin_if_needed();
   try {
-    if (has_session(session.uuid)) {
+    if (has_session(session.summary.uuid)) {
       c.roll_back();
       return false;
     }
@@ -776,7 +798,7 @@ bool PostgresSessionStore::receive_session(const SessionTransfer& session) {
     const std::int64_t trainee = person(c, s.trainee, "trainee");
     const std::int64_t scenario_id = scenario(c, s.scenario_title, session.scenario_text);
     Params row;
-    row.add(std::string_view(session.uuid))
+    row.add(std::string_view(session.summary.uuid))
         .add(trainee)
         .add(scenario_id)
         .add(std::string_view(s.device))
@@ -855,11 +877,7 @@ std::vector<SharedGrade> PostgresSessionStore::grades_of_sessions(
       SharedGrade shared;
       shared.session_uuid = uuid;
       shared.grade_uuid = rows.text(r, 0);
-      shared.grade.instructor = rows.text(r, 1);
-      shared.grade.graded_unix_ms = rows.integer(r, 2);
-      if (!rows.is_null(r, 3)) shared.grade.score_percent = rows.real(r, 3);
-      shared.grade.grade = rows.text(r, 4);
-      shared.grade.comment = rows.text(r, 5);
+      shared.grade = stored_rows::session_grade(rows.row(r), 1);
       result.push_back(std::move(shared));
     }
   }
@@ -867,8 +885,16 @@ std::vector<SharedGrade> PostgresSessionStore::grades_of_sessions(
 }
 
 void PostgresSessionStore::publish_scenario(const Instructor& by, std::string_view name,
-                                            std::string_view title, std::string_view text) {
+                                            std::string_view text) {
   Connection& c = connection_of(by);
+  // Workstations run what they pull: only a scenario that reads and validates goes out.
+  const ScenarioReading reading = read_scenario(text);
+  if (!reading.scenario) {
+    std::string errors;
+    for (const ScenarioError& e : reading.errors) errors += (errors.empty() ? "" : "; ") + e.text();
+    throw std::invalid_argument("the scenario \"" + std::string(name) +
+                                "\" was not published: " + errors);
+  }
   const std::string hash = sha256_hex(text);
   c.run(
       "INSERT INTO published_scenarios (name, title, content, sha256, published_unix_ms) "
@@ -876,7 +902,12 @@ void PostgresSessionStore::publish_scenario(const Instructor& by, std::string_vi
       "content = EXCLUDED.content, sha256 = EXCLUDED.sha256, "
       "version = published_scenarios.version + 1, published_by = session_user, "
       "published_unix_ms = EXCLUDED.published_unix_ms",
-      Params().add(name).add(title).add(text).add(std::string_view(hash)).add(now_unix_ms()),
+      Params()
+          .add(name)
+          .add(std::string_view(reading.scenario->title))
+          .add(text)
+          .add(std::string_view(hash))
+          .add(stored_rows::unix_ms_now()),
       "publishing the scenario \"" + std::string(name) + "\"");
 }
 
@@ -920,24 +951,19 @@ void PostgresSessionStore::append_frames(std::int64_t session, std::span<const S
   if (frames.empty()) return;
   Connection& c = *connection_;
   c.begin_if_needed();
-  Result first = c.run("SELECT frame_count FROM sessions WHERE id = $1", Params().add(session),
-                       "looking up session " + std::to_string(session));
-  if (first.rows() != 1) throw c.error("there is no session " + std::to_string(session));
   const std::vector<std::uint8_t> bytes = encode_frame_chunk(frames);
   c.run(
       "INSERT INTO frame_chunks (session_id, first_frame, frame_count, first_time_s, "
       "last_time_s, layout, data) VALUES ($1, $2, $3, $4, $5, $6, $7)",
       Params()
           .add(session)
-          .add(first.integer(0, 0))
+          .add(claim_items(c, session, "frame_count", frames.size()))
           .add(static_cast<std::int64_t>(frames.size()))
           .add(frames.front().time_s)
           .add(frames.back().time_s)
           .add(std::int64_t{kFrameChunkLayout})
           .add(std::span<const std::uint8_t>(bytes)),
       "storing frames");
-  c.run("UPDATE sessions SET frame_count = frame_count + $2 WHERE id = $1",
-        Params().add(session).add(static_cast<std::int64_t>(frames.size())), "counting frames");
 }
 
 void PostgresSessionStore::append_events(std::int64_t session,
@@ -952,23 +978,17 @@ void PostgresSessionStore::append_inputs(std::int64_t session,
   if (inputs.empty()) return;
   Connection& c = *connection_;
   c.begin_if_needed();
-  Result first = c.run("SELECT input_count FROM sessions WHERE id = $1", Params().add(session),
-                       "looking up session " + std::to_string(session));
-  if (first.rows() != 1) throw c.error("there is no session " + std::to_string(session));
   const std::vector<std::uint8_t> bytes = encode_input_chunk(inputs);
   c.run(
       "INSERT INTO input_chunks (session_id, first_input, input_count, layout, data) "
       "VALUES ($1, $2, $3, $4, $5)",
       Params()
           .add(session)
-          .add(first.integer(0, 0))
+          .add(claim_items(c, session, "input_count", inputs.size()))
           .add(static_cast<std::int64_t>(inputs.size()))
           .add(std::int64_t{kInputChunkLayout})
           .add(std::span<const std::uint8_t>(bytes)),
       "storing the simulation's input");
-  c.run("UPDATE sessions SET input_count = input_count + $2 WHERE id = $1",
-        Params().add(session).add(static_cast<std::int64_t>(inputs.size())),
-        "counting the simulation's input");
 }
 
 void PostgresSessionStore::commit() {
@@ -1037,12 +1057,7 @@ Instructor PostgresSessionStore::add_instructor_account(std::string_view name,
         "on the training centre's server, instructor accounts are added by an instructor who "
         "has logged in, or by its administrator (liversim-cli server add-login)");
   Connection& c = connection_of(*added_by);
-  char* verifier = PQencryptPasswordConn(c.raw(), std::string(password).c_str(),
-                                         std::string(name).c_str(), "scram-sha-256");
-  if (verifier == nullptr)
-    throw c.error("hashing the password failed: " + trimmed(PQerrorMessage(c.raw())));
-  const std::string scram(verifier);
-  PQfreemem(verifier);
+  const std::string scram = scram_verifier(c, name, password);
   const std::int64_t id = c.run("SELECT liversim_add_instructor($1, $2)",
                                 Params().add(name).add(std::string_view(scram)),
                                 "adding the instructor account \"" + std::string(name) + "\"")
@@ -1102,15 +1117,7 @@ std::vector<SessionGrade> PostgresSessionStore::grades(std::int64_t session) {
       "JOIN people p ON p.id = g.instructor_id WHERE g.session_id = $1 ORDER BY g.id",
       Params().add(session), "reading grades");
   std::vector<SessionGrade> result;
-  for (int r = 0; r < rows.rows(); ++r) {
-    SessionGrade g;
-    g.instructor = rows.text(r, 0);
-    g.graded_unix_ms = rows.integer(r, 1);
-    if (!rows.is_null(r, 2)) g.score_percent = rows.real(r, 2);
-    g.grade = rows.text(r, 3);
-    g.comment = rows.text(r, 4);
-    result.push_back(std::move(g));
-  }
+  for (int r = 0; r < rows.rows(); ++r) result.push_back(stored_rows::session_grade(rows.row(r)));
   return result;
 }
 
@@ -1124,60 +1131,11 @@ std::vector<SessionSummary> PostgresSessionStore::sessions_of_trainee(std::strin
 
 std::vector<SessionSummary> PostgresSessionStore::list_sessions(
     std::optional<std::string_view> trainee) {
-  const std::string sql =
-      std::string(
-          "SELECT s.id, p.name, c.title, c.sha256, s.device, s.started_unix_ms, "
-          "s.ended_unix_ms, s.status, s.frame_count, ") +
-      kServoColumns + ", " + kMappingColumns +
-      ", s.uuid::text FROM sessions s JOIN people p ON p.id = s.trainee_id JOIN scenarios c ON "
-      "c.id = "
-      "s.scenario_id WHERE $1::text IS NULL OR p.name = $1 ORDER BY s.id";
-  Result rows = connection_->run(sql.c_str(), Params().add(trainee), "listing sessions");
+  static const std::string query =
+      stored_rows::kSessionSummarySelect + "WHERE $1::text IS NULL OR p.name = $1 ORDER BY s.id";
+  Result rows = connection_->run(query.c_str(), Params().add(trainee), "listing sessions");
   std::vector<SessionSummary> result;
-  for (int r = 0; r < rows.rows(); ++r) {
-    SessionSummary s;
-    s.id = rows.integer(r, 0);
-    s.trainee = rows.text(r, 1);
-    s.scenario_title = rows.text(r, 2);
-    s.scenario_sha256 = rows.text(r, 3);
-    s.device = rows.text(r, 4);
-    s.started_unix_ms = rows.integer(r, 5);
-    if (!rows.is_null(r, 6)) s.ended_unix_ms = rows.integer(r, 6);
-    const std::string status = rows.text(r, 7);
-    s.status = status == "complete"    ? SessionStatus::complete
-               : status == "recording" ? SessionStatus::recording
-                                       : SessionStatus::incomplete;
-    s.frame_count = rows.integer(r, 8);
-    if (!rows.is_null(r, 9)) {
-      const auto count = [&](int column) {
-        return static_cast<std::uint64_t>(rows.integer(r, column));
-      };
-      SessionServoFigures f;
-      f.ticks = count(9);
-      f.rate_hz = rows.real(r, 10);
-      f.period_p50_ms = rows.real(r, 11);
-      f.period_p99_ms = rows.real(r, 12);
-      f.period_max_ms = rows.real(r, 13);
-      f.missed_deadlines = count(14);
-      f.force_clamps = count(15);
-      f.stiffness_clamps = count(16);
-      f.rate_limited = count(17);
-      f.watchdog_trips = count(18);
-      f.device_faults = count(19);
-      f.dropped_frames = count(20);
-      s.servo = f;
-    }
-    if (!rows.is_null(r, 21)) {
-      WorkspaceMapping m;
-      m.scale = rows.real(r, 21);
-      m.rotation = Eigen::Quaterniond(rows.real(r, 22), rows.real(r, 23), rows.real(r, 24),
-                                      rows.real(r, 25));
-      m.offset_m = Eigen::Vector3d(rows.real(r, 26), rows.real(r, 27), rows.real(r, 28));
-      s.mapping = m;
-    }
-    s.uuid = rows.text(r, 29);
-    result.push_back(std::move(s));
-  }
+  for (int r = 0; r < rows.rows(); ++r) result.push_back(stored_rows::session_summary(rows.row(r)));
   return result;
 }
 
@@ -1201,16 +1159,8 @@ std::vector<Item> joined_chunks(Connection& c, const char* sql, std::int64_t ses
     if (rows.rows() == 0) break;
     for (int r = 0; r < rows.rows(); ++r) {
       try {
-        if (rows.integer(r, 0) != static_cast<std::int64_t>(result.size()))
-          throw StorageError(items + " " + std::to_string(result.size()) + " to " +
-                             std::to_string(rows.integer(r, 0)) + " are missing");
-        if (rows.integer(r, 1) != layout)
-          throw StorageError("a chunk of " + items + " has layout " +
-                                 std::to_string(rows.integer(r, 1)) +
-                                 ", which this version cannot read",
-                             StorageProblem::newer_version);
-        std::vector<Item> part = decode(rows.bytes(r, 2));
-        std::move(part.begin(), part.end(), std::back_inserter(result));
+        stored_rows::append_chunk(result, rows.integer(r, 0), rows.integer(r, 1), layout,
+                                  rows.bytes(r, 2), items, decode);
       } catch (const StorageError& e) {
         throw c.error("session " + std::to_string(session) + ": " + e.what(),
                       e.problem() == StorageProblem::other ? StorageProblem::damaged : e.problem());

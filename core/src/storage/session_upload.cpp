@@ -1,21 +1,12 @@
 #include "liversim/storage/session_upload.h"
 
-#include <chrono>
+#include "stored_rows.h"
+
 #include <fstream>
 #include <sstream>
 #include <system_error>
 
 namespace liversim {
-
-namespace {
-
-std::int64_t now_unix_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
 
 SyncReport synchronise(SqliteSessionStore& local, PostgresSessionStore& central) {
   SyncReport report;
@@ -41,13 +32,13 @@ SyncReport synchronise(SqliteSessionStore& local, PostgresSessionStore& central)
         ++report.already_there;
       }
     } catch (const std::exception& e) {  // StorageError, AccessDenied: the server's side
-      report.problem = "session " + std::to_string(session) + " (" + transfer.uuid +
+      report.problem = "session " + std::to_string(session) + " (" + transfer.summary.uuid +
                        ") was not uploaded: " + e.what();
       report.waiting = static_cast<int>(pending.size() - k);
       local.note_upload_problem(session, server, e.what());
       return report;
     }
-    local.mark_uploaded(session, server, now_unix_ms());
+    local.mark_uploaded(session, server, stored_rows::unix_ms_now());
   }
   try {
     const std::vector<std::string> uuids = local.uploaded_session_uuids(server);

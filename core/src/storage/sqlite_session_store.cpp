@@ -3,15 +3,14 @@
 #include "liversim/core/integrator.h"
 #include "liversim/core/sha256.h"
 #include "liversim/storage/session_transfer.h"
+#include "stored_rows.h"
 
 #include <sqlite3.h>
 #include <sys/stat.h>
 
 #include <array>
 #include <cerrno>
-#include <chrono>
 #include <cstring>
-#include <iterator>
 
 namespace liversim {
 
@@ -773,9 +772,7 @@ Instructor SqliteSessionStore::add_instructor_account(std::string_view name,
            "VALUES (?1, ?2, ?3)")
       .bind(1, id)
       .bind(2, std::string_view(hash))
-      .bind(3, static_cast<std::int64_t>(std::chrono::duration_cast<std::chrono::milliseconds>(
-                                             std::chrono::system_clock::now().time_since_epoch())
-                                             .count()))
+      .bind(3, stored_rows::unix_ms_now())
       .run("adding the instructor account");
   commit();
   return vouch_for(id, std::string(name));
@@ -819,15 +816,7 @@ std::vector<SessionGrade> SqliteSessionStore::grades(std::int64_t session) {
                "JOIN people p ON p.id = g.instructor_id WHERE g.session_id = ?1 ORDER BY g.id");
   rows.bind(1, session);
   std::vector<SessionGrade> result;
-  while (rows.step("reading grades")) {
-    SessionGrade g;
-    g.instructor = rows.text(0);
-    g.graded_unix_ms = rows.integer(1);
-    if (!rows.is_null(2)) g.score_percent = rows.real(2);
-    g.grade = rows.text(3);
-    g.comment = rows.text(4);
-    result.push_back(std::move(g));
-  }
+  while (rows.step("reading grades")) result.push_back(stored_rows::session_grade(rows));
   rows.reset();
   return result;
 }
@@ -842,59 +831,12 @@ std::vector<SessionSummary> SqliteSessionStore::sessions_of_trainee(std::string_
 
 std::vector<SessionSummary> SqliteSessionStore::list_sessions(
     std::optional<std::string_view> trainee) {
-  Statement& rows = prepared(
-      kSessions,
-      "SELECT s.id, p.name, c.title, c.sha256, s.device, s.started_unix_ms, s.ended_unix_ms, "
-      "s.status, s.frame_count, s.servo_ticks, s.servo_rate_hz, s.servo_period_p50_ms, "
-      "s.servo_period_p99_ms, s.servo_period_max_ms, s.missed_deadlines, s.force_clamps, "
-      "s.stiffness_clamps, s.rate_limited, s.watchdog_trips, s.device_faults, s.dropped_frames, "
-      "s.mapping_scale, s.mapping_rotation_w, s.mapping_rotation_x, s.mapping_rotation_y, "
-      "s.mapping_rotation_z, s.mapping_offset_x_m, s.mapping_offset_y_m, s.mapping_offset_z_m, "
-      "s.uuid FROM sessions s JOIN people p ON p.id = s.trainee_id "
-      "JOIN scenarios c ON c.id = s.scenario_id WHERE ?1 IS NULL OR p.name = ?1 ORDER BY s.id");
+  static const std::string query =
+      stored_rows::kSessionSummarySelect + "WHERE ?1 IS NULL OR p.name = ?1 ORDER BY s.id";
+  Statement& rows = prepared(kSessions, query.c_str());
   if (trainee) rows.bind(1, *trainee);  // unbound: NULL, every trainee's
   std::vector<SessionSummary> result;
-  while (rows.step("listing sessions")) {
-    SessionSummary s;
-    s.id = rows.integer(0);
-    s.trainee = rows.text(1);
-    s.scenario_title = rows.text(2);
-    s.scenario_sha256 = rows.text(3);
-    s.device = rows.text(4);
-    s.started_unix_ms = rows.integer(5);
-    if (!rows.is_null(6)) s.ended_unix_ms = rows.integer(6);
-    const std::string status = rows.text(7);
-    s.status = status == "complete"    ? SessionStatus::complete
-               : status == "recording" ? SessionStatus::recording
-                                       : SessionStatus::incomplete;
-    s.frame_count = rows.integer(8);
-    if (!rows.is_null(9)) {
-      auto count = [&](int column) { return static_cast<std::uint64_t>(rows.integer(column)); };
-      SessionServoFigures f;
-      f.ticks = count(9);
-      f.rate_hz = rows.real(10);
-      f.period_p50_ms = rows.real(11);
-      f.period_p99_ms = rows.real(12);
-      f.period_max_ms = rows.real(13);
-      f.missed_deadlines = count(14);
-      f.force_clamps = count(15);
-      f.stiffness_clamps = count(16);
-      f.rate_limited = count(17);
-      f.watchdog_trips = count(18);
-      f.device_faults = count(19);
-      f.dropped_frames = count(20);
-      s.servo = f;
-    }
-    if (!rows.is_null(21)) {
-      WorkspaceMapping m;
-      m.scale = rows.real(21);
-      m.rotation = Eigen::Quaterniond(rows.real(22), rows.real(23), rows.real(24), rows.real(25));
-      m.offset_m = Eigen::Vector3d(rows.real(26), rows.real(27), rows.real(28));
-      s.mapping = m;
-    }
-    s.uuid = rows.text(29);
-    result.push_back(std::move(s));
-  }
+  while (rows.step("listing sessions")) result.push_back(stored_rows::session_summary(rows));
   rows.reset();
   return result;
 }
@@ -915,16 +857,8 @@ std::vector<Item> SqliteSessionStore::chunks_of(std::int64_t session, Statement&
   report();
   try {
     while (chunks.step(("reading " + items).c_str())) {
-      if (chunks.integer(0) != static_cast<std::int64_t>(result.size()))
-        throw StorageError(items + " " + std::to_string(result.size()) + " to " +
-                           std::to_string(chunks.integer(0)) + " are missing");
-      if (chunks.integer(1) != layout)
-        throw StorageError("a chunk of " + items + " has layout " +
-                               std::to_string(chunks.integer(1)) +
-                               ", which this version cannot read",
-                           StorageProblem::newer_version);
-      std::vector<Item> part = decode(chunks.blob(2));
-      std::move(part.begin(), part.end(), std::back_inserter(result));
+      stored_rows::append_chunk(result, chunks.integer(0), chunks.integer(1), layout,
+                                chunks.blob(2), items, decode);
       report();
     }
   } catch (const StorageError& e) {
@@ -1001,15 +935,15 @@ std::vector<std::int64_t> SqliteSessionStore::sessions_to_upload(std::string_vie
 SessionTransfer SqliteSessionStore::transfer_of(std::int64_t session) {
   SessionTransfer transfer;
   {
-    Statement row(*this, "SELECT uuid, input_count FROM sessions WHERE id = ?1");
+    Statement row(*this, (stored_rows::kSessionSummarySelect + "WHERE s.id = ?1").c_str());
     row.bind(1, session);
     if (!row.step("reading the session"))
       throw error("there is no session " + std::to_string(session));
-    transfer.uuid = row.text(0);
-    transfer.input_count = row.integer(1);
+    transfer.summary = stored_rows::session_summary(row);
   }
-  for (SessionSummary& summary : list_sessions(std::nullopt))
-    if (summary.id == session) transfer.summary = std::move(summary);
+  transfer.input_count = Statement(*this, "SELECT input_count FROM sessions WHERE id = ?1")
+                             .bind(1, session)
+                             .single_integer("counting the session's inputs");
   transfer.scenario_text = scenario_text(session);
   transfer.replay = replay_setup(session);
   transfer.events = events(session);

@@ -71,9 +71,10 @@ class PostgresSessionStore final : public SessionStore {
   // The grades of these sessions (by UUID), oldest first.
   std::vector<SharedGrade> grades_of_sessions(std::span<const std::string> session_uuids);
 
-  // Scenarios: an instructor publishes (a new version of) one; anyone reads them.
-  void publish_scenario(const Instructor& by, std::string_view name, std::string_view title,
-                        std::string_view text);
+  // Scenarios: an instructor publishes (a new version of) one under a name (letters, digits, '.',
+  // '_', '-': the file it is pulled to); its title is the scenario's. A text that is not a valid
+  // scenario is refused (std::invalid_argument, naming its errors); anyone reads them.
+  void publish_scenario(const Instructor& by, std::string_view name, std::string_view text);
   std::vector<PublishedScenario> published_scenarios();
 
   // SessionStore. Writing sessions directly is what an upload does, in steps; a workstation's

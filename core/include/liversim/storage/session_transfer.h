@@ -29,8 +29,7 @@ using ChunkSink = std::function<void(const StoredChunk&)>;
 using ChunkSource = std::function<void(const ChunkSink&)>;
 
 struct SessionTransfer {
-  std::string uuid;
-  SessionSummary summary;  // its id is the sender's and is not kept
+  SessionSummary summary;  // keyed by its uuid; its id is the sender's and is not kept
   std::string scenario_text;
   std::int64_t input_count = 0;
   std::optional<ReplaySetup> replay;
