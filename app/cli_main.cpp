@@ -5,6 +5,7 @@
 #include "experiment_commands.h"
 #include "record_command.h"
 #include "render_bench_command.h"
+#include "server_command.h"
 #include "servo_bench_command.h"
 #include "sessions_command.h"
 #include "study_command.h"
@@ -168,6 +169,7 @@ int main(int argc, char** argv) {
   const auto run_render_bench = add_render_bench_command(app);
   const auto run_sessions = add_sessions_command(app);
   const auto run_record = add_record_command(app);
+  const auto run_server = add_server_command(app);
 
   try {
     app.parse(argc, argv);
@@ -184,6 +186,7 @@ int main(int argc, char** argv) {
   if (auto exit_code = run_render_bench()) return *exit_code;
   if (auto exit_code = run_sessions()) return *exit_code;
   if (auto exit_code = run_record()) return *exit_code;
+  if (auto exit_code = run_server()) return *exit_code;
   if (report->parsed()) return mesh_report(report_options);
   if (simulate_cmd->parsed()) return simulate(sim);
   if (validate_cmd->parsed()) return validate_scenarios(scenario_files);

@@ -3,6 +3,7 @@
 #include "liversim/core/scenario.h"
 #include "liversim/core/session_export.h"
 #include "liversim/storage/sqlite_session_store.h"
+#include "server_command.h"
 
 #include <CLI/CLI.hpp>
 
@@ -18,11 +19,13 @@ namespace {
 
 struct SessionsOptions {
   std::filesystem::path database;
+  std::string server_url;  // instead of a database: the training centre's server
+  bool pgpass = false;
   std::int64_t session = 0;
   std::filesystem::path frames_csv, events_csv, metrics_csv;
 };
 
-void print_list(SqliteSessionStore& store) {
+void print_list(SessionStore& store) {
   const std::vector<SessionSummary> sessions = store.sessions();
   std::cout << "id,trainee,scenario,scenario_sha256,device,started_unix_ms,ended_unix_ms,status,"
                "frames,servo_rate_hz,servo_period_p99_ms,missed_deadlines,dropped_frames\n";
@@ -40,11 +43,12 @@ void print_list(SqliteSessionStore& store) {
   }
 }
 
-int export_session(SqliteSessionStore& store, const SessionsOptions& o) {
+int export_session(SessionStore& store, const SessionsOptions& o) {
   bool found = false;
   for (const SessionSummary& s : store.sessions()) found |= s.id == o.session;
   if (!found) {
-    std::cerr << "error: " << o.database.string() << " has no session " << o.session << '\n';
+    std::cerr << "error: " << (o.server_url.empty() ? o.database.string() : o.server_url)
+              << " has no session " << o.session << '\n';
     return 1;
   }
   auto write = [&](const std::filesystem::path& file, auto&& what) {
@@ -87,16 +91,27 @@ std::function<std::optional<int>()> add_sessions_command(CLI::App& app) {
   auto* sessions =
       app.add_subcommand("sessions", "List the sessions of a sessions database, or export one");
   sessions->require_subcommand(1);
+  // The sessions of a workstation's database file, or of the training centre's server.
+  const auto store_options = [&](CLI::App* sub) {
+    auto* database = sub->add_option("--database", options->database, "Sessions database (.sqlite)")
+                         ->check(CLI::ExistingFile);
+    auto* server =
+        sub->add_option("--server", options->server_url,
+                        "The training centre's server instead: postgresql://USER@HOST/DB");
+    sub->add_flag("--pgpass", options->pgpass,
+                  "With --server, ask no password: libpq's ~/.pgpass or a client certificate");
+    database->excludes(server);
+    sub->callback([options, sub] {
+      if (options->database.empty() == options->server_url.empty())
+        throw CLI::ValidationError(sub->get_name(), "give one of --database and --server");
+    });
+  };
   auto* list = sessions->add_subcommand("list", "Print every session as a CSV line");
-  list->add_option("--database", options->database, "Sessions database (.sqlite)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  store_options(list);
   auto* exported = sessions->add_subcommand(
       "export",
       "Write a session's frames (and events, metrics) as CSV, every number at full precision");
-  exported->add_option("--database", options->database, "Sessions database (.sqlite)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  store_options(exported);
   exported->add_option("--session", options->session, "Session id (from `sessions list`)")
       ->required();
   exported->add_option("--frames", options->frames_csv, "Output CSV of the frames")->required();
@@ -106,13 +121,18 @@ std::function<std::optional<int>()> add_sessions_command(CLI::App& app) {
   return [=]() -> std::optional<int> {
     if (!sessions->parsed()) return std::nullopt;
     try {
-      SqliteSessionStore store(options->database, SqliteSessionStore::Access::read_only);
+      std::unique_ptr<SessionStore> store;
+      if (options->server_url.empty())
+        store = std::make_unique<SqliteSessionStore>(options->database,
+                                                     SqliteSessionStore::Access::read_only);
+      else
+        store = connect_to_server(options->server_url, options->pgpass);
       if (list->parsed()) {
-        print_list(store);
+        print_list(*store);
         return 0;
       }
-      return export_session(store, *options);
-    } catch (const StorageError& e) {
+      return export_session(*store, *options);
+    } catch (const std::exception& e) {  // StorageError, or a malformed server URL
       std::cerr << "error: " << e.what() << '\n';
       return 1;
     }
