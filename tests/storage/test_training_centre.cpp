@@ -5,6 +5,7 @@
 #include "liversim/storage/postgres_session_store.h"
 #include "liversim/storage/session_upload.h"
 #include "liversim/storage/sqlite_session_store.h"
+#include "liversim/storage/training_centre_sync.h"
 #include "recorded_session.h"
 #include "storage_test_support.h"
 #include "throwaway_postgres.h"
@@ -461,6 +462,86 @@ TEST_F(TrainingCentre, PublishedScenariosArePulledByTheWorkstations) {
   EXPECT_EQ(central.published_scenarios().at(0).published_by, "Dr. Grey");
   EXPECT_EQ(pull_scenarios(central, folder), std::vector<std::string>{"hidden-lesion"});
   EXPECT_EQ(read(folder / "hidden-lesion.json"), changed);
+}
+
+// A run that starts after now, and its outcome (a run under way now may predate the caller's
+// last change).
+TrainingCentreStatus run_and_wait(TrainingCentreSync& sync) {
+  const TrainingCentreStatus now = sync.status();
+  sync.run_soon();
+  return sync.wait_for_runs(now.runs + (now.running ? 2 : 1), 120.0);
+}
+
+// The workstation's link runs in its own thread on its own connection to the file: the recorder
+// commits chunk after chunk while it uploads, a server gone makes a run fail with the server
+// named and the sessions waiting, and the next run once it is back uploads them.
+TEST_F(TrainingCentre, TheWorkstationsLinkUploadsInTheBackgroundAndTheRecorderNeverWaitsOnIt) {
+  PostgresSessionStore office(server_->as("Dr. Grey"), kInstructorPassword);
+  const std::optional<Instructor> grey = office.log_in_instructor("Dr. Grey", kInstructorPassword);
+  ASSERT_TRUE(grey);
+  std::ifstream scenario_file(fs::path(LIVERSIM_TEST_DATA_DIR) / "scenario-small-resection.json");
+  std::ostringstream scenario_text;
+  scenario_text << scenario_file.rdbuf();
+  office.publish_scenario(*grey, "small-resection", scenario_text.str());
+
+  const fs::path database = fresh_database("background-link");
+  SqliteSessionStore recorder(database);  // the workstation's own connection
+  record_session(recorder, "Trainee A", 5000, 21);
+  TrainingCentreLink link;
+  link.server = workstation();
+  link.password = kWorkstationPassword;
+  link.sessions_database = database;
+  link.scenario_folder = fs::path(LIVERSIM_TEST_OUTPUT_DIR) / "training-centre" / "link-pulled";
+  fs::remove_all(link.scenario_folder);
+  link.period_s = 3600.0;  // runs only when asked (and once at the start)
+  TrainingCentreSync sync(link);
+
+  // A session recorded while the link uploads: every commit goes through.
+  const std::vector<ServoFrame> frames = testing::synthetic_frames(20'000, 22);
+  const std::int64_t second = recorder.begin_session(
+      {"Trainee B", "Wedge resection", "{}", "Scripted", 1'795'000'000'000, std::nullopt, {}});
+  for (std::size_t first = 0; first < frames.size(); first += 50) {
+    recorder.append_frames(second, std::span(frames).subspan(first, 50));
+    ASSERT_NO_THROW(recorder.commit()) << "frame " << first;
+    if (first % 2000 == 0) sync.run_soon();
+  }
+  // Just ended, its metrics not computed yet: it waits for them (an upload is never amended).
+  const std::int64_t now_unix_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                                       std::chrono::system_clock::now().time_since_epoch())
+                                       .count();
+  recorder.end_session(second, now_unix_ms, SessionServoFigures{});
+  TrainingCentreStatus status = run_and_wait(sync);
+  EXPECT_TRUE(status.last_run_ok) << status.problem.value_or("");
+  EXPECT_EQ(status.uploaded, 1);
+  const std::vector<MetricValue> metrics{{"path_length_m", 0.5}};
+  recorder.store_metrics(second, metrics);
+  status = run_and_wait(sync);
+  EXPECT_TRUE(status.last_run_ok) << status.problem.value_or("");
+  EXPECT_EQ(status.uploaded, 2);
+  EXPECT_EQ(status.waiting, 0);
+  EXPECT_EQ(status.scenarios_pulled, 1);
+  EXPECT_TRUE(fs::exists(link.scenario_folder / "small-resection.json"));
+  EXPECT_GT(status.last_ok_unix_ms, 0);
+  EXPECT_EQ(count_rows(*server_, "sessions"), 2);
+
+  // The server gone: a run fails naming it; the recorder goes on; the session waits.
+  server_->stop();
+  record_session(recorder, "Trainee C", 500, 23);
+  status = run_and_wait(sync);
+  EXPECT_FALSE(status.last_run_ok);
+  ASSERT_TRUE(status.problem);
+  EXPECT_NE(status.problem->find("server " + server_name(workstation()) + ": cannot connect"),
+            std::string::npos)
+      << *status.problem;
+  EXPECT_EQ(status.waiting, 1);
+  record_session(recorder, "Trainee D", 500, 24);  // recording needs no server
+
+  server_->start();
+  status = run_and_wait(sync);
+  EXPECT_TRUE(status.last_run_ok) << status.problem.value_or("");
+  EXPECT_EQ(status.uploaded, 4);
+  EXPECT_EQ(status.waiting, 0);
+  EXPECT_EQ(count_rows(*server_, "sessions"), 4);
 }
 
 // A server at schema version 1 with sessions in it: a workstation is told the administrator must

@@ -925,8 +925,11 @@ std::vector<std::int64_t> SqliteSessionStore::sessions_to_upload(std::string_vie
   Statement rows(*this,
                  "SELECT s.id FROM sessions s WHERE s.status <> 'recording' AND NOT EXISTS "
                  "(SELECT 1 FROM session_uploads u WHERE u.session_id = s.id AND u.server = ?1 "
-                 "AND u.uploaded_unix_ms IS NOT NULL) ORDER BY s.id");
+                 "AND u.uploaded_unix_ms IS NOT NULL) AND (s.status <> 'complete' OR EXISTS "
+                 "(SELECT 1 FROM metrics m WHERE m.session_id = s.id) OR s.ended_unix_ms < ?2) "
+                 "ORDER BY s.id");
   rows.bind(1, server);
+  rows.bind(2, stored_rows::unix_ms_now() - kMetricsWaitMs);
   std::vector<std::int64_t> result;
   while (rows.step("listing the sessions to upload")) result.push_back(rows.integer(0));
   return result;

@@ -70,7 +70,10 @@ class SqliteSessionStore final : public SessionStore {
 
   // The training centre (session_upload.h). `server` names the server (server_name()).
   // The sessions that ended (complete or incomplete) and are not yet on that server, oldest first.
+  // A complete session waits for its metrics (computed after its end, on a worker), or, should
+  // they never come, until kMetricsWaitMs after its end: an upload is never amended.
   std::vector<std::int64_t> sessions_to_upload(std::string_view server);
+  static constexpr std::int64_t kMetricsWaitMs = 120'000;
   // The session as it is uploaded; its chunk sources read this store while they are called.
   SessionTransfer transfer_of(std::int64_t session);
   // The server has the session / an upload of it failed (the attempt counted, the problem kept).
