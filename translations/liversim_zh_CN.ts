@@ -68,6 +68,10 @@
         <source>Start LiverSim again to make a new sessions database there, or restore the file from a backup. Until then, sessions are not recorded.</source>
         <translation>请重新启动 LiverSim 以在该位置新建会话数据库，或从备份恢复该文件。在此之前，会话不会被录制。</translation>
     </message>
+    <message>
+        <source>Check the login name and password in the training centre settings, or ask the server&apos;s administrator for the permission. Sessions keep being recorded on this workstation.</source>
+        <translation>请检查培训中心设置中的登录名和密码，或请服务器管理员授予权限。本工作站会继续记录训练。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::AccuracyPanel</name>
@@ -1174,6 +1178,58 @@ The scene that was running goes on.</source>
     <message>
         <source>Recording stopped: this session is no longer being saved (what was saved before is kept). %1</source>
         <translation>录制已停止：此会话不再保存（之前已保存的内容会保留）。%1</translation>
+    </message>
+    <message>
+        <source>Review Sessions on the Ser&amp;ver…</source>
+        <translation>在服务器上评阅训练(&amp;V)…</translation>
+    </message>
+    <message>
+        <source>Log in to the training centre&apos;s server</source>
+        <translation>登录培训中心服务器</translation>
+    </message>
+    <message>
+        <source>Instructors: review and grade the sessions of every workstation on the training centre&apos;s server</source>
+        <translation>教员：在培训中心服务器上评阅并评分所有工作站的训练</translation>
+    </message>
+    <message>
+        <source>&amp;Training Centre Server…</source>
+        <translation>培训中心服务器(&amp;T)…</translation>
+    </message>
+    <message>
+        <source>Upload finished sessions to the training centre&apos;s server and pull its scenarios</source>
+        <translation>将已结束的训练上传到培训中心服务器，并获取其发布的情景</translation>
+    </message>
+    <message>
+        <source>There is no sessions database to upload from.</source>
+        <translation>没有可供上传的训练数据库。</translation>
+    </message>
+    <message>
+        <source>Training centre: not connected (Settings ▸ Training Centre Server…)</source>
+        <translation>培训中心：未连接（设置 ▸ 培训中心服务器…）</translation>
+    </message>
+    <message>
+        <source>Training centre: connecting to %1…</source>
+        <translation>培训中心：正在连接 %1…</translation>
+    </message>
+    <message numerus="yes">
+        <source>Training centre: %1 not reached, %n session(s) waiting</source>
+        <translation>
+            <numerusform>培训中心：无法连接 %1，%n 次训练等待上传</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>Training centre: up to date at %1, %n session(s) uploaded</source>
+        <translation>
+            <numerusform>培训中心：%1 时已同步，已上传 %n 次训练</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>No training centre server is set (Settings ▸ Training Centre Server…).</source>
+        <translation>尚未设置培训中心服务器（设置 ▸ 培训中心服务器…）。</translation>
+    </message>
+    <message>
+        <source>%1 is not an instructor on the server.</source>
+        <translation>%1 不是服务器上的教员。</translation>
     </message>
 </context>
 <context>
@@ -2539,6 +2595,33 @@ Simulated: %2.
     <message>
         <source>Force on the tool: %1 N</source>
         <translation>器械受力：%1 N</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::TrainingCentreDialog</name>
+    <message>
+        <source>Training Centre Server</source>
+        <translation>培训中心服务器</translation>
+    </message>
+    <message>
+        <source>Finished sessions are uploaded to the training centre&apos;s server, and its published scenarios pulled, in the background. Recording never waits for the server. The password is not saved.</source>
+        <translation>已结束的训练在后台上传到培训中心服务器，其发布的情景也在后台获取。记录从不等待服务器。密码不会被保存。</translation>
+    </message>
+    <message>
+        <source>The password is in ~/.pgpass, or a client certificate is used (connect at every start)</source>
+        <translation>密码在 ~/.pgpass 中，或使用客户端证书（每次启动时连接）</translation>
+    </message>
+    <message>
+        <source>Server:</source>
+        <translation>服务器：</translation>
+    </message>
+    <message>
+        <source>Password:</source>
+        <translation>密码：</translation>
+    </message>
+    <message>
+        <source>Connect</source>
+        <translation>连接</translation>
     </message>
 </context>
 <context>

@@ -11,6 +11,26 @@
 
 namespace liversim {
 
+QLabel* newFormErrorLabel(const QString& objectName, QWidget* parent) {
+  auto* label = new QLabel(parent);
+  label->setObjectName(objectName);
+  label->setWordWrap(true);
+  label->setStyleSheet("color: #b00020;");
+  label->hide();
+  return label;
+}
+
+void layOutForm(QDialog& dialog, QLabel* intro, QFormLayout* form, QLabel* error,
+                QDialogButtonBox* buttons, const std::function<void()>& request) {
+  QObject::connect(buttons, &QDialogButtonBox::accepted, &dialog, request);
+  QObject::connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
+  auto* layout = new QVBoxLayout(&dialog);
+  layout->addWidget(intro);
+  layout->addLayout(form);
+  layout->addWidget(error);
+  layout->addWidget(buttons);
+}
+
 InstructorLoginDialog::InstructorLoginDialog(Purpose purpose, QWidget* parent)
     : QDialog(parent), purpose_(purpose) {
   setObjectName("instructorLoginDialog");
@@ -39,11 +59,7 @@ InstructorLoginDialog::InstructorLoginDialog(Purpose purpose, QWidget* parent)
   repeated_ = new QLineEdit(this);
   repeated_->setObjectName("instructorPasswordRepeated");
   repeated_->setEchoMode(QLineEdit::Password);
-  error_ = new QLabel(this);
-  error_->setObjectName("instructorLoginError");
-  error_->setWordWrap(true);
-  error_->setStyleSheet("color: #b00020;");
-  error_->hide();
+  error_ = newFormErrorLabel("instructorLoginError", this);
 
   auto* form = new QFormLayout;
   form->addRow(tr("Name:"), name_);
@@ -53,13 +69,7 @@ InstructorLoginDialog::InstructorLoginDialog(Purpose purpose, QWidget* parent)
   auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, this);
   ok_ = buttons->button(QDialogButtonBox::Ok);
   ok_->setText(creating ? tr("Create Account") : tr("Log In"));
-  connect(buttons, &QDialogButtonBox::accepted, this, &InstructorLoginDialog::request);
-  connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
-  auto* layout = new QVBoxLayout(this);
-  layout->addWidget(intro);
-  layout->addLayout(form);
-  layout->addWidget(error_);
-  layout->addWidget(buttons);
+  layOutForm(*this, intro, form, error_, buttons, [this] { request(); });
 }
 
 void InstructorLoginDialog::submit(const QString& name, const QString& password,

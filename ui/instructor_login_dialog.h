@@ -6,11 +6,22 @@
 
 #include <QDialog>
 
+#include <functional>
+
+class QDialogButtonBox;
+class QFormLayout;
 class QLabel;
 class QLineEdit;
 class QPushButton;
 
 namespace liversim {
+
+// The red line a form shows its refusal in (hidden until there is one).
+QLabel* newFormErrorLabel(const QString& objectName, QWidget* parent);
+// A form dialog's layout, top to bottom: what it is for, the fields, the refusal, the buttons.
+// The buttons' accepted() asks `request`; rejected() closes.
+void layOutForm(QDialog& dialog, QLabel* intro, QFormLayout* form, QLabel* error,
+                QDialogButtonBox* buttons, const std::function<void()>& request);
 
 class InstructorLoginDialog : public QDialog {
   Q_OBJECT

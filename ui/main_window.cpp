@@ -22,6 +22,7 @@
 #include "liversim/core/session_recording.h"
 #include "liversim/core/session_replay.h"
 #include "liversim/core/surface.h"
+#include "liversim/storage/postgres_session_store.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "session_reading.h"
 #include "session_review_window.h"
@@ -63,6 +64,16 @@
 
 namespace liversim {
 namespace {
+
+// A form's request answered: it closes when `attempt` succeeds, else shows why not.
+template <typename Form, typename Attempt>
+void answerForm(Form& form, Attempt attempt) {
+  QString why;
+  if (attempt(&why))
+    form.accept();
+  else
+    form.showError(why);
+}
 
 // A positive number with two or three significant digits and no exponent: 0.81, 2.6, 15, 480.
 QString formatAmount(double value) {
@@ -188,6 +199,16 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   cancelBuild_->hide();
   connect(cancelBuild_, &QPushButton::clicked, this, &MainWindow::cancelSceneBuild);
   statusBar()->addPermanentWidget(cancelBuild_);
+  trainingCentreLabel_ = new QLabel(this);
+  trainingCentreLabel_->setObjectName("trainingCentreStatus");
+  trainingCentreLabel_->hide();
+  statusBar()->addPermanentWidget(trainingCentreLabel_);
+  connect(&trainingCentreTimer_, &QTimer::timeout, this, &MainWindow::showTrainingCentreStatus);
+  trainingCentreTimer_.start(1000);
+  // A session's upload waits for its metrics: the link is asked to run once they are stored.
+  connect(this, &MainWindow::sessionMetricsStored, this, [this] {
+    if (trainingCentre_) trainingCentre_->run_soon();
+  });
   if (toolModels_.problem.empty())
     statusBar()->showMessage(
         tr("Drag the liver with the left mouse button; drag the background to "
@@ -615,6 +636,23 @@ void MainWindow::buildMenus() {
   review->setObjectName("reviewSessionsAction");
   review->setToolTip(tr("Instructors: review and grade every trainee's sessions"));
   reviewSessionsAction_ = review;
+  QAction* serverReview = session->addAction(tr("Review Sessions on the Ser&ver…"), this, [this] {
+    auto* login = new InstructorLoginDialog(InstructorLoginDialog::Purpose::log_in, this);
+    login->setObjectName("serverLogin");
+    login->setWindowTitle(tr("Log in to the training centre's server"));
+    login->setAttribute(Qt::WA_DeleteOnClose);
+    connect(login, &InstructorLoginDialog::requested, this,
+            [this, login](const QString& name, const QString& password) {
+              answerForm(*login, [&](QString* why) {
+                return openServerReview(name, password, why) != nullptr;
+              });
+            });
+    login->show();
+  });
+  serverReview->setObjectName("serverReviewAction");
+  serverReview->setToolTip(
+      tr("Instructors: review and grade the sessions of every workstation on the training "
+         "centre's server"));
   QAction* history =
       session->addAction(tr("My &Sessions…"), this, [this] { openTraineeHistory(); });
   history->setObjectName("traineeHistoryAction");
@@ -637,6 +675,11 @@ void MainWindow::buildMenus() {
   });
   addInstructorAction_->setObjectName("addInstructorAction");
   addInstructorAction_->setVisible(instructorMode_);
+  QAction* centre = settings->addAction(tr("&Training Centre Server…"), this,
+                                        [this] { openTrainingCentreSettings(); });
+  centre->setObjectName("trainingCentreAction");
+  centre->setToolTip(
+      tr("Upload finished sessions to the training centre's server and pull its scenarios"));
   settings->addSeparator();
   QMenu* language = settings->addMenu(tr("&Language"));
   language->setObjectName("languageMenu");
@@ -1238,10 +1281,134 @@ bool MainWindow::setSessionsDatabase(const QString& file) {
   } catch (const StorageError& e) {
     sessionsProblem_ = storageProblemText(tr("Sessions are not recorded: %1"), e);
     statusBar()->showMessage(sessionsProblem_);
+    trainingCentre_.reset();
     return false;
   }
   if (servo_) beginRecording();
+  startTrainingCentreAtLaunch();
   return true;
+}
+
+void MainWindow::startTrainingCentreAtLaunch() {
+  if (trainingCentre_) {  // the same server and log-in, from the new file
+    TrainingCentreLink link = trainingCentre_->link();
+    trainingCentre_.reset();
+    link.sessions_database = sessionsFile_.toStdString();
+    link.scenario_folder = pulledScenarioFolder().toStdString();
+    trainingCentre_ = std::make_unique<TrainingCentreSync>(std::move(link));
+  } else if (const TrainingCentreSetting setting = trainingCentreSetting();
+             !setting.serverUrl.isEmpty() && setting.passwordFromLibpq) {
+    connectTrainingCentre(setting, {});
+  }
+  showTrainingCentreStatus();
+}
+
+bool MainWindow::connectTrainingCentre(const TrainingCentreSetting& setting,
+                                       const QString& password, QString* why) {
+  const auto refuse = [&](const QString& reason) {
+    if (why) *why = reason;
+    return false;
+  };
+  if (setting.serverUrl.isEmpty()) {
+    trainingCentre_.reset();
+    setTrainingCentreSetting(setting);
+    showTrainingCentreStatus();
+    return true;
+  }
+  ServerSettings server;
+  try {
+    server = parse_server_url(setting.serverUrl.toStdString());
+  } catch (const std::invalid_argument& e) {
+    return refuse(QString::fromStdString(e.what()));
+  }
+  if (!sessions_) return refuse(tr("There is no sessions database to upload from."));
+  // A wrong log-in is said here, at once; a server out of reach is not: the link retries.
+  try {
+    PostgresSessionStore{server, password.toStdString()};
+  } catch (const StorageError& e) {
+    if (e.problem() == StorageProblem::refused || e.problem() == StorageProblem::not_a_database ||
+        e.problem() == StorageProblem::newer_version)
+      return refuse(QString::fromStdString(e.what()));
+  }
+  setTrainingCentreSetting(setting);
+  TrainingCentreLink link;
+  link.server = server;
+  link.password = password.toStdString();
+  link.sessions_database = sessionsFile_.toStdString();
+  link.scenario_folder = pulledScenarioFolder().toStdString();
+  trainingCentre_.reset();  // the old link's run ends first
+  trainingCentre_ = std::make_unique<TrainingCentreSync>(std::move(link));
+  showTrainingCentreStatus();
+  return true;
+}
+
+QString MainWindow::pulledScenarioFolder() const {
+  if (sessionsFile_.isEmpty()) return {};
+  return QFileInfo(sessionsFile_).absolutePath() + "/training-centre-scenarios";
+}
+
+QString MainWindow::trainingCentreStatusText() const {
+  if (!trainingCentre_)
+    return trainingCentreSetting().serverUrl.isEmpty()
+               ? QString()
+               : tr("Training centre: not connected (Settings ▸ Training Centre Server…)");
+  const TrainingCentreStatus status = trainingCentre_->status();
+  const QString server = QString::fromStdString(server_name(trainingCentre_->server()));
+  if (status.runs == 0) return tr("Training centre: connecting to %1…").arg(server);
+  if (!status.last_run_ok)
+    return tr("Training centre: %1 not reached, %n session(s) waiting", nullptr, status.waiting)
+        .arg(server);
+  return tr("Training centre: up to date at %1, %n session(s) uploaded", nullptr, status.uploaded)
+      .arg(QDateTime::fromMSecsSinceEpoch(status.last_ok_unix_ms).toString("HH:mm"));
+}
+
+void MainWindow::showTrainingCentreStatus() {
+  const QString text = trainingCentreStatusText();
+  trainingCentreLabel_->setText(text);
+  trainingCentreLabel_->setVisible(!text.isEmpty());
+  const std::optional<std::string> problem =
+      trainingCentre_ ? trainingCentre_->status().problem : std::nullopt;
+  trainingCentreLabel_->setToolTip(problem ? QString::fromStdString(*problem) : QString());
+}
+
+TrainingCentreDialog* MainWindow::openTrainingCentreSettings() {
+  auto* dialog = new TrainingCentreDialog(trainingCentreSetting(), this);
+  dialog->setAttribute(Qt::WA_DeleteOnClose);
+  connect(dialog, &TrainingCentreDialog::requested, this,
+          [this, dialog](const TrainingCentreSetting& setting, const QString& password) {
+            answerForm(*dialog,
+                       [&](QString* why) { return connectTrainingCentre(setting, password, why); });
+          });
+  dialog->show();
+  return dialog;
+}
+
+SessionReviewWindow* MainWindow::openServerReview(const QString& instructor,
+                                                  const QString& password, QString* why) {
+  const auto refuse = [&](const QString& reason) -> SessionReviewWindow* {
+    if (why) *why = reason;
+    return nullptr;
+  };
+  const TrainingCentreSetting setting = trainingCentreSetting();
+  if (setting.serverUrl.isEmpty())
+    return refuse(tr("No training centre server is set (Settings ▸ Training Centre Server…)."));
+  try {
+    // The instructor's own login on the server, at the same server and database.
+    ServerSettings server = parse_server_url(setting.serverUrl.toStdString());
+    server.user = instructor.toStdString();
+    auto store = std::make_unique<PostgresSessionStore>(server, password.toStdString());
+    std::optional<Instructor> grader =
+        store->log_in_instructor(instructor.toStdString(), password.toStdString());
+    if (!grader) return refuse(tr("%1 is not an instructor on the server.").arg(instructor));
+    if (serverReview_) serverReview_->close();
+    serverReview_ = new SessionReviewWindow(
+        std::move(store), QString::fromStdString(server_name(server)), grader, this);
+    serverReview_->setAttribute(Qt::WA_DeleteOnClose);
+    serverReview_->show();
+    return serverReview_;
+  } catch (const std::exception& e) {  // StorageError, a malformed address
+    return refuse(QString::fromStdString(e.what()));
+  }
 }
 
 std::optional<std::int64_t> MainWindow::recordingSession() const {

@@ -6,6 +6,7 @@
 #include "haptic_preferences.h"
 #include "instructor_login_dialog.h"
 #include "render/liver_scene.h"
+#include "training_centre_dialog.h"
 
 #include "liversim/core/default_scene.h"
 #include "liversim/core/emulated_devices.h"
@@ -17,6 +18,7 @@
 #include "liversim/core/servo_loop.h"
 #include "liversim/core/session_recorder.h"
 #include "liversim/core/session_recording.h"
+#include "liversim/storage/training_centre_sync.h"
 
 #include <QElapsedTimer>
 #include <QMainWindow>
@@ -185,6 +187,26 @@ class MainWindow : public QMainWindow {
   // no session is recorded or no tool is in the scene.
   bool markLesionUnderTool();
 
+  // The training centre (docs/training-centre.md; Settings ▸ Training Centre Server…): finished
+  // sessions uploaded and published scenarios pulled (to pulledScenarioFolder()) in the
+  // background, on the link's own thread and connection, so recording never waits for the
+  // server; the status bar says how it stands. Connecting saves the server's address (never the
+  // password, held in memory only) and starts the link; an empty address stops it. False, with
+  // the reason, for an address that is none or without a sessions database. At start, a saved
+  // server whose password libpq finds is connected to at once; otherwise the status bar asks for
+  // the log-in.
+  bool connectTrainingCentre(const TrainingCentreSetting& setting, const QString& password,
+                             QString* why = nullptr);
+  TrainingCentreSync* trainingCentre() const { return trainingCentre_.get(); }
+  QString trainingCentreStatusText() const;
+  QString pulledScenarioFolder() const;
+  TrainingCentreDialog* openTrainingCentreSettings();
+  // The review of every session on the training centre's server, as an instructor's own server
+  // login; grades saved there reach the workstations with their next run. Null, saying why,
+  // without a server set or when it refuses the log-in.
+  SessionReviewWindow* openServerReview(const QString& instructor, const QString& password,
+                                        QString* why = nullptr);
+
   // Spring stiffness of a mouse grab and the radius of tissue it holds.
   static constexpr double kGrabStiffnessNPerM = 300.0;
   static constexpr double kGrabRadiusM = 0.02;
@@ -299,6 +321,12 @@ class MainWindow : public QMainWindow {
   QMenu* recentMenu_ = nullptr;
   QPointer<CalibrationDialog> calibration_;
   QLabel* statusLabel_ = nullptr;
+  QLabel* trainingCentreLabel_ = nullptr;  // shown while a server is set
+  std::unique_ptr<TrainingCentreSync> trainingCentre_;
+  QTimer trainingCentreTimer_;  // the label follows the link's status
+  QPointer<SessionReviewWindow> serverReview_;
+  void showTrainingCentreStatus();
+  void startTrainingCentreAtLaunch();
   QProgressBar* buildProgress_ = nullptr;  // while a scene is built, with cancelBuild_
   QPushButton* cancelBuild_ = nullptr;
   std::shared_ptr<std::atomic<bool>> buildCancelled_;  // of the build under way

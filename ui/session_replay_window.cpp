@@ -39,6 +39,13 @@ constexpr int kCyclesPerCall = 4;
 
 SessionReplayWindow::SessionReplayWindow(const QString& databaseFile, std::int64_t session,
                                          QWidget* parent)
+    : SessionReplayWindow(nullptr, databaseFile, session, parent) {}
+
+SessionReplayWindow::SessionReplayWindow(SessionStore& store, std::int64_t session, QWidget* parent)
+    : SessionReplayWindow(&store, QString(), session, parent) {}
+
+SessionReplayWindow::SessionReplayWindow(SessionStore* openStore, const QString& databaseFile,
+                                         std::int64_t session, QWidget* parent)
     : QWidget(parent, Qt::Window), session_(session) {
   setObjectName("sessionReplay");
   setWindowTitle(tr("Replay of session %1").arg(session));
@@ -98,8 +105,11 @@ SessionReplayWindow::SessionReplayWindow(const QString& databaseFile, std::int64
   std::vector<SimulationInput> inputs;
   std::string scenario_text;
   try {
-    SqliteSessionStore store(std::filesystem::path(databaseFile.toStdString()),
-                             SqliteSessionStore::Access::read_only);
+    std::unique_ptr<SqliteSessionStore> file;
+    if (openStore == nullptr)
+      file = std::make_unique<SqliteSessionStore>(std::filesystem::path(databaseFile.toStdString()),
+                                                  SqliteSessionStore::Access::read_only);
+    SessionStore& store = openStore != nullptr ? *openStore : *file;
     std::optional<double> scale;
     for (const SessionSummary& summary : store.sessions())
       if (summary.id == session && summary.mapping) scale = summary.mapping->scale;

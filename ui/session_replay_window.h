@@ -39,8 +39,16 @@ class SessionReplayWindow : public QWidget {
   // Reads the session from the database file (its own connection) and builds its scene on a
   // worker; ready() when it can play. A session that cannot be replayed says why in problem().
   SessionReplayWindow(const QString& databaseFile, std::int64_t session, QWidget* parent = nullptr);
+  // The same from a store already open (the training centre's server), read at once.
+  SessionReplayWindow(SessionStore& store, std::int64_t session, QWidget* parent = nullptr);
   ~SessionReplayWindow() override;
 
+ private:
+  // `store` null: opens the file read-only.
+  SessionReplayWindow(SessionStore* store, const QString& databaseFile, std::int64_t session,
+                      QWidget* parent);
+
+ public:
   std::int64_t session() const { return session_; }
   bool ready() const { return replay_ != nullptr; }
   QString problem() const { return problem_; }

@@ -59,16 +59,38 @@ QTableWidgetItem* cell(const QString& text) {
 
 }  // namespace
 
+SessionReviewWindow::OpenedStore SessionReviewWindow::openFile(const QString& databaseFile) {
+  try {
+    return {std::make_unique<SqliteSessionStore>(std::filesystem::path(databaseFile.toStdString())),
+            {}};
+  } catch (const StorageError& e) {
+    return {nullptr, storageProblemText(tr("The sessions cannot be read: %1"), e)};
+  }
+}
+
 SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
                                          const std::optional<QString>& trainee,
                                          const std::optional<Instructor>& grader, QWidget* parent)
+    : SessionReviewWindow(openFile(databaseFile), databaseFile, databaseFile, trainee, grader,
+                          parent) {}
+
+SessionReviewWindow::SessionReviewWindow(std::unique_ptr<SessionStore> store, const QString& source,
+                                         const std::optional<Instructor>& grader, QWidget* parent)
+    : SessionReviewWindow(OpenedStore{std::move(store), {}}, source, QString(), std::nullopt,
+                          grader, parent) {}
+
+SessionReviewWindow::SessionReviewWindow(OpenedStore opened, const QString& source,
+                                         const QString& databaseFile,
+                                         const std::optional<QString>& trainee,
+                                         const std::optional<Instructor>& grader, QWidget* parent)
     : QWidget(parent, Qt::Window),
+      store_(std::move(opened.store)),
+      problem_(opened.problem),
       trainee_(trainee),
       grader_(trainee ? std::nullopt : grader),
       databaseFile_(databaseFile) {
   setObjectName(trainee ? "traineeHistoryWindow" : "sessionReviewWindow");
-  setWindowTitle(trainee ? tr("Sessions of %1").arg(*trainee)
-                         : tr("Sessions — %1").arg(databaseFile));
+  setWindowTitle(trainee ? tr("Sessions of %1").arg(*trainee) : tr("Sessions — %1").arg(source));
   problemLabel_ = new QLabel(this);
   problemLabel_->setObjectName("reviewProblem");
   problemLabel_->setWordWrap(true);
@@ -192,12 +214,6 @@ SessionReviewWindow::SessionReviewWindow(const QString& databaseFile,
   layout->addWidget(splitter);
   resize(1100, 800);
 
-  try {
-    store_ =
-        std::make_unique<SqliteSessionStore>(std::filesystem::path(databaseFile.toStdString()));
-  } catch (const StorageError& e) {
-    problem_ = storageProblemText(tr("The sessions cannot be read: %1"), e);
-  }
   refresh();
 }
 
@@ -393,7 +409,8 @@ void SessionReviewWindow::showOpenedSession() {
 SessionReplayWindow* SessionReviewWindow::openReplay() {
   if (!opened_) return nullptr;
   if (replayWindow_) replayWindow_->close();  // one replay at a time: each holds a whole model
-  replayWindow_ = new SessionReplayWindow(databaseFile_, *opened_, this);
+  replayWindow_ = databaseFile_.isEmpty() ? new SessionReplayWindow(*store_, *opened_, this)
+                                          : new SessionReplayWindow(databaseFile_, *opened_, this);
   replayWindow_->setAttribute(Qt::WA_DeleteOnClose);
   replayWindow_->show();
   return replayWindow_;

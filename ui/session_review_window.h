@@ -45,6 +45,10 @@ class SessionReviewWindow : public QWidget {
                                const std::optional<QString>& trainee = std::nullopt,
                                const std::optional<Instructor>& grader = std::nullopt,
                                QWidget* parent = nullptr);
+  // Every session of a store already open (the training centre's server, named `source` in the
+  // title), graded by `grader` (an instructor logged in on that store).
+  SessionReviewWindow(std::unique_ptr<SessionStore> store, const QString& source,
+                      const std::optional<Instructor>& grader, QWidget* parent = nullptr);
   ~SessionReviewWindow() override;
 
   QString problem() const { return problem_; }
@@ -87,6 +91,14 @@ class SessionReviewWindow : public QWidget {
   SessionReplayWindow* openReplay();
 
  private:
+  struct OpenedStore {
+    std::unique_ptr<SessionStore> store;
+    QString problem;  // why there is none
+  };
+  static OpenedStore openFile(const QString& databaseFile);
+  SessionReviewWindow(OpenedStore opened, const QString& source, const QString& databaseFile,
+                      const std::optional<QString>& trainee,
+                      const std::optional<Instructor>& grader, QWidget* parent);
   void showSessions();
   void setProblem(const QString& problem);
   void showOpenedSession();
@@ -120,7 +132,7 @@ class SessionReviewWindow : public QWidget {
   QPushButton* csvButton_ = nullptr;
   QPushButton* pdfButton_ = nullptr;
   QPushButton* replayButton_ = nullptr;
-  QString databaseFile_;
+  QString databaseFile_;  // empty: the store is not a file (replays read store_)
   QPointer<SessionReplayWindow> replayWindow_;
   QLabel* gradesLabel_ = nullptr;
 };

@@ -131,7 +131,8 @@ void ThrowawayPostgres::run(const std::string& what, const std::string& command)
 
 void ThrowawayPostgres::start() {
   std::string settings = "-p " + std::to_string(port_) + " -k " + folder_.string() +
-                         " -c listen_addresses=127.0.0.1 -c fsync=off -c max_connections=60";
+                         " -c listen_addresses=127.0.0.1 -c max_connections=60";
+  if (!options_.durable) settings += " -c fsync=off";
   if (options_.tls)
     settings += " -c ssl=on -c ssl_cert_file=" + (folder_ / "server.crt").string() +
                 " -c ssl_key_file=" + (folder_ / "server.key").string();

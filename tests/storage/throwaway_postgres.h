@@ -15,6 +15,8 @@ class ThrowawayPostgres {
  public:
   struct Options {
     bool tls = false;  // a test certificate authority signs the server's certificate
+    // Writes durably (fsync on), as a real server: for the load bench. The tests need not.
+    bool durable = false;
   };
   // Throws std::runtime_error saying what failed (the server's log is in the message).
   ThrowawayPostgres() : ThrowawayPostgres(Options{}) {}
