@@ -525,6 +525,42 @@ TEST(SessionRecorder, AWriterKilledMidSessionLosesAtMostTheLastCommitPeriod) {
   EXPECT_GT(frames.size(), 300u);
 }
 
+// Another connection opened for writing while a session is recorded (the review window, the
+// training centre's link, `liversim-cli server upload`) leaves the session recording; once the
+// recorder is gone without ending it (its process killed: the test above), the next opening
+// closes it.
+TEST(SessionStore, AnOpeningWhileASessionIsRecordedLeavesItRecording) {
+  const fs::path file = fresh_database("opened-while-recording");
+  auto recorder = std::make_unique<SqliteSessionStore>(file);
+  const std::int64_t session = recorder->begin_session(
+      {"Trainee A", "Palpation", "{}", "Mouse", 1'700'000'000'000, std::nullopt, std::nullopt});
+  const std::vector<ServoFrame> frames = synthetic_frames(100, 41);
+  recorder->append_frames(session, frames);
+  recorder->commit();
+  {
+    SqliteSessionStore other(file);
+    ASSERT_EQ(other.sessions().size(), 1u);
+    EXPECT_EQ(other.sessions()[0].status, SessionStatus::recording)
+        << "an opening closed a session another connection is recording";
+  }
+  recorder->append_frames(session, frames);  // goes on, and ends complete
+  recorder->end_session(session, 1'700'000'060'000, SessionServoFigures{});
+  {
+    SqliteSessionStore other(file);
+    EXPECT_EQ(other.sessions()[0].status, SessionStatus::complete);
+    EXPECT_EQ(other.sessions()[0].frame_count, 200);
+  }
+  // A second session left recording by a connection that is gone: the next opening closes it.
+  const std::int64_t second = recorder->begin_session(
+      {"Trainee A", "Palpation", "{}", "Mouse", 1'700'000'100'000, std::nullopt, std::nullopt});
+  recorder->commit();
+  recorder.reset();
+  SqliteSessionStore next(file);
+  ASSERT_EQ(next.sessions().size(), 2u);
+  EXPECT_EQ(next.sessions()[1].id, second);
+  EXPECT_EQ(next.sessions()[1].status, SessionStatus::incomplete);
+}
+
 TEST(SessionStore, RefusesFilesItCannotUseWithTheFileAndTheReasonNamed) {
   // Not a database at all.
   const fs::path text = fresh_database("plain-text");

@@ -5,8 +5,11 @@
 #include "liversim/storage/session_transfer.h"
 #include "stored_rows.h"
 
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <array>
 #include <cerrno>
@@ -331,9 +334,13 @@ SqliteSessionStore::SqliteSessionStore(const std::filesystem::path& file, Access
         execute(("PRAGMA user_version = " + std::to_string(v + 1)).c_str(), doing.c_str());
         execute("COMMIT", doing.c_str());
       }
-      // A writer killed mid-session left it recording: it is over, not lost.
-      execute("UPDATE sessions SET status = 'incomplete' WHERE status = 'recording'",
-              "closing sessions left recording");
+      // A writer killed mid-session left it recording: it is over, not lost. Not while another
+      // connection records (it holds the recording lock): its session goes on.
+      const int lock = ::open(recording_lock_file().c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+      if (lock < 0 || flock(lock, LOCK_EX | LOCK_NB) == 0)
+        execute("UPDATE sessions SET status = 'incomplete' WHERE status = 'recording'",
+                "closing sessions left recording");
+      if (lock >= 0) ::close(lock);  // and the lock with it
     } else if (version < kSchemaVersion) {
       throw error("schema version " + std::to_string(version) +
                   " needs migrating; open it for writing once");
@@ -346,7 +353,25 @@ SqliteSessionStore::SqliteSessionStore(const std::filesystem::path& file, Access
   }
 }
 
+std::filesystem::path SqliteSessionStore::recording_lock_file() const {
+  return file_.string() + "-recording.lock";
+}
+
+void SqliteSessionStore::hold_recording_lock() {
+  if (recording_lock_fd_ >= 0) return;
+  // Without the lock file (a folder turned read-only) the session is recorded all the same; an
+  // opening meanwhile may then take it for one left recording.
+  recording_lock_fd_ = ::open(recording_lock_file().c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (recording_lock_fd_ >= 0 && flock(recording_lock_fd_, LOCK_SH) != 0) release_recording_lock();
+}
+
+void SqliteSessionStore::release_recording_lock() {
+  if (recording_lock_fd_ >= 0) ::close(recording_lock_fd_);
+  recording_lock_fd_ = -1;
+}
+
 SqliteSessionStore::~SqliteSessionStore() {
+  release_recording_lock();
   if (in_transaction_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
   statements_.clear();
   sqlite3_close(db_);
@@ -466,7 +491,11 @@ void SqliteSessionStore::limit_pages_for_testing(std::int64_t pages) {
 void SqliteSessionStore::begin_if_needed() {
   if (in_transaction_) return;
   check_file_is_still_there();
-  if (sqlite3_exec(db_, "BEGIN", nullptr, nullptr, nullptr) != SQLITE_OK)
+  // IMMEDIATE: the write lock now, waiting (busy timeout) for another connection's write to end.
+  // A deferred transaction that read first could not take it once another connection had
+  // committed (SQLITE_BUSY_SNAPSHOT, at once): the training centre's link writing its notes
+  // made the recorder's next append fail.
+  if (sqlite3_exec(db_, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr) != SQLITE_OK)
     fail("starting a transaction");
   in_transaction_ = true;
 }
@@ -514,6 +543,8 @@ std::int64_t SqliteSessionStore::person(std::string_view name, std::string_view 
 }
 
 std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
+  hold_recording_lock();  // before the row: no opening may close it
+  ++sessions_recording_;
   begin_if_needed();
   // Added if new (a name per role and a text's hash are unique), then looked up either way.
   const std::int64_t trainee = person(start.trainee, "trainee");
@@ -696,6 +727,7 @@ void SqliteSessionStore::end_session(std::int64_t session, std::int64_t ended_un
       .run("ending the session");
   if (sqlite3_changes(db_) != 1) throw error("there is no session " + std::to_string(session));
   commit();
+  if (sessions_recording_ > 0 && --sessions_recording_ == 0) release_recording_lock();
 }
 
 void SqliteSessionStore::store_metrics(std::int64_t session, std::span<const MetricValue> metrics) {

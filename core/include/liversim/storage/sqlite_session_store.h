@@ -136,6 +136,15 @@ class SqliteSessionStore final : public SessionStore {
   std::uint64_t file_device_ = 0;
   std::uint64_t file_inode_ = 0;
   bool file_identity_known_ = false;
+  // While this connection records a session it holds FILE-recording.lock shared (flock, so
+  // per open file, released by the kernel when the process dies): an opening for writing closes
+  // the sessions left recording only when it can lock that file exclusively, so a review window
+  // or the training centre's link, opened while the workstation records, does not.
+  int recording_lock_fd_ = -1;
+  int sessions_recording_ = 0;
+  std::filesystem::path recording_lock_file() const;
+  void hold_recording_lock();
+  void release_recording_lock();
 };
 
 }  // namespace liversim
