@@ -38,7 +38,8 @@ if [ "$command" = test ]; then
   # (the whole suites under ASan and TSan take longer than CI allows: docs/sanitizers.md).
   cmake --preset tsan >/dev/null
   cmake --build --preset tsan --parallel "$(nproc)" --target liversim_core_tests \
-    liversim_storage_tests liversim_cli_record_tests liversim-cli liversim_session_writer_child
+    liversim_storage_tests liversim_training_centre_tests liversim_cli_record_tests liversim-cli \
+    liversim_session_writer_child
   exec ctest --preset tsan-threads --parallel "$(nproc)"
 fi
 
