@@ -7,6 +7,7 @@
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 
+#include <array>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -32,18 +33,30 @@ std::string read_password(const std::string& prompt) {
   return line;
 }
 
-std::unique_ptr<PostgresSessionStore> connect_to_server(const std::string& url, bool pgpass) {
-  const ServerSettings settings = parse_server_url(url);
-  const std::string password =
-      pgpass ? std::string() : read_password("password of " + server_name(settings));
-  return std::make_unique<PostgresSessionStore>(settings, password);
+void add_server_connection_options(CLI::App& command, ServerConnectionOptions& options,
+                                   bool required) {
+  CLI::Option* url =
+      command.add_option("--server", options.url,
+                         "The training centre's server: postgresql://LOGIN@HOST:PORT/DATABASE"
+                         "?sslmode=...");
+  if (required) url->required();
+  command.add_flag("--pgpass", options.pgpass,
+                   "Ask no password: libpq's ~/.pgpass or a client certificate");
+}
+
+std::string login_password(const ServerSettings& settings, bool pgpass) {
+  return pgpass ? std::string() : read_password("password of " + server_name(settings));
+}
+
+std::unique_ptr<PostgresSessionStore> connect_to_server(const ServerConnectionOptions& options) {
+  const ServerSettings settings = parse_server_url(options.url);
+  return std::make_unique<PostgresSessionStore>(settings, login_password(settings, options.pgpass));
 }
 
 namespace {
 
 struct ServerOptions {
-  std::string url;
-  bool pgpass = false;
+  ServerConnectionOptions server;
   std::string name;
   bool workstation = false, instructor = false;
   std::filesystem::path database, folder, scenario_file;
@@ -63,15 +76,14 @@ std::optional<std::string> read_text(const std::filesystem::path& file) {
 }
 
 int run(const std::string& which, const ServerOptions& o) {
-  const ServerSettings settings = parse_server_url(o.url);
+  const ServerSettings settings = parse_server_url(o.server.url);
   if (which == "add-login" && o.workstation == o.instructor) {
     std::cerr << "error: add-login needs one of --workstation and --instructor\n";
     return 2;
   }
   std::optional<std::string> scenario_text;
   if (which == "publish-scenario" && !(scenario_text = read_text(o.scenario_file))) return 1;
-  const std::string password =
-      o.pgpass ? std::string() : read_password("password of " + server_name(settings));
+  const std::string password = login_password(settings, o.server.pgpass);
   if (which == "set-up") {
     PostgresSessionStore::set_up_server(settings, password);
     PostgresSessionStore store(settings, password);
@@ -133,12 +145,8 @@ std::function<std::optional<int>()> add_server_command(CLI::App& app) {
   auto* server = app.add_subcommand("server", "The training centre's PostgreSQL server");
   server->require_subcommand(1);
   const auto common = [&](CLI::App* sub) {
-    sub->add_option("--server", options->url, "postgresql://USER@HOST:PORT/DATABASE?sslmode=...")
-        ->required();
-    sub->add_flag("--pgpass", options->pgpass,
-                  "Ask no password: libpq's ~/.pgpass or a client certificate");
+    add_server_connection_options(*sub, options->server, true);
   };
-  std::vector<std::pair<std::string, CLI::App*>> subs;
   auto* set_up = server->add_subcommand("set-up", "Create or migrate the schema (administrator)");
   common(set_up);
   auto* add_login =
@@ -150,7 +158,8 @@ std::function<std::optional<int>()> add_server_command(CLI::App& app) {
   auto* upload = server->add_subcommand("upload", "Upload finished sessions, pull grades");
   common(upload);
   upload->add_option("--database", options->database, "The workstation's sessions database")
-      ->required();
+      ->required()
+      ->check(CLI::ExistingFile);
   auto* pull =
       server->add_subcommand("pull-scenarios", "Write the published scenarios to a folder");
   common(pull);
@@ -159,13 +168,12 @@ std::function<std::optional<int>()> add_server_command(CLI::App& app) {
   common(publish);
   publish->add_option("--instructor", options->instructor_name)->required();
   publish->add_option("file", options->scenario_file)->required()->check(CLI::ExistingFile);
-  for (CLI::App* sub : {set_up, add_login, upload, pull, publish})
-    subs.emplace_back(sub->get_name(), sub);
+  const std::array<CLI::App*, 5> subs{set_up, add_login, upload, pull, publish};
   return [options, subs]() -> std::optional<int> {
-    for (const auto& [name, sub] : subs) {
+    for (CLI::App* sub : subs) {
       if (!sub->parsed()) continue;
       try {
-        return run(name, *options);
+        return run(sub->get_name(), *options);
       } catch (const std::exception& e) {
         std::cerr << "error: " << e.what() << '\n';
         return 1;

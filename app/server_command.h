@@ -27,8 +27,20 @@ std::function<std::optional<int>()> add_server_command(CLI::App& app);
 // A password from the terminal (without echo) or the next line of standard input.
 std::string read_password(const std::string& prompt);
 
-// Connects to the server of `url` (parse_server_url), asking the login's password unless
-// `pgpass`. Throws StorageError or std::invalid_argument naming what is wrong.
-std::unique_ptr<PostgresSessionStore> connect_to_server(const std::string& url, bool pgpass);
+// The options naming a server: --server URL and --pgpass.
+struct ServerConnectionOptions {
+  std::string url;
+  bool pgpass = false;
+};
+// Adds them to a command; --server required or not.
+void add_server_connection_options(CLI::App& command, ServerConnectionOptions& options,
+                                   bool required);
+
+// The password of the login of `settings`: none with --pgpass (libpq finds it), else asked.
+std::string login_password(const ServerSettings& settings, bool pgpass);
+
+// Connects to the server of `options.url` (parse_server_url), asking the login's password unless
+// --pgpass. Throws StorageError or std::invalid_argument naming what is wrong.
+std::unique_ptr<PostgresSessionStore> connect_to_server(const ServerConnectionOptions& options);
 
 }  // namespace liversim::cli

@@ -19,8 +19,7 @@ namespace {
 
 struct SessionsOptions {
   std::filesystem::path database;
-  std::string server_url;  // instead of a database: the training centre's server
-  bool pgpass = false;
+  ServerConnectionOptions server;  // instead of a database: the training centre's server
   std::int64_t session = 0;
   std::filesystem::path frames_csv, events_csv, metrics_csv;
 };
@@ -47,7 +46,7 @@ int export_session(SessionStore& store, const SessionsOptions& o) {
   bool found = false;
   for (const SessionSummary& s : store.sessions()) found |= s.id == o.session;
   if (!found) {
-    std::cerr << "error: " << (o.server_url.empty() ? o.database.string() : o.server_url)
+    std::cerr << "error: " << (o.server.url.empty() ? o.database.string() : o.server.url)
               << " has no session " << o.session << '\n';
     return 1;
   }
@@ -93,16 +92,11 @@ std::function<std::optional<int>()> add_sessions_command(CLI::App& app) {
   sessions->require_subcommand(1);
   // The sessions of a workstation's database file, or of the training centre's server.
   const auto store_options = [&](CLI::App* sub) {
-    auto* database = sub->add_option("--database", options->database, "Sessions database (.sqlite)")
-                         ->check(CLI::ExistingFile);
-    auto* server =
-        sub->add_option("--server", options->server_url,
-                        "The training centre's server instead: postgresql://USER@HOST/DB");
-    sub->add_flag("--pgpass", options->pgpass,
-                  "With --server, ask no password: libpq's ~/.pgpass or a client certificate");
-    database->excludes(server);
+    sub->add_option("--database", options->database, "Sessions database (.sqlite)")
+        ->check(CLI::ExistingFile);
+    add_server_connection_options(*sub, options->server, false);
     sub->callback([options, sub] {
-      if (options->database.empty() == options->server_url.empty())
+      if (options->database.empty() == options->server.url.empty())
         throw CLI::ValidationError(sub->get_name(), "give one of --database and --server");
     });
   };
@@ -122,11 +116,11 @@ std::function<std::optional<int>()> add_sessions_command(CLI::App& app) {
     if (!sessions->parsed()) return std::nullopt;
     try {
       std::unique_ptr<SessionStore> store;
-      if (options->server_url.empty())
+      if (options->server.url.empty())
         store = std::make_unique<SqliteSessionStore>(options->database,
                                                      SqliteSessionStore::Access::read_only);
       else
-        store = connect_to_server(options->server_url, options->pgpass);
+        store = connect_to_server(options->server);
       if (list->parsed()) {
         print_list(*store);
         return 0;

@@ -203,7 +203,10 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   trainingCentreLabel_->setObjectName("trainingCentreStatus");
   trainingCentreLabel_->hide();
   statusBar()->addPermanentWidget(trainingCentreLabel_);
-  connect(&trainingCentreTimer_, &QTimer::timeout, this, &MainWindow::showTrainingCentreStatus);
+  // The link's status changes on its thread; the rest changes here and is shown at once.
+  connect(&trainingCentreTimer_, &QTimer::timeout, this, [this] {
+    if (trainingCentre_) showTrainingCentreStatus();
+  });
   trainingCentreTimer_.start(1000);
   // A session's upload waits for its metrics: the link is asked to run once they are stored.
   connect(this, &MainWindow::sessionMetricsStored, this, [this] {
@@ -347,14 +350,11 @@ InstructorLoginDialog* MainWindow::openInstructorLogin(InstructorLoginDialog::Pu
   dialog->setAttribute(Qt::WA_DeleteOnClose);
   connect(dialog, &InstructorLoginDialog::requested, this,
           [this, dialog](const QString& name, const QString& password) {
-            QString why;
-            const bool done = dialog->purpose() == InstructorLoginDialog::Purpose::add_account
-                                  ? addInstructorAccount(name, password, &why)
-                                  : logInInstructor(name, password, &why);
-            if (done)
-              dialog->accept();
-            else
-              dialog->showError(why);
+            answerForm(*dialog, [&](QString* why) {
+              return dialog->purpose() == InstructorLoginDialog::Purpose::add_account
+                         ? addInstructorAccount(name, password, why)
+                         : logInInstructor(name, password, why);
+            });
           });
   loginDialog_ = dialog;
   dialog->open();
@@ -1355,7 +1355,7 @@ QString MainWindow::trainingCentreStatusText() const {
   const TrainingCentreStatus status = trainingCentre_->status();
   const QString server = QString::fromStdString(server_name(trainingCentre_->server()));
   if (status.runs == 0) return tr("Training centre: connecting to %1…").arg(server);
-  if (!status.last_run_ok)
+  if (!status.last_run_ok())
     return tr("Training centre: %1 not reached, %n session(s) waiting", nullptr, status.waiting)
         .arg(server);
   return tr("Training centre: up to date at %1, %n session(s) uploaded", nullptr, status.uploaded)

@@ -241,6 +241,30 @@ TEST_F(CliServer, ABadURLAWrongPasswordAndADownServerAreNamedAndChangeNothing) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("uploaded 1 sessions"), std::string::npos) << r.out;
 
+  // Bad files: a database that is not there (not created), a scenario that does not validate (its
+  // errors named, nothing published), a folder that cannot be made.
+  r = run_cli(
+      folder_,
+      {"server", "upload", "--server", workstation_url(), "--database", folder_ / "no-such.sqlite"},
+      std::string(kWorkstationPassword) + "\n");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("no-such.sqlite"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(folder_ / "no-such.sqlite"));
+  const fs::path broken = folder_ / "broken.json";
+  std::ofstream(broken) << "{\"title\": \"no liver, no task\"}";
+  r = run_cli(folder_,
+              {"server", "publish-scenario", "--server", instructor_url(), "--instructor",
+               "dr_grey", broken},
+              std::string(kInstructorPassword) + "\n" + kInstructorPassword + "\n");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("broken"), std::string::npos) << r.err;
+  r = run_cli(folder_,
+              {"server", "pull-scenarios", "--server", workstation_url(), "--folder",
+               folder_ / "stdin.txt" / "scenarios"},
+              std::string(kWorkstationPassword) + "\n");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("scenario folder"), std::string::npos) << r.err;
+
   // Usage errors: exit code 2 from the parser or the command, before any password is asked.
   r = run_cli(folder_, {"server", "add-login", "--server", workstation_url(), "someone"}, "");
   EXPECT_EQ(r.exit_code, 2);

@@ -511,12 +511,12 @@ TEST_F(TrainingCentre, TheWorkstationsLinkUploadsInTheBackgroundAndTheRecorderNe
                                        .count();
   recorder.end_session(second, now_unix_ms, SessionServoFigures{});
   TrainingCentreStatus status = run_and_wait(sync);
-  EXPECT_TRUE(status.last_run_ok) << status.problem.value_or("");
+  EXPECT_TRUE(status.last_run_ok()) << status.problem.value_or("");
   EXPECT_EQ(status.uploaded, 1);
   const std::vector<MetricValue> metrics{{"path_length_m", 0.5}};
   recorder.store_metrics(second, metrics);
   status = run_and_wait(sync);
-  EXPECT_TRUE(status.last_run_ok) << status.problem.value_or("");
+  EXPECT_TRUE(status.last_run_ok()) << status.problem.value_or("");
   EXPECT_EQ(status.uploaded, 2);
   EXPECT_EQ(status.waiting, 0);
   EXPECT_EQ(status.scenarios_pulled, 1);
@@ -528,7 +528,7 @@ TEST_F(TrainingCentre, TheWorkstationsLinkUploadsInTheBackgroundAndTheRecorderNe
   server_->stop();
   record_session(recorder, "Trainee C", 500, 23);
   status = run_and_wait(sync);
-  EXPECT_FALSE(status.last_run_ok);
+  EXPECT_FALSE(status.last_run_ok());
   ASSERT_TRUE(status.problem);
   EXPECT_NE(status.problem->find("server " + server_name(workstation()) + ": cannot connect"),
             std::string::npos)
@@ -538,7 +538,7 @@ TEST_F(TrainingCentre, TheWorkstationsLinkUploadsInTheBackgroundAndTheRecorderNe
 
   server_->start();
   status = run_and_wait(sync);
-  EXPECT_TRUE(status.last_run_ok) << status.problem.value_or("");
+  EXPECT_TRUE(status.last_run_ok()) << status.problem.value_or("");
   EXPECT_EQ(status.uploaded, 4);
   EXPECT_EQ(status.waiting, 0);
   EXPECT_EQ(count_rows(*server_, "sessions"), 4);

@@ -82,7 +82,6 @@ void TrainingCentreSync::run_once() {
   std::lock_guard lock(mutex_);
   ++status_.runs;
   status_.running = false;
-  status_.last_run_ok = !problem;
   status_.problem = problem;
   status_.uploaded += report.uploaded;
   status_.waiting = report.waiting;

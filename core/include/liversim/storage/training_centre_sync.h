@@ -29,13 +29,14 @@ struct TrainingCentreLink {
 struct TrainingCentreStatus {
   std::int64_t runs = 0;               // finished, successful or not
   bool running = false;                // a run is under way
-  bool last_run_ok = false;            // the last run reached the server and did all it had to
   std::optional<std::string> problem;  // what stopped the last run, naming the server
   int uploaded = 0;                    // sessions uploaded by this link since it started
   int waiting = 0;                     // finished sessions not on the server after the last run
   int grades_pulled = 0;               // since it started
   int scenarios_pulled = 0;            // new or changed scenario files written since it started
   std::int64_t last_ok_unix_ms = 0;    // when a run last succeeded; 0: never
+  // The last run reached the server and did all it had to.
+  bool last_run_ok() const { return runs > 0 && !problem; }
 };
 
 class TrainingCentreSync {
