@@ -13,8 +13,13 @@
 #include <QDir>
 #include <QIcon>
 #include <QMessageBox>
+#include <QSocketNotifier>
 #include <QStandardPaths>
 #include <QTimer>
+
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -177,6 +182,37 @@ Options parse_options(int argc, char** argv) {
   return options;
 }
 
+// SIGTERM (a logout, a shutdown, `kill`) and SIGINT (Ctrl+C in its terminal) close the
+// workstation as --quit-after does, so the session under way ends complete instead of being left
+// for the next start to close as incomplete. The handler only writes a byte (async-signal-safe);
+// the event loop reads it and quits.
+int stop_signal_socket = -1;
+
+void on_stop_signal(int signal) {
+  const char byte = static_cast<char>(signal);
+  [[maybe_unused]] const ssize_t written = ::write(stop_signal_socket, &byte, 1);
+}
+
+void quit_on_stop_signals(QApplication& app) {
+  int sockets[2];
+  if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, sockets) != 0) return;  // left default
+  stop_signal_socket = sockets[0];
+  auto* notifier = new QSocketNotifier(sockets[1], QSocketNotifier::Read, &app);
+  QObject::connect(notifier, &QSocketNotifier::activated, &app, [fd = sockets[1]] {
+    char signal = 0;
+    if (::read(fd, &signal, 1) == 1)
+      std::cerr << "liversim: " << (signal == SIGINT ? "SIGINT" : "SIGTERM")
+                << ": closing the workstation as its window's close does" << std::endl;
+    QApplication::quit();
+  });
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;
+  sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGINT, &action, nullptr);
+}
+
 bool has_display() {
   for (const char* variable : {"DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM"}) {
     const char* value = std::getenv(variable);
@@ -218,6 +254,7 @@ int main(int argc, char** argv) {
   name_application();
   QApplication::setDesktopFileName("org.liversim.LiverSim");
   QApplication::setWindowIcon(QIcon(":/icons/liversim.svg"));
+  quit_on_stop_signals(app);
   liversim::installTranslations(options.language.isEmpty() ? liversim::languageSetting()
                                                            : options.language);
   try {
@@ -230,6 +267,10 @@ int main(int argc, char** argv) {
     }
     if (!window.setSessionsDatabase(database))
       std::cerr << "liversim: " << window.sessionsProblem().toStdString() << '\n';
+    // Also in the terminal's log, for whoever looks after the workstation.
+    QObject::connect(&window, &liversim::MainWindow::recordingStopped, [](const QString& message) {
+      std::cerr << "liversim: " << message.toStdString() << std::endl;
+    });
     window.show();
     if (!options.trajectory_file.isEmpty() &&
         !window.useDevice(liversim::DeviceChoice::scripted, options.trajectory_file)) {

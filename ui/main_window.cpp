@@ -1113,6 +1113,7 @@ void MainWindow::showNewestSnapshot() {
             *failure);
         statusBar()->showMessage(sessionsProblem_);
         devicePanel_->showStatus(sessionsProblem_, true);
+        emit recordingStopped(sessionsProblem_);
       }
     }
   }

@@ -215,6 +215,9 @@ class MainWindow : public QMainWindow {
   // A recorded session's metrics were computed and stored (or not: stored false, the reason in
   // sessionsProblem()), after its end, on a worker.
   void sessionMetricsStored(qint64 session, bool stored);
+  // The session under way is no longer being saved (a full disk, a deleted or read-only file):
+  // what is said to the trainee, with what to do.
+  void recordingStopped(const QString& message);
   void integratorChangeFinished(bool applied);
   void tissueChangeFinished(bool applied);
   void scenarioOpenFinished(bool opened);
