@@ -53,7 +53,8 @@ int main(int argc, char** argv) {
                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                            std::chrono::duration<double>(servo.now_s()));
     SessionStart start{"Trainee A",   "Scripted circle", "{\"title\": \"Scripted circle\"}",
-                       device.name(), 1'795'000'000'000, std::nullopt};
+                       device.name(), 1'795'000'000'000, std::nullopt,
+                       std::nullopt};
     SessionRecorder recorder(store, start,
                              [&](ServoFrame& frame) { return servo.next_logged_frame(frame); });
     servo.start();

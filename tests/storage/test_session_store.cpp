@@ -46,7 +46,8 @@ struct ReleasedFrames {
 };
 
 SessionStart start_of(const std::string& trainee, const std::string& scenario_text) {
-  return {trainee, "Palpation", scenario_text, "Scripted", 1'795'000'000'000, std::nullopt};
+  return {trainee,           "Palpation",  scenario_text, "Scripted",
+          1'795'000'000'000, std::nullopt, std::nullopt};
 }
 
 // Runs SQL on a file directly, outside the store (to make files the store must refuse).
@@ -307,7 +308,9 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     EXPECT_EQ(sessions[0].frame_count, earlier.frame_count);
     EXPECT_EQ(static_cast<std::int64_t>(store.frames(sessions[0].id).size()), earlier.frame_count);
     EXPECT_EQ(sessions[0].mapping.has_value(), earlier.mapping_scale.has_value());
-    if (sessions[0].mapping) EXPECT_EQ(sessions[0].mapping->scale, *earlier.mapping_scale);
+    if (sessions[0].mapping) {
+      EXPECT_EQ(sessions[0].mapping->scale, *earlier.mapping_scale);
+    }
     EXPECT_EQ(store.metrics(sessions[0].id),
               (std::vector<MetricValue>{{"peak_force_n", earlier.peak_force_n}}));
     ASSERT_EQ(store.events(sessions[0].id).size(), 1u);
@@ -350,7 +353,7 @@ TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {
   probe.pose.origin_m = {0.01, 0.02, 0.03};
   for (int k = 0; k < 500; ++k) {
     probe.pose.origin_m.x() += 1e-4;
-    written.push_back({SimulationInput::Kind::tool, probe});
+    written.push_back({SimulationInput::Kind::tool, probe, {}});
     if (k % 50 == 0)
       written.push_back(
           {SimulationInput::Kind::springs, std::nullopt, {{k, {0.1, 0.2, 0.3}, 300.0, 1.0}}});
@@ -392,12 +395,15 @@ TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {
   for (std::size_t i = 0; i < read.size(); ++i) {
     ASSERT_EQ(read[i].kind, written[i].kind) << i;
     ASSERT_EQ(read[i].tool.has_value(), written[i].tool.has_value()) << i;
-    if (read[i].tool) ASSERT_EQ(read[i].tool->pose.origin_m, written[i].tool->pose.origin_m) << i;
+    if (read[i].tool) {
+      ASSERT_EQ(read[i].tool->pose.origin_m, written[i].tool->pose.origin_m) << i;
+    }
     ASSERT_EQ(read[i].springs.size(), written[i].springs.size()) << i;
     ASSERT_EQ(read[i].steps, written[i].steps) << i;
     ASSERT_EQ(read[i].check_energy, written[i].check_energy) << i;
-    if (read[i].kind == SimulationInput::Kind::cycle)  // NaN for the others
+    if (read[i].kind == SimulationInput::Kind::cycle) {  // NaN for the others
       ASSERT_EQ(read[i].servo_time_s, written[i].servo_time_s) << i;
+    }
   }
 
   // A chunk damaged on disk: named, with its session.
@@ -761,6 +767,57 @@ TEST(InstructorAccounts, EachForbiddenActionIsRefused) {
   EXPECT_EQ(own[0].id, mine);
   EXPECT_TRUE(store.sessions_of_trainee("Trainee C").empty());
   EXPECT_EQ(store.sessions().size(), 2u);
+}
+
+// A stored hash carries its own cost; one doctored (or damaged) to ask for 4 GiB or 2^32 passes
+// would make the log-in take all the memory or hours. It is refused, naming the account, before
+// any hashing; the other accounts still log in.
+TEST(InstructorAccounts, AStoredHashAskingForMoreThanTheHighestCostIsRefusedUnrun) {
+  const fs::path file = fresh_database("accounts-costly-hash");
+  {
+    SqliteSessionStore store(file);
+    store.set_password_cost_for_testing(kCheapPasswordCostForTesting);
+    const Instructor grey = store.add_instructor_account("Dr. Grey", "correct horse", nullptr);
+    store.add_instructor_account("Dr. Rossi", "battery staple", &grey);
+  }
+  const std::vector<std::pair<const char*, const char*>> doctored{
+      {"$argon2id$v=19$m=4194304,t=2,p=1$c2FsdHNhbHRzYWx0$aGFzaGhhc2hoYXNoaGFzaA",
+       "it asks for 4096 MiB, more than the 1024 MiB of the highest cost"},
+      {"$argon2id$v=19$m=65536,t=4294967295,p=1$c2FsdHNhbHRzYWx0$aGFzaGhhc2hoYXNoaGFzaA",
+       "it asks for 4294967295 passes, more than the 4 of the highest cost"},
+      {"$argon2id$v=19$m=65536,t=2$c2FsdHNhbHRzYWx0$aGFzaGhhc2hoYXNoaGFzaA",
+       "its cost is not written as m=KiB,t=passes,p=lanes"},
+      {"$2b$10$N9qo8uLOickgx2ZMRZoMyeIjZAgcfl7p92ldGxad68LJZdL17lhWy",
+       "it is not an Argon2id hash of version 19"}};
+  for (const auto& [hash, why] : doctored) {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    sqlite3_stmt* update = nullptr;
+    ASSERT_EQ(sqlite3_prepare_v2(db,
+                                 "UPDATE instructor_accounts SET password_hash = ?1 WHERE "
+                                 "person_id = (SELECT id FROM people WHERE name = 'Dr. Grey')",
+                                 -1, &update, nullptr),
+              SQLITE_OK);
+    sqlite3_bind_text(update, 1, hash, -1, SQLITE_STATIC);
+    EXPECT_EQ(sqlite3_step(update), SQLITE_DONE);
+    EXPECT_EQ(sqlite3_changes(db), 1);
+    sqlite3_finalize(update);
+    sqlite3_close(db);
+
+    SqliteSessionStore store(file);
+    try {
+      store.log_in_instructor("Dr. Grey", "correct horse");
+      ADD_FAILURE() << "a hash asking " << why << " was run";
+    } catch (const StorageError& e) {
+      EXPECT_EQ(e.problem(), StorageProblem::damaged);
+      const std::string said = e.what();
+      EXPECT_NE(said.find(file.string()), std::string::npos) << said;
+      EXPECT_NE(said.find("the instructor account 'Dr. Grey'"), std::string::npos) << said;
+      EXPECT_NE(said.find(why), std::string::npos) << said;
+    }
+    EXPECT_TRUE(store.log_in_instructor("Dr. Rossi", "battery staple").has_value());
+    EXPECT_FALSE(store.log_in_instructor("Dr. Rossi", "correct horse").has_value());
+  }
 }
 
 // Names and comments are data, never SQL: every statement binds its values. Hostile text is

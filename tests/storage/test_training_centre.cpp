@@ -209,7 +209,8 @@ TEST_F(TrainingCentre, AFinishedSessionIsUploadedExactlyOnceWithEveryBit) {
 
 TEST_F(TrainingCentre, ASessionStillRecordingIsNotUploaded) {
   SqliteSessionStore local(fresh_database("recording"));
-  SessionStart start{"Trainee A", "Palpation", "{}", "Scripted", 1'795'000'000'000, std::nullopt};
+  SessionStart start{"Trainee A",       "Palpation",  "{}",        "Scripted",
+                     1'795'000'000'000, std::nullopt, std::nullopt};
   const std::int64_t id = local.begin_session(start);
   const std::vector<ServoFrame> frames = synthetic_frames(10, 3);
   local.append_frames(id, frames);

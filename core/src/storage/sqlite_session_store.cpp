@@ -813,6 +813,11 @@ Instructor SqliteSessionStore::add_instructor_account(std::string_view name,
 std::optional<Instructor> SqliteSessionStore::log_in_instructor(std::string_view name,
                                                                 std::string_view password) {
   const auto account = account_of(name);
+  if (account)
+    if (const std::optional<std::string> problem = stored_password_hash_problem(account->second))
+      throw error("the password hash of the instructor account '" + std::string(name) +
+                      "' cannot be checked (a damaged file?): " + *problem,
+                  StorageProblem::damaged);
   // An unknown name costs a verification too, so that the time does not tell names apart.
   static const std::string unknown_name_hash = hash_password("no such account");
   const bool matches = password_matches(password, account ? account->second : unknown_name_hash);
