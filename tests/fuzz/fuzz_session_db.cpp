@@ -1,7 +1,9 @@
 // Fuzz target: the sessions database loader (sqlite_session_store.h) on a fuzzed SQLite file.
 // The file is opened as the review and replay windows open it (read-only) and then as the
 // workstation does (for writing: migrated, sessions left recording closed), and everything of
-// every session is loaded. The store promises its data or a StorageError naming the file.
+// every session is loaded: its parts, its upload to the training centre (read as the link reads
+// it, chunks included), and an instructor's log-in (the stored password hash checked). The store
+// promises its data or a StorageError naming the file.
 
 #include "fuzz_support.h"
 #include "liversim/storage/sqlite_session_store.h"
@@ -25,12 +27,35 @@ void load(const std::string& file, Load&& what) {
   }
 }
 
+// The seeds' instructor account and trainee (make_seeds.cpp), and a server name.
+constexpr const char* kInstructor = "instructor-b";
+constexpr const char* kPassword = "seed password";
+constexpr const char* kTrainee = "trainee-a";
+constexpr const char* kServer = "fuzz-server";
+
+// A transfer's chunks read through as the upload streams them; each within the session's count.
+void read_chunks(const ChunkSource& source) {
+  if (!source) return;
+  source(
+      [](const StoredChunk& chunk) { LIVERSIM_FUZZ_CHECK(chunk.first >= 0 && chunk.count >= 0); });
+}
+
 void load_everything(const std::filesystem::path& file, SqliteSessionStore::Access access) {
   const std::string name = file.string();
   load(name, [&] {
     SqliteSessionStore store(file, access);
+    store.set_password_cost_for_testing(kCheapPasswordCostForTesting);
     load(name, [&] { store.schema_version(); });
     load(name, [&] { store.integrity_check(); });
+    // A log-in runs the hash the file holds, at the cost the file says; only when there are
+    // accounts (an unknown name costs a hash at the interactive level, which would slow the run).
+    load(name, [&] {
+      if (!store.has_instructor_accounts()) return;
+      store.log_in_instructor(kInstructor, kPassword);
+    });
+    load(name, [&] { store.sessions_of_trainee(kTrainee); });
+    load(name, [&] { store.sessions_to_upload(kServer); });
+    load(name, [&] { store.uploaded_session_uuids(kServer); });
     std::vector<SessionSummary> sessions;
     load(name, [&] { sessions = store.sessions(); });
     int loaded = 0;
@@ -44,6 +69,12 @@ void load_everything(const std::filesystem::path& file, SqliteSessionStore::Acce
       load(name, [&] { store.metrics(id); });
       load(name, [&] { store.grades(id); });
       load(name, [&] { store.scenario_text(id); });
+      load(name, [&] { store.upload_state(id, kServer); });
+      load(name, [&] {
+        const SessionTransfer transfer = store.transfer_of(id);
+        read_chunks(transfer.frame_chunks);
+        read_chunks(transfer.input_chunks);
+      });
     }
   });
 }

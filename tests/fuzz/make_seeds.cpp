@@ -154,6 +154,9 @@ void session_seeds(const fs::path& out, const fs::path& data, const fs::path& sc
         store.add_instructor_account("instructor-b", "seed password", nullptr);
     store.store_grade(grader, complete,
                       SessionGrade{"instructor-b", 1700000002000, 80.0, "B", "good"});
+    // The training centre's records: uploaded to one server; the fuzz target's server not reached.
+    store.mark_uploaded(complete, "other-server", 1700000003000);
+    store.note_upload_problem(complete, "fuzz-server", "the server was not reached");
 
     start.trainee = "trainee-c";
     start.mapping.reset();
