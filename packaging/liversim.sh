@@ -2,8 +2,9 @@
 # The two commands of README for a new user on Debian 12:
 #   packaging/liversim.sh run    install what is missing, build, start the workstation
 #   packaging/liversim.sh test   install what is missing, build, run the whole test suite, then
-#                                fuzz each reader briefly (the fuzz preset: docs/fuzzing.md) and
-#                                run the threaded parts under ThreadSanitizer (docs/sanitizers.md)
+#                                fuzz each reader briefly (the fuzz preset: docs/fuzzing.md), run
+#                                the storage, bad-input and crash tests under ASan + UBSan and the
+#                                threaded parts under ThreadSanitizer (docs/sanitizers.md)
 # Without a display, "run" says so and runs the headless demo instead (a short simulation and a
 # screenshot written to liversim-demo.png in the current directory).
 set -euo pipefail
@@ -30,10 +31,12 @@ if [ "$command" = test ]; then
   # GUI and rendering tests need an X server: Xvfb provides one whether or not a display exists.
   "${xvfb[@]}" ctest --preset "$preset" --parallel "$(nproc)" --timeout 300
   # Then each fuzz target fuzzed briefly: a clang build of what they need, with libFuzzer and the
-  # sanitizers (docs/fuzzing.md).
+  # sanitizers (docs/fuzzing.md). The same build, ASan + UBSan, runs the tests of the sessions
+  # store, the roles, the training centre and the CLI's recording, crash and bad-input tests.
   cmake --preset fuzz >/dev/null
   cmake --build --preset fuzz --parallel "$(nproc)"
   ctest --preset fuzz --parallel "$(nproc)"
+  ctest --preset asan-inputs --parallel "$(nproc)"
   # Then the threaded parts under ThreadSanitizer: the programs their tests need, and those tests
   # (the whole suites under ASan and TSan take longer than CI allows: docs/sanitizers.md).
   cmake --preset tsan >/dev/null
