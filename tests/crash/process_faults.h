@@ -13,6 +13,7 @@
 #include <sys/ioctl.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 
@@ -100,10 +101,17 @@ class ReadOnlyFileSystem {
     if (listener_ >= 0) close(listener_);
   }
 
-  // Starts `arguments` under the filter, stdout and stderr to files of `folder`; -1 (and why in
-  // `problem`) when this kernel or sandbox does not allow it.
+  // Starts `arguments` under the filter, stdout and stderr to files of `folder`, whose file system
+  // is the one that turns read-only; -1 (and why in `problem`) when this kernel or sandbox does
+  // not allow it.
   pid_t start(const std::vector<std::string>& arguments, const fs::path& folder,
               std::string& problem) {
+    struct stat folder_status {};
+    if (stat(folder.c_str(), &folder_status) != 0) {
+      problem = "cannot stat " + folder.string();
+      return -1;
+    }
+    device_ = folder_status.st_dev;
     std::vector<std::string> all = arguments;
     std::vector<char*> argv;
     for (std::string& a : all) argv.push_back(a.data());
@@ -265,9 +273,9 @@ class ReadOnlyFileSystem {
     }
   }
 
-  // Whether the notified call touches the file system: a call on a descriptor does when it names
-  // a file (a pipe, socket or eventfd stays writable on a read-only file system; AddressSanitizer
-  // probes memory through a pipe), a call on a path always does.
+  // Whether the notified call touches the file system: a call on a descriptor does when its file
+  // is on that file system (not a pipe, socket or eventfd; not a memfd, in which the GL driver
+  // keeps its images; AddressSanitizer probes memory through a pipe), a call on a path always does.
   bool on_the_file_system(const seccomp_notif& request) const {
     const auto call = static_cast<long>(request.data.nr);
     const bool on_a_descriptor = call == SYS_write || call == SYS_writev || call == SYS_pwrite64 ||
@@ -276,14 +284,15 @@ class ReadOnlyFileSystem {
     if (!on_a_descriptor) return true;
     const std::string link = "/proc/" + std::to_string(request.pid) + "/fd/" +
                              std::to_string(static_cast<int>(request.data.args[0]));
-    char target[512] = {};
-    const ssize_t length = readlink(link.c_str(), target, sizeof(target) - 1);
+    struct stat target {};  // of the file the descriptor is open on (stat follows the link)
+    const bool known = stat(link.c_str(), &target) == 0;
     // The answer holds only while the call is still waiting (the descriptor may be reused after).
     std::uint64_t id = request.id;
     if (ioctl(listener_, SECCOMP_IOCTL_NOTIF_ID_VALID, &id) != 0) return false;
-    return length > 0 && target[0] == '/';
+    return known && target.st_dev == device_;
   }
 
+  dev_t device_ = 0;  // the file system that turns read-only
   int listener_ = -1;
   std::atomic<bool> refuse_{false}, stop_{false};
   std::thread supervisor_;
