@@ -70,6 +70,22 @@ inline std::optional<std::string> namespaces_unavailable() {
   return std::nullopt;
 }
 
+// Waits until `writer` (its stderr in folder/stderr.txt) has committed `frames` frames to the
+// first session of `database`; what it committed. If it has not within `patience`, it is killed
+// and the test fails with its stderr.
+inline std::optional<std::int64_t> wait_until_recording(pid_t writer, const fs::path& database,
+                                                        std::int64_t frames,
+                                                        std::chrono::seconds patience,
+                                                        const fs::path& folder) {
+  const std::optional<std::int64_t> committed = wait_for_committed(database, frames, patience);
+  if (committed && *committed >= frames) return committed;
+  kill(writer, SIGKILL);
+  wait_for(writer);
+  ADD_FAILURE() << "no session recorded (" << committed.value_or(0) << " of " << frames
+                << " frames committed): " << read_text(folder / "stderr.txt");
+  return std::nullopt;
+}
+
 // Runs `arguments` with `disk` a tmpfs of `size_kib` KiB (a full disk once that is written),
 // stdout and stderr to files of `folder`, then writes its exit code to folder/rc and copies the
 // files `disk/NAME*` of `database_name` to folder/kept, which outlives the namespace. The shell's

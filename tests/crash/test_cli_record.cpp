@@ -125,9 +125,8 @@ TEST(CliRecordCrash, KilledMidSessionItLosesNothingCommittedAndTheNextRunRecover
   const pid_t cli = spawn(record_arguments(trajectory, database, 600.0), folder);
   ASSERT_GT(cli, 0);
   const std::optional<std::int64_t> before =
-      crash::wait_for_committed(database, 500, std::chrono::seconds(60));
-  ASSERT_TRUE(before && *before >= 500)
-      << "no session recorded: " << read_text(folder / "stderr.txt");
+      crash::wait_until_recording(cli, database, 500, std::chrono::seconds(60), folder);
+  if (!before) return;
   crash::kill_and_expect_recovery(cli, database, *before);
   if (HasFatalFailure()) return;
   const pid_t next = spawn(record_arguments(trajectory, database, 1.0), folder);
@@ -149,8 +148,8 @@ TEST(CliRecordCrash, SigtermEndsTheSessionNormally) {
   const pid_t cli = spawn(record_arguments(write_trajectory(folder), database, 600.0), folder);
   ASSERT_GT(cli, 0);
   const std::optional<std::int64_t> before =
-      crash::wait_for_committed(database, 200, std::chrono::seconds(60));
-  ASSERT_TRUE(before && *before >= 200) << read_text(folder / "stderr.txt");
+      crash::wait_until_recording(cli, database, 200, std::chrono::seconds(60), folder);
+  if (!before) return;
   ASSERT_EQ(kill(cli, SIGTERM), 0);
   ASSERT_EQ(wait_for(cli), 0) << read_text(folder / "stderr.txt");
   EXPECT_NE(read_text(folder / "stdout.txt").find("(complete, ended by SIGTERM)"),
@@ -212,12 +211,8 @@ TEST(CliRecordCrash, AFileSystemTurnedReadOnlyStopsTheRecordingWithTheFileNamed)
                                       folder, problem);
   if (cli < 0) GTEST_SKIP() << problem;
   const std::optional<std::int64_t> before =
-      crash::wait_for_committed(database, 300, std::chrono::seconds(60));
-  if (!before || *before < 300) {
-    kill(cli, SIGKILL);
-    wait_for(cli);
-    FAIL() << "no session recorded: " << read_text(folder / "stderr.txt");
-  }
+      crash::wait_until_recording(cli, database, 300, std::chrono::seconds(60), folder);
+  if (!before) return;
   file_system.make_read_only();
   EXPECT_EQ(wait_for(cli), 1);
   const std::string stderr_text = read_text(folder / "stderr.txt");

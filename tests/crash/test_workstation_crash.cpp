@@ -102,22 +102,19 @@ class WorkstationCrash : public ::testing::Test {
   }
 
   // Starts the workstation recording to folder/sessions.sqlite and waits until it has committed
-  // `frames` frames (the scene is built first); what it committed. Killed if it did not.
-  std::int64_t startRecording(const fs::path& folder, std::int64_t frames) {
+  // `frames` frames (the scene is built first); what it committed, none (a failure) if it did not.
+  std::optional<std::int64_t> startRecording(const fs::path& folder, std::int64_t frames) {
     database_ = folder / "sessions.sqlite";
     running_ =
         crash::spawn(workstation(folder, recording(database_, write_trajectory(folder))), folder);
-    EXPECT_GT(running_, 0);
-    const std::optional<std::int64_t> committed =
-        crash::wait_for_committed(database_, frames, std::chrono::seconds(90));
-    if (running_ > 0 && !(committed && *committed >= frames)) {
-      kill(running_, SIGKILL);
-      wait_for(running_);
-      ADD_FAILURE() << "the workstation recorded no session: " << read_text(folder / "stderr.txt");
-      return 0;
+    if (running_ <= 0) {
+      ADD_FAILURE() << "the workstation could not be started";
+      return std::nullopt;
     }
-    return *committed;
+    return crash::wait_until_recording(running_, database_, frames, kStartPatience, folder);
   }
+
+  static constexpr std::chrono::seconds kStartPatience{90};  // the scene is built first
 
   fs::path database_;
   pid_t running_ = -1;
@@ -125,18 +122,19 @@ class WorkstationCrash : public ::testing::Test {
 
 TEST_F(WorkstationCrash, KilledMidSessionItLosesNothingCommittedAndTheNextStartRecovers) {
   const fs::path folder = fresh_folder("killed-mid-session");
-  const std::int64_t before = startRecording(folder, 500);  // half a second of frames committed
-  if (HasFailure()) return;
+  // Half a second of frames committed.
+  const std::optional<std::int64_t> before = startRecording(folder, 500);
+  if (!before) return;
   // The next start (opening for writing): the session is over, not lost.
-  crash::kill_and_expect_recovery(running_, database_, before);
+  crash::kill_and_expect_recovery(running_, database_, *before);
   if (HasFatalFailure()) return;
   expect_the_next_start_records(folder, database_);
 }
 
 TEST_F(WorkstationCrash, SigtermEndsTheSessionNormally) {
   const fs::path folder = fresh_folder("sigterm");
-  const std::int64_t before = startRecording(folder, 300);
-  if (HasFailure()) return;
+  const std::optional<std::int64_t> before = startRecording(folder, 300);
+  if (!before) return;
   ASSERT_EQ(kill(running_, SIGTERM), 0);
   EXPECT_EQ(wait_for(running_), 0) << read_text(folder / "stderr.txt");
   EXPECT_NE(read_text(folder / "stderr.txt").find("SIGTERM: closing"), std::string::npos);
@@ -144,7 +142,7 @@ TEST_F(WorkstationCrash, SigtermEndsTheSessionNormally) {
   const std::vector<SessionSummary> sessions = store.sessions();
   ASSERT_EQ(sessions.size(), 1u);
   EXPECT_EQ(sessions[0].status, SessionStatus::complete);
-  EXPECT_GE(sessions[0].frame_count, before);
+  EXPECT_GE(sessions[0].frame_count, *before);
 }
 
 // A real full disk: the sessions file on a 256 KiB tmpfs, in a user and mount namespace. The
@@ -188,12 +186,8 @@ TEST_F(WorkstationCrash, AFileSystemTurnedReadOnlyStopsTheRecordingWithItsMessag
       workstation(folder, recording(database, write_trajectory(folder))), folder, problem);
   if (running < 0) GTEST_SKIP() << problem;
   const std::optional<std::int64_t> before =
-      crash::wait_for_committed(database, 500, std::chrono::seconds(90));
-  if (!before || *before < 500) {
-    kill(running, SIGKILL);
-    wait_for(running);
-    FAIL() << "the workstation recorded no session: " << read_text(folder / "stderr.txt");
-  }
+      crash::wait_until_recording(running, database, 500, kStartPatience, folder);
+  if (!before) return;
   file_system.make_read_only();
   const bool stopped =
       wait_for_text(folder / "stderr.txt", "Recording stopped", std::chrono::seconds(60));

@@ -33,7 +33,7 @@ constexpr const char* kPassword = "seed password";
 constexpr const char* kTrainee = "trainee-a";
 constexpr const char* kServer = "fuzz-server";
 
-// A transfer's chunks read through as the upload streams them; each within the session's count.
+// A transfer's chunks read through as the upload streams them; none starts or counts below 0.
 void read_chunks(const ChunkSource& source) {
   if (!source) return;
   source(
@@ -44,7 +44,6 @@ void load_everything(const std::filesystem::path& file, SqliteSessionStore::Acce
   const std::string name = file.string();
   load(name, [&] {
     SqliteSessionStore store(file, access);
-    store.set_password_cost_for_testing(kCheapPasswordCostForTesting);
     load(name, [&] { store.schema_version(); });
     load(name, [&] { store.integrity_check(); });
     // A log-in runs the hash the file holds, at the cost the file says; only when there are
