@@ -2,13 +2,14 @@
 
 #include "cli_commands.h"
 
-#include "liversim/core/accuracy_study.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/forces_variants.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/liver_geometry.h"
-#include "liversim/core/performance.h"
-#include "liversim/core/seed_experiments.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/meshing/liver_geometry.h"
+#include "liversim/studies/accuracy_study.h"
+#include "liversim/studies/forces_variants.h"
+#include "liversim/studies/performance.h"
+#include "liversim/studies/seed_experiments.h"
 
 #include <CLI/CLI.hpp>
 

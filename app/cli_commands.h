@@ -2,8 +2,8 @@
 // The headless commands of liversim-cli. Each returns the process exit code and reports problems
 // on stderr as "liversim-cli: error: ...".
 
-#include "liversim/core/default_scene.h"
-#include "liversim/core/model.h"
+#include "liversim/engine/model.h"
+#include "liversim/meshing/default_scene.h"
 
 #include <Eigen/Core>
 

@@ -2,10 +2,11 @@
 
 #include "cli_commands.h"
 
-#include "liversim/core/cutting.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/surface_bvh.h"
-#include "liversim/core/worker_pool.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/surface_bvh.h"
+#include "liversim/engine/worker_pool.h"
+#include "liversim/interaction/cutting.h"
+#include "liversim/meshing/default_scene.h"
 
 #include <CLI/CLI.hpp>
 

@@ -2,9 +2,9 @@
 
 #include "cli_commands.h"
 
-#include "liversim/core/default_scene.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/seed_experiments.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/studies/seed_experiments.h"
 
 #include <CLI/CLI.hpp>
 

@@ -2,8 +2,8 @@
 
 #include "cli_commands.h"
 
-#include "liversim/core/default_scene.h"
-#include "liversim/core/liver_geometry.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/meshing/liver_geometry.h"
 
 #ifdef LIVERSIM_HAVE_RENDER
 #include "render/liver_scene.h"

@@ -1,12 +1,13 @@
 #include "servo_bench_command.h"
 
 #include "cli_commands.h"
-#include "liversim/core/cutting.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/emulated_devices.h"
-#include "liversim/core/realtime_simulation.h"
-#include "liversim/core/servo_loop.h"
-#include "liversim/core/worker_pool.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/worker_pool.h"
+#include "liversim/haptics/emulated_devices.h"
+#include "liversim/haptics/servo_loop.h"
+#include "liversim/interaction/cutting.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/simulation/realtime_simulation.h"
 
 #include <CLI/CLI.hpp>
 

@@ -1,7 +1,7 @@
 #include "sessions_command.h"
 
-#include "liversim/core/scenario.h"
-#include "liversim/core/session_export.h"
+#include "liversim/scenario/scenario.h"
+#include "liversim/sessions/session_export.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "server_command.h"
 

@@ -2,8 +2,8 @@
 
 #include "cli_commands.h"
 
-#include "liversim/core/parameter_ranges.h"
-#include "liversim/core/stability_suite.h"
+#include "liversim/engine/parameter_ranges.h"
+#include "liversim/studies/stability_suite.h"
 
 #include <CLI/CLI.hpp>
 
@@ -107,7 +107,8 @@ int run_suite(const StabilityStudyOptions& o) {
      << std::thread::hardware_concurrency()
      << " hardware threads, one used; wall times are of that run). The cases, their checks and "
         "where each limit comes from are in [stability.md](stability.md) and "
-        "`core/src/stability_case*.cpp`. Energy created: the largest energy created over the run "
+        "`core/studies/src/stability_case*.cpp`. Energy created: the largest energy created over "
+        "the run "
         "as "
         "a fraction of the energy supplied (initial + work of loads and tools), 0 when the books "
         "showed only dissipation; dissipated: the share of the energy supplied that viscosity, "

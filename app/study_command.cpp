@@ -3,7 +3,7 @@
 #include "cli_commands.h"
 #include "stability_command.h"
 
-#include "liversim/core/accuracy_study.h"
+#include "liversim/studies/accuracy_study.h"
 
 #ifdef LIVERSIM_HAVE_RENDER
 #include "render/curve_plot.h"

@@ -5,8 +5,8 @@
 #include "translations.h"
 #include "vtk_viewport.h"
 
-#include "liversim/core/default_scene.h"
-#include "liversim/core/scenario.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/scenario/scenario.h"
 
 #include <QApplication>
 #include <QCommandLineParser>

@@ -1,6 +1,6 @@
 #include "accuracy_panel.h"
 
-#include "liversim/core/integrator.h"
+#include "liversim/engine/integrator.h"
 
 #include <QComboBox>
 #include <QDoubleSpinBox>

@@ -3,7 +3,7 @@
 // (or, for the adaptive dopri5, what error tolerance). Shows the setting in use, lets the user edit
 // it and asks for it to be applied; whoever applies it reports back whether that worked.
 
-#include "liversim/core/model.h"
+#include "liversim/engine/model.h"
 
 #include <QWidget>
 

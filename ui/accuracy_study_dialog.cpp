@@ -2,7 +2,7 @@
 
 #include "accuracy_panel.h"
 
-#include "liversim/core/liver_geometry.h"
+#include "liversim/meshing/liver_geometry.h"
 
 #include <QCheckBox>
 #include <QComboBox>

@@ -5,7 +5,7 @@
 // A run's setting can be put to use on the running liver. `liversim-cli study accuracy` runs the
 // full grid and writes docs/accuracy-study.md.
 
-#include "liversim/core/accuracy_study.h"
+#include "liversim/studies/accuracy_study.h"
 
 #include <QDialog>
 

@@ -5,7 +5,7 @@
 
 #include "haptic_preferences.h"
 
-#include "liversim/core/haptics.h"
+#include "liversim/haptics/haptics.h"
 
 #include <QWidget>
 

@@ -3,7 +3,7 @@
 // over the mapping's scale), each bucket of frames shown as its largest force, so that a peak is
 // never averaged away however long the session.
 
-#include "liversim/core/servo_loop.h"
+#include "liversim/haptics/servo_loop.h"
 
 #include <QAbstractSeries>
 #include <QChart>

@@ -2,7 +2,7 @@
 // The haptic device the workstation uses and how it is mapped, kept in the user's settings
 // (QSettings, group "haptics") so that a trainee's calibration survives a restart.
 
-#include "liversim/core/haptics.h"
+#include "liversim/haptics/haptics.h"
 
 #include <QString>
 

@@ -2,7 +2,7 @@
 
 #include "parameter_spin_box.h"
 
-#include "liversim/core/parameter_ranges.h"
+#include "liversim/engine/parameter_ranges.h"
 
 #include <QDoubleSpinBox>
 #include <QFormLayout>

@@ -5,7 +5,7 @@
 // scene leaves off are not shown: they are not simulated. In trainee mode the values are shown but
 // cannot be changed.
 
-#include "liversim/core/scenario.h"
+#include "liversim/scenario/scenario.h"
 
 #include <QWidget>
 

@@ -1,6 +1,6 @@
 #include "recent_scenarios.h"
 
-#include "liversim/core/data_paths.h"
+#include "liversim/scenario/data_paths.h"
 
 #include <QDir>
 #include <QFileInfo>

@@ -3,7 +3,7 @@
 // undo history of its edits. Every edit goes through edit(), so every edit can be undone; saving
 // validates first and refuses a scenario with errors.
 
-#include "liversim/core/scenario.h"
+#include "liversim/scenario/scenario.h"
 
 #include <QObject>
 #include <QString>

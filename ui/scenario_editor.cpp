@@ -7,9 +7,9 @@
 #include "render/scenario_overlay.h"
 #include "vtk_viewport.h"
 
-#include "liversim/core/parameter_ranges.h"
-#include "liversim/core/performance.h"
-#include "liversim/core/surface_import.h"
+#include "liversim/engine/parameter_ranges.h"
+#include "liversim/meshing/surface_import.h"
+#include "liversim/studies/performance.h"
 
 #include <vtkCamera.h>
 #include <vtkGenericOpenGLRenderWindow.h>

@@ -7,7 +7,7 @@
 
 #include "scenario_document.h"
 
-#include "liversim/core/default_scene.h"
+#include "liversim/meshing/default_scene.h"
 
 #include <QMainWindow>
 #include <QPoint>

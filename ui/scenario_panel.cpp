@@ -1,6 +1,6 @@
 #include "scenario_panel.h"
 
-#include "liversim/core/tools.h"
+#include "liversim/interaction/tools.h"
 
 #include <QFileInfo>
 #include <QLabel>

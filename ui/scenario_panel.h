@@ -3,7 +3,7 @@
 // time limit, the tools it allows and the effects it simulates, and the file it came from. Without
 // a scenario it says the window is in free practice and how to open one.
 
-#include "liversim/core/scenario.h"
+#include "liversim/scenario/scenario.h"
 
 #include <QWidget>
 

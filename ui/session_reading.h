@@ -4,7 +4,7 @@
 // kSessionReadingDialogDelayMs. The dialog is window-modal and keeps the interface responsive
 // while it reads on the GUI thread, chunk by chunk.
 
-#include "liversim/core/session_log.h"
+#include "liversim/sessions/session_store.h"
 
 #include <QString>
 

@@ -6,7 +6,7 @@
 #include "storage_messages.h"
 #include "vtk_viewport.h"
 
-#include "liversim/core/scenario.h"
+#include "liversim/scenario/scenario.h"
 #include "liversim/storage/sqlite_session_store.h"
 
 #include <vtkGenericOpenGLRenderWindow.h>

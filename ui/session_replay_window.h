@@ -6,8 +6,8 @@
 // and the replayed force on the tool beside it. The liver can be seen through, with the lesions
 // of the session's scenario inside it.
 
-#include "liversim/core/session_log.h"
-#include "liversim/core/session_replay.h"
+#include "liversim/sessions/session_replay.h"
+#include "liversim/sessions/session_store.h"
 
 #include <QElapsedTimer>
 #include <QString>

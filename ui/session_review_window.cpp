@@ -5,8 +5,8 @@
 #include "session_replay_window.h"
 #include "storage_messages.h"
 
-#include "liversim/core/scenario.h"
-#include "liversim/core/session_export.h"
+#include "liversim/scenario/scenario.h"
+#include "liversim/sessions/session_export.h"
 #include "liversim/storage/sqlite_session_store.h"
 
 #include <QBuffer>

@@ -4,8 +4,8 @@
 // the overall score, the force on the device over time with the session's events, and a grade
 // and comment saved to the database (docs/session-storage.md).
 
-#include "liversim/core/grading.h"
-#include "liversim/core/session_log.h"
+#include "liversim/sessions/grading.h"
+#include "liversim/sessions/session_store.h"
 #include "session_reading.h"
 
 #include <QPointer>

@@ -2,7 +2,7 @@
 // A storage error as the workstation says it: what went wrong (the store's own message, which
 // names the file) and what the user can do about it.
 
-#include "liversim/core/session_log.h"
+#include "liversim/sessions/session_store.h"
 
 #include <QString>
 

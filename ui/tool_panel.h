@@ -3,7 +3,7 @@
 // scalpel, and the force the tissue puts on it, live as a number and as a trace of the last
 // seconds.
 
-#include "liversim/core/tools.h"
+#include "liversim/interaction/tools.h"
 
 #include <QWidget>
 

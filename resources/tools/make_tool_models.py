@@ -7,7 +7,7 @@ bytes.
 
 Units: millimetres (the simulator scales the files by 1e-3 when it reads them).
 
-Frame: the tool's own, the one its physics capsules use (core/include/liversim/core/tools.h).
+Frame: the tool's own, the one its physics capsules use (core/interaction/include/liversim/interaction/tools.h).
 Right-handed; the working end (probe ball centre, jaw hinge, blade heel) is at the origin; the
 shaft runs along +z toward the surgeon's hand; the jaws and the blade reach along -z; the forceps
 jaws open in the x-z plane, each turning about the y axis through the origin.

@@ -1,7 +1,7 @@
 #pragma once
 // Test meshes: the box meshes of core (box_mesh.h) under the names the tests use.
 
-#include "liversim/core/box_mesh.h"
+#include "liversim/meshing/box_mesh.h"
 
 namespace liversim::testing {
 

@@ -1,6 +1,6 @@
 // The accuracy study runs its grid, measures errors against its reference and costs, and refuses
 // options it cannot honour with a message naming them.
-#include "liversim/core/accuracy_study.h"
+#include "liversim/studies/accuracy_study.h"
 
 #include <gtest/gtest.h>
 

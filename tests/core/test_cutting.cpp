@@ -4,12 +4,13 @@
 // pieces that come free.
 #include "block_mesh.h"
 
-#include "liversim/core/cutting.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/forces.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/mesh_quality.h"
-#include "liversim/core/model.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/mesh_quality.h"
+#include "liversim/engine/model.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/interaction/cutting.h"
+#include "liversim/meshing/default_scene.h"
 
 #include <gtest/gtest.h>
 

@@ -2,10 +2,10 @@
 // material.cpp and fibres.cpp element by element: stretched, compressed below the volumetric
 // continuation's J0, inverted, and fibres past the exponential's guard. Enough elements that the
 // vector body and the remainder loop both run.
-#include "../../core/src/element_kernels.h"
+#include "../../core/engine/src/element_kernels.h"
 
-#include "liversim/core/fibres.h"
-#include "liversim/core/material.h"
+#include "liversim/engine/fibres.h"
+#include "liversim/engine/material.h"
 
 #include <gtest/gtest.h>
 

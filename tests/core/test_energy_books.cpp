@@ -2,9 +2,10 @@
 // what the Maxwell arms' dashpots dissipated.
 #include "block_mesh.h"
 
-#include "liversim/core/energy.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/state.h"
+#include "liversim/engine/energy.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/state.h"
 
 #include <gtest/gtest.h>
 

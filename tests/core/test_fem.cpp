@@ -1,11 +1,12 @@
 #include "block_mesh.h"
 
-#include "liversim/core/forces.h"
-#include "liversim/core/grab.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/liver_geometry.h"
-#include "liversim/core/state.h"
-#include "liversim/core/surface.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/state.h"
+#include "liversim/engine/surface.h"
+#include "liversim/interaction/grab.h"
+#include "liversim/meshing/liver_geometry.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>

@@ -1,9 +1,10 @@
 #include "block_mesh.h"
 
-#include "liversim/core/fibres.h"
-#include "liversim/core/forces.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/state.h"
+#include "liversim/engine/fibres.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/state.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>

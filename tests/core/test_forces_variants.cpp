@@ -3,8 +3,9 @@
 // a scene that has it on.
 #include "block_mesh.h"
 
-#include "liversim/core/forces.h"
-#include "liversim/core/forces_variants.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/studies/forces_variants.h"
 
 #include <gtest/gtest.h>
 

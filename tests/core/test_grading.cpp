@@ -1,6 +1,6 @@
 // Grading a session against its scenario's rubric (issue 10): pass rules, weights, missing
 // metrics, and the score, against answers worked out by hand.
-#include "liversim/core/grading.h"
+#include "liversim/sessions/grading.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
 // The haptic force path (issue 8) without hardware: units through the workspace mapping, the
 // renderer's clamps, rate limit and watchdog under adversarial models, passivity against a stiff
 // wall, the servo thread's rate, the lock-free exchanges, and replay of a logged session.
-#include "liversim/core/emulated_devices.h"
-#include "liversim/core/haptics.h"
-#include "liversim/core/servo_loop.h"
-#include "liversim/core/spsc_ring.h"
-#include "liversim/core/triple_buffer.h"
+#include "liversim/haptics/emulated_devices.h"
+#include "liversim/haptics/haptics.h"
+#include "liversim/haptics/servo_loop.h"
+#include "liversim/haptics/spsc_ring.h"
+#include "liversim/haptics/triple_buffer.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>

@@ -2,7 +2,8 @@
 // the state goes back to the last good one, the problem is reported, and the simulation goes on.
 #include "block_mesh.h"
 
-#include "liversim/core/health.h"
+#include "liversim/engine/health.h"
+#include "liversim/engine/model_building.h"
 
 #include <gtest/gtest.h>
 

@@ -3,10 +3,11 @@
 // unstable recipe (RK4, Δt = 2 ms, ν = 0.49) runs without blowing up and says what it did.
 #include "block_mesh.h"
 
-#include "liversim/core/default_scene.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/liver_geometry.h"
-#include "liversim/core/mesh_io.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/mesh_io.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/meshing/liver_geometry.h"
 
 #include <gtest/gtest.h>
 

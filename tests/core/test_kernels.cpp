@@ -3,10 +3,11 @@
 // evaluation of the same laws gives, to round-off, for every combination of effects.
 #include "block_mesh.h"
 
-#include "liversim/core/fibres.h"
-#include "liversim/core/forces.h"
-#include "liversim/core/material.h"
-#include "liversim/core/state.h"
+#include "liversim/engine/fibres.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/material.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/state.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-#include "liversim/core/liver_geometry.h"
-#include "liversim/core/mesh_quality.h"
-#include "liversim/core/surface.h"
+#include "liversim/engine/mesh_quality.h"
+#include "liversim/engine/surface.h"
+#include "liversim/meshing/liver_geometry.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,9 @@
 // Volumetric locking of linear tetrahedra at ν = 0.49 in bending, and average nodal pressure.
 #include "block_mesh.h"
 
-#include "liversim/core/integrator.h"
-#include "liversim/core/state.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/state.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Tests of the Abaqus and Gmsh tetrahedral mesh readers, on a real liver mesh, on tiny hand-written
 // cubes, and on broken copies of both.
 
-#include "liversim/core/mesh_io.h"
+#include "liversim/engine/mesh_io.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
-#include "liversim/core/mesh_quality.h"
-#include "liversim/core/surface.h"
+#include "liversim/engine/mesh_quality.h"
+#include "liversim/engine/surface.h"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,10 @@
 // The Mooney–Rivlin option and the objectivity of every energy.
 #include "block_mesh.h"
 
-#include "liversim/core/fibres.h"
-#include "liversim/core/forces.h"
-#include "liversim/core/material.h"
+#include "liversim/engine/fibres.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/material.h"
+#include "liversim/engine/model_building.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>

@@ -3,7 +3,8 @@
 // an answer worked out by hand, on synthetic geometry or a block cut by the real cutter.
 #include "block_mesh.h"
 
-#include "liversim/core/outcome_metrics.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/sessions/outcome_metrics.h"
 
 #include <gtest/gtest.h>
 
@@ -224,7 +225,7 @@ TEST(OutcomeMetrics, ResectingTheTopOfABlockMeasuresMarginPlaneVolumeAndSuccess)
   tracker.carry_over(cut);
   // The cut faces lie on z = 32 mm (snapped); the lesion ball of 2 mm around z = 37 mm is 3 mm
   // above them; the planned plane z = 30 mm is 2 mm below them everywhere.
-  const double spacing_mm = tracker.settings().margin_sample_spacing_mm;
+  const double spacing_mm = OutcomeSettings{}.margin_sample_spacing_mm;
   const Scenario wide = resection(2.0, 2.5);
   OutcomeMetrics m = compute_outcome_metrics(block.model, *cut.model, tracker, &wide, {});
   ASSERT_EQ(m.lesions.size(), 1u);

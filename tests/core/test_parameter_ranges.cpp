@@ -1,10 +1,10 @@
 // The documented parameter ranges (core/parameter_ranges.h): well formed, and every corner of
 // them accepted by the validators, so a scenario inside them always builds.
-#include "liversim/core/parameter_ranges.h"
+#include "liversim/engine/parameter_ranges.h"
 
-#include "liversim/core/fibres.h"
-#include "liversim/core/material.h"
-#include "liversim/core/viscous_tissue.h"
+#include "liversim/engine/fibres.h"
+#include "liversim/engine/material.h"
+#include "liversim/engine/viscous_tissue.h"
 
 #include <gtest/gtest.h>
 

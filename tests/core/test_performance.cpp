@@ -2,7 +2,8 @@
 // accounting is: state for an effect exists only when the effect is on.
 #include "block_mesh.h"
 
-#include "liversim/core/performance.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/studies/performance.h"
 
 #include <gtest/gtest.h>
 

@@ -2,13 +2,14 @@
 // and the backlog beyond the cap dropped (simulated time slows down instead of spiralling). The
 // clock is tested with made-up elapsed times; the running loop only for what a tiny cap on a
 // heavy model must give whatever the machine's speed.
-#include "liversim/core/cutting.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/emulated_devices.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/liver_geometry.h"
-#include "liversim/core/realtime_simulation.h"
-#include "liversim/core/surface.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/surface.h"
+#include "liversim/haptics/emulated_devices.h"
+#include "liversim/interaction/cutting.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/meshing/liver_geometry.h"
+#include "liversim/simulation/realtime_simulation.h"
 
 #include <gtest/gtest.h>
 

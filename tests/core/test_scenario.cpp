@@ -1,7 +1,8 @@
 // Scenario files: every field survives a save and a load, the shipped scenarios build, and each
 // file of the malformed corpus is refused with its own error naming the field.
-#include "liversim/core/model.h"
-#include "liversim/core/scenario.h"
+#include "liversim/engine/model.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/scenario/scenario.h"
 
 #include <gtest/gtest.h>
 

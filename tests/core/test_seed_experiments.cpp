@@ -1,8 +1,9 @@
 // The seed's experiments as runners: the load patch, the creep ramp, the feedback force of a pull
 // at equilibrium (bounded by the settle criterion) and the timing at the seed's step.
-#include "liversim/core/default_scene.h"
-#include "liversim/core/liver_geometry.h"
-#include "liversim/core/seed_experiments.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/meshing/liver_geometry.h"
+#include "liversim/studies/seed_experiments.h"
 
 #include <gtest/gtest.h>
 

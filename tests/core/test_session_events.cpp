@@ -1,5 +1,5 @@
 // Session events found from what the simulation showed at successive display frames (issue 10).
-#include "liversim/core/session_events.h"
+#include "liversim/sessions/session_events.h"
 
 #include <gtest/gtest.h>
 

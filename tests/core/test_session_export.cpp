@@ -1,5 +1,5 @@
 // Sessions as CSV (issue 10): RFC 4180 quoting, and the metrics against the rubric.
-#include "liversim/core/session_export.h"
+#include "liversim/sessions/session_export.h"
 
 #include <gtest/gtest.h>
 

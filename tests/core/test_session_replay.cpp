@@ -2,10 +2,11 @@
 // damaged chunk is refused naming what is wrong, and SessionReplay, built again from the scene,
 // goes through the run's states to the last bit however it is sought: straight to the end, in
 // steps of a few cycles, forward from the middle, or back to the middle (from rest again).
-#include "liversim/core/default_scene.h"
-#include "liversim/core/emulated_devices.h"
-#include "liversim/core/session_log.h"
-#include "liversim/core/session_replay.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/haptics/emulated_devices.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/sessions/session_replay.h"
+#include "liversim/sessions/session_store.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // SHA-256 against the FIPS 180-4 / NIST examples and around the padding boundary, where the length
 // no longer fits in the last block (55 bytes fit, 56 do not; 64 fill a block exactly).
-#include "liversim/core/sha256.h"
+#include "liversim/storage/sha256.h"
 
 #include <gtest/gtest.h>
 

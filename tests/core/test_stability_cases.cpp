@@ -1,7 +1,7 @@
 // The stability suite (issue 5): every named hard case of core's suite (stability_suite.h) must
 // pass each of its checks: no NaN or infinity, no give-up, energy books within their tolerance,
 // displacement bounded, and the case's own answers.
-#include "liversim/core/stability_suite.h"
+#include "liversim/studies/stability_suite.h"
 
 #include <gtest/gtest.h>
 

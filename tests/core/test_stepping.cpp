@@ -1,11 +1,12 @@
 // Stepping allocates nothing, and the real-time loop runs the liver off the caller's thread.
-#include "liversim/core/default_scene.h"
-#include "liversim/core/grab.h"
-#include "liversim/core/health.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/liver_geometry.h"
-#include "liversim/core/realtime_simulation.h"
-#include "liversim/core/tools.h"
+#include "liversim/engine/health.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/interaction/grab.h"
+#include "liversim/interaction/tools.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/meshing/liver_geometry.h"
+#include "liversim/simulation/realtime_simulation.h"
 
 #include <gtest/gtest.h>
 

@@ -2,8 +2,8 @@
 // visits exactly the triangles whose boxes overlap the query box, each once.
 #include "block_mesh.h"
 
-#include "liversim/core/surface.h"
-#include "liversim/core/surface_bvh.h"
+#include "liversim/engine/surface.h"
+#include "liversim/engine/surface_bvh.h"
 
 #include <gtest/gtest.h>
 

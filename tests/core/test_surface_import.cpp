@@ -1,12 +1,12 @@
 // Surface models (issue 9): the real liver of ../shared (Zhang's Liver_Iso.inp, its boundary)
 // written through assimp's exporters in every format the importer reads, read back, and
 // tetrahedralised by Gmsh at a requested count; broken surfaces refused, naming what and where.
-#include "liversim/core/default_scene.h"
-#include "liversim/core/mesh_io.h"
-#include "liversim/core/mesh_quality.h"
-#include "liversim/core/scenario.h"
-#include "liversim/core/surface.h"
-#include "liversim/core/surface_import.h"
+#include "liversim/engine/mesh_io.h"
+#include "liversim/engine/mesh_quality.h"
+#include "liversim/engine/surface.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/meshing/surface_import.h"
+#include "liversim/scenario/scenario.h"
 
 #include <assimp/scene.h>
 #include <gtest/gtest.h>

@@ -1,10 +1,11 @@
 // The tangent ∂P/∂F of every energy equals the finite-difference derivative of its stress.
 #include "block_mesh.h"
 
-#include "liversim/core/fibres.h"
-#include "liversim/core/forces.h"
-#include "liversim/core/material.h"
-#include "liversim/core/viscous_tissue.h"
+#include "liversim/engine/fibres.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/material.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/viscous_tissue.h"
 
 #include <gtest/gtest.h>
 

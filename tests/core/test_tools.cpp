@@ -3,10 +3,11 @@
 // base stands in for the liver.
 #include "block_mesh.h"
 
-#include "liversim/core/forces.h"
-#include "liversim/core/integrator.h"
-#include "liversim/core/model.h"
-#include "liversim/core/tools.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/interaction/tools.h"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // Trace metrics (docs/session-metrics.md) on synthetic servo traces whose answers follow by hand:
 // the frames are samples of piecewise-linear position and force, so a straight line's length, a
 // square wave's integrals and its crossing times are known in closed form.
-#include "liversim/core/scenario.h"
-#include "liversim/core/session_log.h"
-#include "liversim/core/trace_metrics.h"
+#include "liversim/scenario/scenario.h"
+#include "liversim/sessions/session_store.h"
+#include "liversim/sessions/trace_metrics.h"
 
 #include <gtest/gtest.h>
 

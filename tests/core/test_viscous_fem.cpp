@@ -2,8 +2,9 @@
 // permanent set of a bar loaded above its yield limit.
 #include "block_mesh.h"
 
-#include "liversim/core/integrator.h"
-#include "liversim/core/state.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/state.h"
 
 #include <gtest/gtest.h>
 

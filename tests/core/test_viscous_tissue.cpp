@@ -9,7 +9,7 @@
 // and the axial stress is φ convolved with (E1 + E2)·ε: the 1-D standard linear solid. The
 // remaining differences are geometric, of relative order ε.
 
-#include "liversim/core/viscous_tissue.h"
+#include "liversim/engine/viscous_tissue.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>

@@ -2,10 +2,10 @@
 // (surface.h, embed_points): what the see-through view draws lesions with.
 #include "block_mesh.h"
 
-#include "liversim/core/data_paths.h"
-#include "liversim/core/surface.h"
-#include "liversim/core/surface_import.h"
-#include "liversim/core/visual_model.h"
+#include "liversim/engine/surface.h"
+#include "liversim/meshing/surface_import.h"
+#include "liversim/meshing/visual_model.h"
+#include "liversim/scenario/data_paths.h"
 
 #include <gtest/gtest.h>
 

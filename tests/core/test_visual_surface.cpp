@@ -1,5 +1,5 @@
-#include "liversim/core/default_scene.h"
-#include "liversim/core/surface.h"
+#include "liversim/engine/surface.h"
+#include "liversim/meshing/default_scene.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The worker pool runs every chunk of a job exactly once, on more than one thread, and falls back
 // to the caller's thread when it is busy; jobs follow each other without loss.
-#include "liversim/core/worker_pool.h"
+#include "liversim/engine/worker_pool.h"
 
 #include <gtest/gtest.h>
 

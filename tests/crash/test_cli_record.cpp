@@ -2,7 +2,7 @@
 // recorder killed with SIGKILL mid-session (nothing committed is lost, the next run recovers); a
 // real full disk (a tiny tmpfs in a user and mount namespace); the database's file system turning
 // read-only mid-session. Runs the real binary; needs no display.
-#include "liversim/core/session_replay.h"
+#include "liversim/sessions/session_replay.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "process_faults.h"
 

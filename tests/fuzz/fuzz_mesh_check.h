@@ -4,7 +4,7 @@
 // coordinates, and named sets of valid, sorted, distinct indices.
 
 #include "fuzz_support.h"
-#include "liversim/core/tet_mesh.h"
+#include "liversim/engine/tet_mesh.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 
 #include "fuzz_mesh_check.h"
 #include "fuzz_support.h"
-#include "liversim/core/mesh_io.h"
+#include "liversim/engine/mesh_io.h"
 
 #include <cstddef>
 #include <cstdint>

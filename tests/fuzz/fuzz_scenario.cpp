@@ -3,7 +3,7 @@
 // reads back the same after write_scenario (what the editor saves is what it opens).
 
 #include "fuzz_support.h"
-#include "liversim/core/scenario.h"
+#include "liversim/scenario/scenario.h"
 
 #include <cstddef>
 #include <cstdint>

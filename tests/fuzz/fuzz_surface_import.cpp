@@ -5,7 +5,7 @@
 // orient_outward) must not fail on what it returns. Gmsh's meshing is not fuzzed (docs/fuzzing.md).
 
 #include "fuzz_support.h"
-#include "liversim/core/surface_import.h"
+#include "liversim/meshing/surface_import.h"
 
 #include <cstddef>
 #include <cstdint>

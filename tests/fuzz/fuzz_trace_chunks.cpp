@@ -4,7 +4,7 @@
 // fixed point (inputs: a flag byte other than 0 or 1 reads as 1).
 
 #include "fuzz_support.h"
-#include "liversim/core/session_log.h"
+#include "liversim/sessions/session_store.h"
 
 #include <cstddef>
 #include <cstdint>

@@ -5,9 +5,9 @@
 //   build/fuzz/tests/fuzz/liversim_fuzz_make_seeds tests/fuzz/corpus
 // (any build tree will do). The seeds are committed; this is how they were made.
 
-#include "liversim/core/scenario.h"
-#include "liversim/core/session_log.h"
-#include "liversim/core/surface_import.h"
+#include "liversim/meshing/surface_import.h"
+#include "liversim/scenario/scenario.h"
+#include "liversim/sessions/session_store.h"
 #include "liversim/storage/sqlite_session_store.h"
 
 #include <assimp/postprocess.h>

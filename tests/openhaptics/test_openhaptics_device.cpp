@@ -1,8 +1,8 @@
 // The OpenHaptics driver against fake_hd.cpp, a libHD.so of our own that emulates a PHANTOM Omni:
 // loading and its failures, the device's limits and units, the servo tick on the vendor's
 // scheduler, error classes, and shutdown.
-#include "liversim/core/openhaptics_device.h"
-#include "liversim/core/servo_loop.h"
+#include "liversim/haptics/openhaptics_device.h"
+#include "liversim/haptics/servo_loop.h"
 
 #include <dlfcn.h>
 #include <gtest/gtest.h>

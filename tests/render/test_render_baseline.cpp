@@ -31,12 +31,13 @@
 #include <string>
 #include <vector>
 
-#include "liversim/core/cutting.h"
-#include "liversim/core/data_paths.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/scenario.h"
-#include "liversim/core/state.h"
-#include "liversim/core/surface.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/state.h"
+#include "liversim/engine/surface.h"
+#include "liversim/interaction/cutting.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/scenario/data_paths.h"
+#include "liversim/scenario/scenario.h"
 #include "render/liver_scene.h"
 
 namespace liversim {

@@ -2,7 +2,7 @@
 // A finished session as a workstation records it, written to a sessions database: for the
 // training centre's tests and its load bench.
 
-#include "liversim/core/integrator.h"
+#include "liversim/engine/integrator.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "synthetic_frames.h"
 

@@ -6,9 +6,9 @@
 // Usage: liversim_session_writer_child DATABASE [--seconds S] [--fresh]
 // --fresh removes DATABASE first. Prints "epoch_ns N" (the servo clock's zero on the steady
 // clock) and "session ID", then runs.
-#include "liversim/core/emulated_devices.h"
-#include "liversim/core/servo_loop.h"
-#include "liversim/core/session_recorder.h"
+#include "liversim/haptics/emulated_devices.h"
+#include "liversim/haptics/servo_loop.h"
+#include "liversim/sessions/session_recorder.h"
 #include "liversim/storage/sqlite_session_store.h"
 
 #include <chrono>

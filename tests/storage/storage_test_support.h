@@ -2,7 +2,7 @@
 // What the storage tests share: fresh database paths, frames that cannot read back right by
 // accident, and their exact comparison.
 
-#include "liversim/core/servo_loop.h"
+#include "liversim/haptics/servo_loop.h"
 #include "synthetic_frames.h"
 
 #include <gtest/gtest.h>

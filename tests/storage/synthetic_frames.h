@@ -1,7 +1,7 @@
 #pragma once
 // Servo frames for storage tests and benches.
 
-#include "liversim/core/servo_loop.h"
+#include "liversim/haptics/servo_loop.h"
 
 #include <cstdint>
 #include <random>

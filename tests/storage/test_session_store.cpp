@@ -1,6 +1,6 @@
 // The embedded session store on real SQLite files: sessions written and read back exactly, a
 // writer killed mid-session, and files that are damaged, foreign, newer, read-only or full.
-#include "liversim/core/session_recorder.h"
+#include "liversim/sessions/session_recorder.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "storage_test_support.h"
 

@@ -1,7 +1,7 @@
 // The training centre against a real PostgreSQL server (a throwaway cluster on loopback): the
 // schema and its migration, uploads exactly once, an upload cut by the server stopping, grades
 // and scenarios shared, the roles enforced by the server as well as by the application, and TLS.
-#include "liversim/core/integrator.h"
+#include "liversim/engine/integrator.h"
 #include "liversim/storage/postgres_session_store.h"
 #include "liversim/storage/session_upload.h"
 #include "liversim/storage/sqlite_session_store.h"

@@ -2,8 +2,8 @@
 // Where the palpation tests hold the probe: 10 mm outside the surface node nearest a lesion's
 // centre, so that the probe's ball (3 mm) is clear of the curved surface around it.
 
-#include "liversim/core/cutting.h"
-#include "liversim/core/model.h"
+#include "liversim/engine/model.h"
+#include "liversim/interaction/cutting.h"
 
 #include <Eigen/Core>
 

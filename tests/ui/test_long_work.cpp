@@ -24,7 +24,7 @@
 
 #include "accuracy_panel.h"
 #include "accuracy_study_dialog.h"
-#include "liversim/core/default_scene.h"
+#include "liversim/meshing/default_scene.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
 #include "session_review_window.h"

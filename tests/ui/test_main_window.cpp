@@ -32,8 +32,8 @@
 #include <optional>
 
 #include "accuracy_panel.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/integrator.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/meshing/default_scene.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
 #include "render/liver_scene.h"

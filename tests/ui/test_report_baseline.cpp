@@ -9,7 +9,7 @@
 //
 // Updating the baseline after an intended change: run the test, look at the picture it names, and
 // copy it over tests/baselines/instructor_report.png.
-#include "liversim/core/scenario.h"
+#include "liversim/scenario/scenario.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "session_review_window.h"
 #include "translations.h"

@@ -25,8 +25,8 @@
 
 #include <memory>
 
-#include "liversim/core/default_scene.h"
-#include "liversim/core/scenario.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/scenario/scenario.h"
 #include "main_window.h"
 #include "render/liver_scene.h"
 #include "render/scenario_overlay.h"

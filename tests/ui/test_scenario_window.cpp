@@ -23,10 +23,10 @@
 #include <memory>
 
 #include "accuracy_panel.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/mesh_io.h"
-#include "liversim/core/scenario.h"
-#include "liversim/core/surface.h"
+#include "liversim/engine/mesh_io.h"
+#include "liversim/engine/surface.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/scenario/scenario.h"
 #include "main_window.h"
 #include "recent_scenarios.h"
 #include "scenario_panel.h"

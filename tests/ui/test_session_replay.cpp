@@ -5,8 +5,8 @@
 // it uncut again, play moves the cursor over the force plot and pause holds it. A session
 // recorded before replays existed says why it cannot be replayed. The replay sees through the
 // liver to the scenario's lesions.
-#include "liversim/core/scenario.h"
-#include "liversim/core/session_replay.h"
+#include "liversim/scenario/scenario.h"
+#include "liversim/sessions/session_replay.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
 #include "render/liver_scene.h"

@@ -4,7 +4,7 @@
 #include "main_window.h"
 #include "translations.h"
 
-#include "liversim/core/default_scene.h"
+#include "liversim/meshing/default_scene.h"
 
 #include <gtest/gtest.h>
 #include <QAbstractButton>

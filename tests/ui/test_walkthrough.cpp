@@ -20,9 +20,9 @@
 
 #include "device_panel.h"
 #include "haptic_preferences.h"
-#include "liversim/core/data_paths.h"
-#include "liversim/core/default_scene.h"
-#include "liversim/core/emulated_devices.h"
+#include "liversim/haptics/emulated_devices.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/scenario/data_paths.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
 #include "palpation_points.h"

@@ -16,7 +16,7 @@
 #include <memory>
 
 #include "instructor_login_dialog.h"
-#include "liversim/core/default_scene.h"
+#include "liversim/meshing/default_scene.h"
 #include "main_window.h"
 #include "material_panel.h"
 #include "wait_limits.h"

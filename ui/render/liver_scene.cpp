@@ -3,10 +3,10 @@
 #include "render/offscreen_png.h"
 #include "render/scenario_overlay.h"
 
-#include "liversim/core/cutting.h"
-#include "liversim/core/data_paths.h"
-#include "liversim/core/haptics.h"
-#include "liversim/core/surface_import.h"
+#include "liversim/haptics/haptics.h"
+#include "liversim/interaction/cutting.h"
+#include "liversim/meshing/surface_import.h"
+#include "liversim/scenario/data_paths.h"
 
 #include <vtkActor.h>
 #include <vtkCamera.h>

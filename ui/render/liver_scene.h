@@ -3,12 +3,12 @@
 // and conversion between the screen and the scene. VTK only (no Qt): the workstation, the CLI and
 // the rendering tests share it.
 
-#include "liversim/core/model.h"
-#include "liversim/core/scenario.h"
-#include "liversim/core/surface.h"
-#include "liversim/core/tet_mesh.h"
-#include "liversim/core/tools.h"
-#include "liversim/core/visual_model.h"
+#include "liversim/engine/model.h"
+#include "liversim/engine/surface.h"
+#include "liversim/engine/tet_mesh.h"
+#include "liversim/interaction/tools.h"
+#include "liversim/meshing/visual_model.h"
+#include "liversim/scenario/scenario.h"
 
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>

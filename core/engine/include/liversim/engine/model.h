@@ -1,0 +1,143 @@
+#pragma once
+// The constant simulation model, built once from a mesh and a scenario's settings. Everything that
+// changes while simulating lives in SimState (state.h); stepping reads the model and never writes
+// it.
+
+#include "liversim/engine/fibres.h"
+#include "liversim/engine/material.h"
+#include "liversim/engine/tet_mesh.h"
+#include "liversim/engine/viscous_tissue.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace liversim {
+
+// What one region of the organ is made of: the parenchyma (region 0) or a lesion.
+struct RegionMaterial {
+  TissueMaterial tissue;
+  std::optional<FibreParameters> fibres;  // none: isotropic
+  // Seed Eq. 1–3. When given, tissue.youngs_modulus_pa must be the instantaneous modulus E1 + E2
+  // and tissue.mooney_rivlin_fraction 0 (the viscous law's elastic base is Neo-Hookean).
+  std::optional<ViscoelasticParameters> viscoelastic;
+  // Seed Eq. 4, in series; needs `viscoelastic`.
+  std::optional<ViscoplasticParameters> viscoplastic;
+};
+
+// Reference fibre directions (normalised when the model is built): empty for no family, one vector
+// for a uniform direction, or one per element.
+struct FibreField {
+  std::vector<Eigen::Vector3d> first_family;
+  std::vector<Eigen::Vector3d> second_family;
+};
+
+// Effects the model computes; the element kernel is chosen from these once, and an effect that is
+// off costs nothing in the step.
+struct EffectSet {
+  bool fibres = false;
+  bool viscous = false;  // viscoelasticity (and viscoplasticity) in some region
+  // Near-incompressibility on linear tetrahedra: the λ part of the pressure is taken from the
+  // average nodal volume ratio (Joldes, Wittek & Miller 2009; NiftySim's T4ANP), not the element's.
+  bool average_nodal_pressure = false;
+  bool mooney_rivlin = false;  // some region has a Mooney–Rivlin I2 term
+};
+
+// Time integrators (facts about each in integrator.h).
+enum class IntegratorKind {
+  central_difference,  // explicit, 2nd order, TLED style (the default)
+  rk4,                 // classical Runge–Kutta, explicit, 4th order (the seed's)
+  dopri5,              // Dormand–Prince 5(4), explicit, adaptive step with error control
+  backward_euler,      // implicit, 1st order, Newton + sparse Cholesky
+  bdf2,                // implicit, 2nd order (BE for its first step and after a step change)
+};
+
+struct IntegratorSettings {
+  IntegratorKind kind = IntegratorKind::central_difference;
+  // Requested step. Explicit schemes take the largest stable step when 0, and shorten a requested
+  // step that is not stable (and report it). Implicit schemes need a step > 0. dopri5 starts from
+  // it and adapts.
+  double step_s = 0.0;
+  // dopri5: tolerated local error per step (m; positions, and velocities times the step).
+  double tolerance_m = 1e-6;
+  // Implicit schemes: Newton stops when no node moves more than this in an iteration.
+  double newton_tolerance_m = 1e-9;
+  int max_newton_iterations = 25;
+  bool operator==(const IntegratorSettings&) const = default;
+};
+
+struct ModelOptions {
+  // Region r of the mesh (TetMesh::region) is made of regions[r]; region 0 is the parenchyma.
+  std::vector<RegionMaterial> regions{RegionMaterial{}};
+  FibreField fibre_field;
+  bool average_nodal_pressure = false;  // see EffectSet
+  std::vector<NodeIndex> fixed_nodes;   // held at their rest position (e.g. ligament attachment)
+  double mass_damping_per_s = 8.0;      // Rayleigh mass-proportional damping coefficient α
+  double stable_step_safety = 0.8;      // fraction of the central-difference limit actually used
+  IntegratorSettings integrator;
+};
+
+struct SimModel {
+  std::size_t node_count = 0;
+  std::size_t tet_count = 0;
+  std::array<std::vector<NodeIndex>, 4> corner;  // corner[c][e]
+  // Total-Lagrangian shape-function data: Dm⁻¹ per element, row-major entry k at dm_inverse[k][e],
+  // where Dm = [X1−X0, X2−X0, X3−X0] in the rest configuration.
+  std::array<std::vector<double>, 9> dm_inverse;
+  std::vector<double> rest_volume_m3;
+  std::vector<double> shear_modulus_pa;  // μ per element
+  std::vector<double> lame_lambda_pa;    // λ per element
+  // Mooney–Rivlin c2 per element (allocated only when effects.mooney_rivlin); shear_modulus_pa
+  // then holds the Neo-Hookean part 2c1 = (1 − f) μ.
+  std::vector<double> mooney_rivlin_c2_pa;
+  std::vector<std::int32_t> region;  // region per element
+  std::vector<RegionMaterial> regions;
+  EffectSet effects;
+  // Fibre data per element, allocated only when effects.fibres: HGO parameters (k1 = 0 where the
+  // region has none) and the unit reference direction of each family (zero vector: no family).
+  std::vector<FibreParameters> fibre_parameters;
+  std::array<std::vector<Eigen::Vector3d>, 2> fibre_direction;
+  // Per region, the viscous law of regions that have one (allocated only when effects.viscous).
+  std::vector<std::optional<ViscousTissueParameters>> viscous_parameters;
+  NodeArray rest_position_m;
+  std::vector<double> lumped_mass_kg;
+  std::vector<double> inverse_mass_per_kg;  // 0 on fixed nodes, so they never move
+  std::vector<std::uint8_t> is_fixed;
+  // Node → element-corner incidence (CSR) for gathering element forces without atomics. A slot s
+  // names corner s / tet_count of element s % tet_count.
+  std::vector<std::int32_t> node_slot_begin;  // size node_count + 1
+  std::vector<std::int32_t> node_slots;
+  std::vector<std::int32_t> node_slot_element;  // the element of each entry of node_slots
+  double mass_damping_per_s = 0.0;
+  // Largest eigenfrequency of M⁻¹K at rest (free nodes), from power iteration, and the explicit
+  // step used: safety · 2/ω_max (reduced for damping).
+  double max_frequency_rad_per_s = 0.0;
+  double stable_time_step_s = 0.0;
+  double stable_step_safety = 0.8;
+  IntegratorSettings integrator;
+  // Smallest element height at rest: no node may travel more than a tenth of it in one step, which
+  // keeps fast, large distortions (a yank, an inversion) from jumping past the stiffening.
+  double min_element_height_m = 0.0;
+  // Faces made by cuts (cutting.h), per element: bit c for the face opposite corner c. Empty until
+  // the first cut.
+  std::vector<std::uint8_t> cut_face_mask;
+  // Faces on the boundary (the organ's surface and cut faces), per element, bit c as above; kept
+  // by cuts so that a cut surface is read off the elements instead of hashed again. Empty until
+  // the first cut.
+  std::vector<std::uint8_t> boundary_face_mask;
+  // Mass of each element, kept through cuts (a node snapped onto a cut on a curved surface
+  // changes its elements' volumes a little, never the mass). Empty until the first cut: density
+  // times rest volume.
+  std::vector<double> element_mass_kg;
+};
+
+// Throws std::invalid_argument naming the first integrator setting out of range.
+void validate_integrator(const IntegratorSettings& settings);
+
+// Fills the model's node → element-corner incidence (node_slot_*) from its corners.
+void build_node_incidence(SimModel& model);
+
+}  // namespace liversim

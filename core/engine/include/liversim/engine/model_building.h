@@ -1,0 +1,28 @@
+#pragma once
+// Building the constant model from a mesh and its options, and changing its materials live: both
+// end with the model's stable explicit step, so they sit above the force loops and the integrators
+// (model.h, the model itself, below them).
+
+#include "liversim/engine/model.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/tet_mesh.h"
+
+#include <vector>
+
+namespace liversim {
+
+// Builds the model. Throws std::invalid_argument naming the problem for an invalid material, a
+// region without a material, a fibre field of the wrong size or with a zero vector, an empty mesh,
+// an inverted or zero-volume element, a fixed node index out of range, or integrator settings out
+// of range.
+SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
+
+// Gives the model's regions these materials (a live change of the tissue, also of a cut model):
+// every per-element modulus, fibre and viscous parameter, the masses (a cut model's element masses
+// scale with the density), the effects they switch on and the stable step follow, as build_model
+// would make them. A region with fibres needs the model to have fibre directions already. Throws
+// std::invalid_argument as build_model does for the materials; the model is then unchanged only
+// if the throw came from validation (callers change a copy).
+void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& regions);
+
+}  // namespace liversim

@@ -1,0 +1,90 @@
+#pragma once
+// The devices that need no hardware: the mouse and keyboard, a scripted trajectory, and the replay
+// of a logged session. They are product features (the default without a Phantom, the CLI and the
+// instructor's replay) and what the tests drive the force path with.
+
+#include "liversim/haptics/haptic_device.h"
+#include "liversim/haptics/servo_loop.h"
+#include "liversim/haptics/triple_buffer.h"
+
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace liversim {
+
+// The mouse and keyboard: the workstation sets the position (device mm) and buttons from mouse
+// drags, modifiers and the wheel; the servo reads the newest, and takes the velocity from the
+// change. The force written is kept (the mouse cannot push back) so that it can be shown.
+class ManualDevice final : public HapticDevice {
+ public:
+  std::string name() const override { return "Mouse and keyboard"; }
+  DeviceLimits limits() const override { return limits_; }
+  DeviceStatus read(double time_s, DeviceSample& sample) override;
+  DeviceStatus write_force(const Eigen::Vector3d& force_n) override;
+
+  // UI thread. `set` moves the device there (its velocity is the change over the servo's ticks);
+  // `place` puts it there at once (a press where the mouse is, not a motion: zero velocity, and
+  // the first sample there marked kRepositioned).
+  void set(const Eigen::Vector3d& position_mm, std::uint32_t buttons);
+  void place(const Eigen::Vector3d& position_mm, std::uint32_t buttons);
+  Eigen::Vector3d last_force_n();
+
+ private:
+  struct Input {
+    Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+    std::uint32_t buttons = 0;
+    std::uint64_t placement = 0;  // counts place() calls
+  };
+  DeviceLimits limits_;  // the Omni's: the mouse pushes nothing back
+  TripleBuffer<Input> input_{Input{}};
+  TripleBuffer<Eigen::Vector3d> force_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d previous_mm_ = Eigen::Vector3d::Zero();
+  double previous_s_ = -1.0;
+  std::uint64_t placements_ = 0;      // UI thread
+  std::uint64_t read_placement_ = 0;  // servo thread
+};
+
+// One point of a trajectory: where the device is at a time, and which buttons are down.
+struct TrajectoryPoint {
+  double time_s = 0.0;
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+  std::uint32_t buttons = 0;
+};
+
+// A trajectory file: one point per line, `time_s x_mm y_mm z_mm buttons`, whitespace-separated,
+// times strictly increasing; `#` starts a comment. Throws std::runtime_error naming the file, the
+// line and what is wrong.
+std::vector<TrajectoryPoint> load_trajectory(const std::filesystem::path& file);
+void save_trajectory(const std::filesystem::path& file, const std::vector<TrajectoryPoint>& points);
+
+// The device input logged with a session (servo frames), as a trajectory starting at time 0:
+// positions and buttons at the frames' own times, so a TrajectoryDevice replays it at its original
+// rate. Frames whose time does not increase are skipped.
+std::vector<TrajectoryPoint> trajectory_of_frames(std::span<const ServoFrame> frames);
+
+// Plays a trajectory on the servo clock: positions interpolated linearly between points, the
+// velocity the slope there, the buttons of the point before. Before the first point it stays at
+// the first, after the last at the last. A scripted device follows a trajectory file; a replay
+// device follows the device input logged with a session, at its original rate.
+class TrajectoryDevice final : public HapticDevice {
+ public:
+  // Throws std::invalid_argument for an empty trajectory or times that do not increase.
+  TrajectoryDevice(std::string name, std::vector<TrajectoryPoint> points, DeviceLimits limits = {});
+  std::string name() const override { return name_; }
+  DeviceLimits limits() const override { return limits_; }
+  DeviceStatus read(double time_s, DeviceSample& sample) override;
+  DeviceStatus write_force(const Eigen::Vector3d& force_n) override;
+
+  double duration_s() const { return points_.back().time_s; }
+  const std::vector<TrajectoryPoint>& points() const { return points_; }
+
+ private:
+  std::string name_;
+  std::vector<TrajectoryPoint> points_;
+  DeviceLimits limits_;
+  std::size_t cursor_ = 0;  // the segment of the last read: reads move forward, so no search
+};
+
+}  // namespace liversim

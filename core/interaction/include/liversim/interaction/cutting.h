@@ -1,0 +1,121 @@
+#pragma once
+// Cutting: the scalpel's edge separates the tissue it sweeps through where the local stress
+// exceeds the cutting threshold; below it the tissue only deforms (plastically past the yield
+// limit), and the dent stays.
+//
+// The cut follows the swept surface cleanly by node snapping with duplication (Nienhuys & van der
+// Stappen 2001): the nearer node of each edge the surface crosses is moved onto the surface when
+// every element it belongs to keeps its shape (and a node of the organ's surface moves only along
+// it); the faces the surface then runs along are separated, and each node on them gets one copy
+// per side. Where a node cannot be moved, the elements the surface still passes through go whole
+// to the side of their centroid. A node whose parted surroundings would not be one manifold fan
+// keeps its faces joined (a small bridge the next stroke cuts), so the surface stays manifold.
+// No element is made or split, so the region, fibres and viscous history of every element carry
+// over and none can be a sliver; a snap shares the mass of the elements around the node by their
+// new volumes, so no mass is lost. Pieces that come free are taken out and their volume counted
+// as resected.
+//
+// The model stays constant between cuts: a cut makes a new model and state from the old ones.
+
+#include "liversim/engine/model.h"
+#include "liversim/engine/state.h"
+#include "liversim/engine/surface.h"
+#include "liversim/interaction/tools.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace liversim {
+
+struct CuttingSettings {
+  // Von Mises equivalent of the Cauchy stress (Pa) of an element the edge sweeps through, above
+  // which the edge separates it; 0: the edge cuts whatever it sweeps through.
+  double cutting_stress_pa = 1500.0;
+  // A node is moved onto the cut when the cut crosses one of its edges within this fraction of
+  // the edge's length from it, and when every element it belongs to keeps at least
+  // `snap_min_shape_fraction` of its smallest height and of its volume, at rest and deformed.
+  double snap_fraction = 0.5;
+  double snap_min_shape_fraction = 0.25;
+};
+
+// The problem with the settings, if any (a message naming the setting, its value and what is
+// expected).
+std::optional<std::string> validate(const CuttingSettings& settings);
+
+// The surface a blade edge sweeps over a stroke: the edge (heel, tip) at successive instants
+// (scene, m); between instants i and i + 1 it covers the triangles (heel_i, tip_i, tip_i+1) and
+// (heel_i, tip_i+1, heel_i+1). An element is cut once the stroke has passed all the way through
+// it, however many instants that took, so a stroke keeps all its edges until it ends.
+struct BladeStroke {
+  std::vector<std::array<Eigen::Vector3d, 2>> edges_m;
+
+  void add(const std::array<Eigen::Vector3d, 2>& edge_m) { edges_m.push_back(edge_m); }
+};
+
+// The scalpel's edge (heel, tip) in the scene.
+std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel);
+
+// Whether the edge (heel, tip) passes through any element of the model in `position`, or within
+// about `reach_m` of one (each element's faces pushed out by that much).
+bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
+                          const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m = 0.0);
+
+struct CutReport {
+  std::size_t elements_swept = 0;           // elements the sweep touches
+  std::size_t elements_over_threshold = 0;  // of those, stressed past the cutting threshold
+  std::size_t snapped_nodes = 0;
+  std::size_t separated_faces = 0;
+  std::size_t duplicated_nodes = 0;  // node copies made
+  std::size_t removed_elements = 0;  // in pieces that came free
+  std::size_t removed_nodes = 0;
+  double resected_volume_m3 = 0.0;  // rest volume of those pieces
+  double resected_mass_kg = 0.0;
+};
+
+struct CutResult {
+  // Null when the sweep separated nothing (the old model and state stand).
+  std::shared_ptr<const SimModel> model;
+  SimState state;
+  // For each node and element of the new model, the one of the old model it came from.
+  std::vector<NodeIndex> node_origin;
+  std::vector<TetIndex> element_origin;
+  CutReport report;
+
+  bool cut() const { return model != nullptr; }
+};
+
+// Cuts `model` in `state` along the stroke. Throws std::invalid_argument for invalid settings or
+// a stroke that is not finite.
+CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
+                     const CuttingSettings& settings);
+
+// Von Mises equivalent of the Cauchy stress of element e in `state` (Pa): of the elastic part
+// F·Fp⁻¹ in viscous regions (the instantaneous response, before the Maxwell arm relaxes).
+double element_cutting_stress_pa(const SimModel& model, const SimState& state, std::size_t e);
+
+// The largest angular frequency at rest of the model's free nodes among `nodes`, the other nodes
+// held: power iteration on that block of M^(-1/2)·K·M^(-1/2), K the elements' stiffness (with
+// average nodal pressure, its nodal volumetric energy). The block's largest eigenvalue is at most
+// the whole mesh's (Cauchy interlacing); the modes a cut raises are local to the cut, so the block
+// around it holds them, and a cut takes the larger of it and the model's old frequency.
+double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<NodeIndex>& nodes);
+
+// The mesh of a model (rest positions, elements, regions), e.g. to extract its surface.
+TetMesh model_mesh(const SimModel& model);
+
+// The model's boundary: read off its boundary-face marks once it has been cut (no hashing of
+// every face), else extract_surface of its mesh. The same triangles either way (their order
+// differs).
+BoundarySurface boundary_surface(const SimModel& model);
+
+// Which triangles of `surface` (extracted from the model's mesh) are faces made by cuts (shown as
+// the tissue's interior), one flag per triangle.
+std::vector<std::uint8_t> cut_face_flags(const SimModel& model, const BoundarySurface& surface);
+
+}  // namespace liversim

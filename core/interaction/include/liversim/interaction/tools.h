@@ -1,0 +1,201 @@
+#pragma once
+// Surgical tools as rigid shapes with a pose, and what they do to the liver: contact that keeps
+// them out of the tissue, and the forceps' grasp. Both act through damped node springs (forces.h),
+// recomputed at every interval from the deformed surface, so the force on the tool is the
+// reaction of the tissue on those springs, in newtons.
+
+#include "liversim/engine/forces.h"
+#include "liversim/engine/surface_bvh.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+namespace liversim {
+
+enum class ToolKind { probe, forceps, scalpel };
+inline constexpr std::array<ToolKind, 3> kToolKinds = {ToolKind::probe, ToolKind::forceps,
+                                                       ToolKind::scalpel};
+std::string_view tool_name(ToolKind kind);
+// The tool named `name` (as tool_name names it), if any.
+std::optional<ToolKind> tool_kind(std::string_view name);
+
+// A segment swept by a sphere: every tool part is one.
+struct Capsule {
+  Eigen::Vector3d a_m, b_m;
+  double radius_m = 0.0;
+};
+
+// Sizes of 5 mm laparoscopic instruments. In the tool's frame the working end (probe ball, jaw
+// hinge, blade heel) is at the origin, the shaft runs along +z toward the hand, the jaws and the
+// blade reach along −z, and the jaws open in the x–z plane.
+struct ToolGeometry {
+  double shaft_radius_m = 0.0025;
+  double shaft_length_m = 0.06;  // the part that can reach the tissue
+  double probe_tip_radius_m = 0.003;
+  double jaw_length_m = 0.02;
+  double jaw_radius_m = 0.0015;
+  double max_jaw_angle_rad = 0.35;  // each jaw off the axis when fully open (20°)
+  double blade_length_m = 0.02;
+  double blade_half_thickness_m = 0.0005;
+  bool operator==(const ToolGeometry&) const = default;
+};
+
+struct ToolPose {
+  Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+
+  Eigen::Vector3d to_scene(const Eigen::Vector3d& local_m) const {
+    return origin_m + orientation * local_m;
+  }
+};
+
+struct Tool {
+  ToolKind kind = ToolKind::probe;
+  ToolPose pose;
+  double jaw_opening = 1.0;  // forceps: 0 closed, 1 fully open
+  // Scalpel: the blade may break in and cut (a device's cut button held); disarmed it only pushes,
+  // and a blade already in passes on without cutting until armed again or drawn out.
+  bool blade_armed = true;
+  ToolGeometry geometry;
+};
+
+// The tool's parts in the scene: shaft and ball (probe), shaft and two jaws (forceps), shaft and
+// blade (scalpel). Returns how many of `parts` it wrote.
+int tool_capsules(const Tool& tool, std::array<Capsule, 3>& parts);
+// Forceps: the point midway between the jaws, where a closing grasp takes hold.
+Eigen::Vector3d forceps_grasp_point_m(const Tool& tool);
+
+// Closest point of segment [a, b] to p.
+Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                         const Eigen::Vector3d& p);
+
+// Closest point of triangle (p0, p1, p2) to p, with its barycentric weights.
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& p0,
+                                          const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                                          std::array<double, 3>& weight);
+
+// Closest points of segment [a, b] and triangle (p0, p1, p2): the point on the triangle with its
+// barycentric weights. Distance 0 when the segment passes through the triangle.
+struct SegmentTriangleClosest {
+  Eigen::Vector3d on_segment, on_triangle;
+  std::array<double, 3> weight;
+  double distance;
+};
+SegmentTriangleClosest segment_triangle_closest(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                                const Eigen::Vector3d& p0,
+                                                const Eigen::Vector3d& p1,
+                                                const Eigen::Vector3d& p2);
+
+// Penalty contact against the surface triangles: where a part reaches within its radius of a
+// triangle, the triangle's closest point is pushed out of the part (radially from the part's axis,
+// or along the face's inward normal once the axis has gone through the face) by a critically
+// damped spring whose stiffness gives the mass at that point the contact frequency; the corners
+// share it by their barycentric weights (force w·k·push, stiffness w²·k), and each node gets one
+// spring with the sum of its shares. A thin tool between nodes still meets the faces.
+struct ContactSettings {
+  // High enough that the tissue gives way well before the tool sinks in (a few tenths of a mm at
+  // a probe's push), low enough that the 1 ms step stays below the explicit stability limit.
+  double frequency_hz = 150.0;
+};
+
+// Per-node sums of one contact evaluation; zero between evaluations.
+struct ContactScratch {
+  std::vector<double> stiffness_n_per_m;
+  std::vector<Eigen::Vector3d> force_n;
+  std::vector<NodeIndex> touched;
+  void resize(std::size_t nodes) {
+    if (stiffness_n_per_m.size() == nodes) return;
+    stiffness_n_per_m.assign(nodes, 0.0);
+    force_n.assign(nodes, Eigen::Vector3d::Zero());
+    touched.clear();
+    touched.reserve(nodes);
+  }
+};
+
+// Finds the faces in contact through the hierarchy (refitted to `position` by the caller) and
+// appends one spring per pushed free node to `springs`; returns how many. Allocates nothing when
+// the scratch is sized and `springs` has the capacity.
+std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
+                                const NodeArray& position, std::span<const Capsule> parts,
+                                const ContactSettings& settings, ContactScratch& scratch,
+                                std::vector<NodeSpring>& springs);
+
+// The forceps' hold on the tissue: the surface nodes near the jaws when they closed,
+// carried rigidly with the tool from then on. Empty: no hold.
+struct ForcepsGrasp {
+  std::vector<NodeIndex> nodes;
+  std::vector<Eigen::Vector3d> offset_in_tool_m;  // node position at the grasp, in the tool frame
+  std::vector<double> stiffness_n_per_m;
+  std::vector<double> damping_n_s_per_m;
+
+  bool empty() const { return nodes.empty(); }
+  void clear() {
+    nodes.clear();
+    offset_in_tool_m.clear();
+    stiffness_n_per_m.clear();
+    damping_n_s_per_m.clear();
+  }
+};
+
+struct GraspSettings {
+  double close_below = 0.3;    // jaw opening at which the jaws take hold
+  double release_above = 0.5;  // and let go (hysteresis: a hold does not flicker)
+  double radius_m = 0.01;      // surface nodes this close to the closed jaws are held
+  double total_stiffness_n_per_m = 300.0;
+};
+
+// A tool acting on the liver, one interval at a time: contact of all its parts, and for the forceps
+// the grasp, taken when the jaws close on tissue and let go when they open.
+class ToolInteraction {
+ public:
+  ToolInteraction(const SimModel& model, const BoundarySurface& surface,
+                  ContactSettings contact = {}, GraspSettings grasp = {});
+
+  // The springs for the next interval at the tool's pose and the tissue's `position`. A scalpel
+  // whose blade is cutting (`blade_cuts`) pushes with its shaft only: the blade passes into the
+  // tissue it separates. Allocates nothing (every buffer is sized for the whole surface at
+  // construction).
+  std::span<const NodeSpring> update(const Tool& tool, const NodeArray& position,
+                                     bool blade_cuts = false);
+  // The springs of the last update.
+  std::span<const NodeSpring> springs() const { return springs_; }
+
+  // The force of the tissue on the tool at `position` with the springs of the last update (N).
+  Eigen::Vector3d force_on_tool_n(const NodeArray& position) const {
+    return spring_reaction_force_n(springs_, position);
+  }
+  bool grasping() const { return !grasp_.empty(); }
+  // The tool has left the scene: let go of any hold, no springs.
+  void release() {
+    grasp_.clear();
+    springs_.clear();
+    contact_count_ = 0;
+  }
+  const ForcepsGrasp* grasp() const { return grasping() ? &grasp_ : nullptr; }
+  std::size_t contact_count() const { return contact_count_; }
+  const SurfaceBvh& bvh() const { return bvh_; }
+
+ private:
+  void try_grasp(const Tool& tool, const NodeArray& position);
+
+  const SimModel* model_;
+  SurfaceBvh bvh_;
+  ContactSettings contact_;
+  GraspSettings grasp_settings_;
+  // Sized for every surface node once, so that closing the jaws in a step allocates nothing.
+  ForcepsGrasp grasp_;
+  std::vector<double> grasp_weight_;
+  std::vector<std::uint8_t> node_mark_;
+  ContactScratch contact_scratch_;
+  std::vector<NodeSpring> springs_;
+  std::size_t contact_count_ = 0;
+};
+
+}  // namespace liversim

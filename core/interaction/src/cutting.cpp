@@ -1,0 +1,1191 @@
+#include "liversim/interaction/cutting.h"
+#include "liversim/engine/validation_message.h"
+
+#include "liversim/engine/energy.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/mesh_quality.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <random>
+#include <stdexcept>
+
+namespace liversim {
+
+std::optional<std::string> validate(const CuttingSettings& settings) {
+  auto out_of_range = [](const char* name, double value, const char* expected) {
+    return std::optional<std::string>(
+        out_of_range_message(std::string("cutting setting ") + name, value, expected));
+  };
+  if (!std::isfinite(settings.cutting_stress_pa) || settings.cutting_stress_pa < 0.0)
+    return out_of_range("cutting stress (Pa)", settings.cutting_stress_pa, "a finite value >= 0");
+  if (!(settings.snap_fraction >= 0.0 && settings.snap_fraction <= 0.5))
+    return out_of_range("snap fraction", settings.snap_fraction, "a value in [0, 0.5]");
+  if (!(settings.snap_min_shape_fraction > 0.0 && settings.snap_min_shape_fraction < 1.0))
+    return out_of_range("snap shape fraction", settings.snap_min_shape_fraction,
+                        "a value in (0, 1)");
+  return std::nullopt;
+}
+
+std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel) {
+  std::array<Capsule, 3> parts;
+  Tool blade = scalpel;
+  blade.kind = ToolKind::scalpel;
+  const int count = tool_capsules(blade, parts);
+  const Capsule& edge = parts[count - 1];  // shaft, then blade
+  return {edge.a_m, edge.b_m};
+}
+
+double element_cutting_stress_pa(const SimModel& model, const SimState& state, std::size_t e) {
+  Eigen::Matrix3d F = deformation_gradient(model, state.position_m, e);
+  if (model.effects.viscous && model.viscous_parameters[model.region[e]])
+    F = F * state.viscous_history.inverse_plastic_deformation(e);
+  const double J = F.determinant();
+  if (!(J > 0.0)) return std::numeric_limits<double>::infinity();  // crushed: it gives way
+  const Eigen::Matrix3d sigma = element_first_piola_stress(model, e, F) * F.transpose() / J;
+  const Eigen::Matrix3d deviator = sigma - sigma.trace() / 3.0 * Eigen::Matrix3d::Identity();
+  return std::sqrt(1.5 * deviator.squaredNorm());
+}
+
+TetMesh model_mesh(const SimModel& model) {
+  TetMesh mesh;
+  mesh.rest_position_m = model.rest_position_m;
+  mesh.corner = model.corner;
+  mesh.region = model.region;
+  return mesh;
+}
+
+BoundarySurface boundary_surface(const SimModel& model) {
+  if (model.boundary_face_mask.empty()) return extract_surface(model_mesh(model));
+  BoundarySurface surface;
+  std::vector<std::int32_t> local(model.node_count, -1);
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    for (int f = 0; f < 4; ++f)
+      if ((model.boundary_face_mask[e] >> f) & 1)
+        for (int k = 0; k < 3; ++k) local[model.corner[kTetFace[f][k]][e]] = 0;
+  for (std::size_t n = 0; n < model.node_count; ++n)
+    if (local[n] == 0) {
+      local[n] = static_cast<std::int32_t>(surface.nodes.size());
+      surface.nodes.push_back(static_cast<NodeIndex>(n));
+    }
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    for (int f = 0; f < 4; ++f)
+      if ((model.boundary_face_mask[e] >> f) & 1) {
+        surface.triangles.push_back({local[model.corner[kTetFace[f][0]][e]],
+                                     local[model.corner[kTetFace[f][1]][e]],
+                                     local[model.corner[kTetFace[f][2]][e]]});
+        surface.triangle_tet.push_back(static_cast<TetIndex>(e));
+      }
+  return surface;
+}
+
+std::vector<std::uint8_t> cut_face_flags(const SimModel& model, const BoundarySurface& surface) {
+  std::vector<std::uint8_t> flags(surface.triangles.size(), 0);
+  if (model.cut_face_mask.empty()) return flags;
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    const auto e = static_cast<std::size_t>(surface.triangle_tet[t]);
+    const std::uint8_t mask = model.cut_face_mask[e];
+    if (mask == 0) continue;
+    // The triangle is the face opposite the corner that is none of its nodes.
+    for (int c = 0; c < 4; ++c) {
+      const NodeIndex node = model.corner[c][e];
+      bool on_triangle = false;
+      for (auto local : surface.triangles[t]) on_triangle |= surface.nodes[local] == node;
+      if (!on_triangle) flags[t] = (mask >> c) & 1;
+    }
+  }
+  return flags;
+}
+
+namespace {
+
+using Triangle = std::array<Eigen::Vector3d, 3>;
+constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
+// The stroke's triangles, with the tolerance within which a point counts as on them, and a tree
+// of boxes over runs of them in stroke order (neighbours in a stroke are neighbours in space):
+// every query of a long stroke would otherwise visit all of its triangles.
+struct SweepSurface {
+  std::vector<Triangle> triangle;
+  std::vector<Eigen::Vector3d> unit_normal;
+  std::vector<Aabb> box;
+  double tolerance_m = 0.0;
+
+  // Node k covers triangles [first, end); its children are nodes child and child + 1 (0: leaf).
+  struct RunNode {
+    Aabb box;
+    std::size_t first = 0, end = 0, child = 0;
+  };
+  std::vector<RunNode> run;
+  static constexpr std::size_t kLeafTriangles = 4;
+
+  std::size_t size() const { return triangle.size(); }
+
+  void build_runs() {
+    run.assign(1, RunNode{{}, 0, size(), 0});
+    for (std::size_t k = 0; k < run.size(); ++k) {
+      const std::size_t first = run[k].first, end = run[k].end;
+      for (std::size_t t = first; t < end; ++t) run[k].box.grow(box[t]);
+      if (end - first <= kLeafTriangles) continue;
+      const std::size_t middle = first + (end - first) / 2;
+      run[k].child = run.size();
+      run.push_back(RunNode{{}, first, middle, 0});
+      run.push_back(RunNode{{}, middle, end, 0});
+    }
+  }
+
+  // Calls visit(t) for the triangles whose box overlaps `query`, in stroke order, until it
+  // returns true; returns whether one did.
+  template <typename Visit>
+  bool first_overlapping(const Aabb& query, Visit&& visit, std::size_t k = 0) const {
+    if (run.empty() || !run[k].box.overlaps(query)) return false;
+    if (run[k].child == 0) {
+      for (std::size_t t = run[k].first; t < run[k].end; ++t)
+        if (box[t].overlaps(query) && visit(t)) return true;
+      return false;
+    }
+    return first_overlapping(query, visit, run[k].child) ||
+           first_overlapping(query, visit, run[k].child + 1);
+  }
+
+  double triangle_distance_m(std::size_t t, const Eigen::Vector3d& p) const {
+    std::array<double, 3> weight;
+    return (closest_point_on_triangle(p, triangle[t][0], triangle[t][1], triangle[t][2], weight) -
+            p)
+        .norm();
+  }
+  // Distance to the nearest triangle, and which it is (the first in stroke order of those as
+  // near).
+  std::pair<double, std::size_t> nearest(const Eigen::Vector3d& p) const {
+    std::pair<double, std::size_t> best{std::numeric_limits<double>::infinity(), 0};
+    if (!run.empty()) nearest_in(0, p, best);
+    return best;
+  }
+  // Signed distance to the plane of the triangle nearest p.
+  double side_distance_m(const Eigen::Vector3d& p, std::size_t nearest_triangle) const {
+    return (p - triangle[nearest_triangle][0]).dot(unit_normal[nearest_triangle]);
+  }
+  double side_distance_m(const Eigen::Vector3d& p) const {
+    return side_distance_m(p, nearest(p).second);
+  }
+  // Where segment [a, b] passes through a triangle (the first in stroke order), as the parameter
+  // along it; none when it does not, or only within the tolerance at an end.
+  std::optional<double> crossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+    std::optional<double> found;
+    first_overlapping(Aabb::around(a, b, tolerance_m), [&](std::size_t t) {
+      const double da = (a - triangle[t][0]).dot(unit_normal[t]);
+      const double db = (b - triangle[t][0]).dot(unit_normal[t]);
+      if (std::abs(da) <= tolerance_m || std::abs(db) <= tolerance_m || (da > 0.0) == (db > 0.0))
+        return false;
+      const double s = da / (da - db);
+      if (triangle_distance_m(t, a + s * (b - a)) > tolerance_m) return false;
+      found = s;
+      return true;
+    });
+    return found;
+  }
+
+ private:
+  static double box_distance_sq(const Aabb& b, const Eigen::Vector3d& p) {
+    return (b.min_m - p).cwiseMax(p - b.max_m).cwiseMax(0.0).squaredNorm();
+  }
+  // Nearer child first; a box farther than the best so far cannot hold a nearer triangle (one as
+  // near with a smaller index can only lie in a box as near, which is still visited).
+  void nearest_in(std::size_t k, const Eigen::Vector3d& p,
+                  std::pair<double, std::size_t>& best) const {
+    if (box_distance_sq(run[k].box, p) > best.first * best.first) return;
+    if (run[k].child == 0) {
+      for (std::size_t t = run[k].first; t < run[k].end; ++t) {
+        if (box_distance_sq(box[t], p) > best.first * best.first) continue;
+        const double d = triangle_distance_m(t, p);
+        if (d < best.first || (d == best.first && t < best.second)) best = {d, t};
+      }
+      return;
+    }
+    const std::size_t left = run[k].child, right = left + 1;
+    const bool right_first = box_distance_sq(run[right].box, p) < box_distance_sq(run[left].box, p);
+    nearest_in(right_first ? right : left, p, best);
+    nearest_in(right_first ? left : right, p, best);
+  }
+};
+
+// The stroke's triangles, oriented alike (a stroke that turns back keeps one side one side);
+// degenerate ones (the blade still, or moving along itself) are left out.
+SweepSurface sweep_surface(const BladeStroke& stroke) {
+  SweepSurface surface;
+  double extent = 0.0;
+  for (std::size_t i = 0; i + 1 < stroke.edges_m.size(); ++i) {
+    const auto& [heel0, tip0] = stroke.edges_m[i];
+    const auto& [heel1, tip1] = stroke.edges_m[i + 1];
+    for (const Triangle& tri : {Triangle{heel0, tip0, tip1}, Triangle{heel0, tip1, heel1}}) {
+      const Eigen::Vector3d normal = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+      const double longest =
+          std::max({(tri[1] - tri[0]).norm(), (tri[2] - tri[1]).norm(), (tri[0] - tri[2]).norm()});
+      if (!(longest > 0.0) || !(normal.norm() > 1e-12 * longest * longest)) continue;
+      extent = std::max(extent, longest);
+      Eigen::Vector3d unit = normal.normalized();
+      if (!surface.unit_normal.empty() && unit.dot(surface.unit_normal.front()) < 0.0) unit = -unit;
+      surface.triangle.push_back(tri);
+      surface.unit_normal.push_back(unit);
+    }
+  }
+  surface.tolerance_m = 1e-9 * extent;
+  for (const Triangle& tri : surface.triangle) {
+    Aabb box;
+    for (const auto& p : tri) box.grow(p);
+    box.min_m.array() -= surface.tolerance_m;
+    box.max_m.array() += surface.tolerance_m;
+    surface.box.push_back(box);
+  }
+  surface.build_runs();
+  return surface;
+}
+
+// Whether the tetrahedron p touches the sweep: an edge of one meets a face of the other, or the
+// sweep lies inside it.
+bool tet_touches_sweep(const std::array<Eigen::Vector3d, 4>& p, const Aabb& tet_box,
+                       const SweepSurface& sweep) {
+  return sweep.first_overlapping(tet_box, [&](std::size_t t) {
+    const Triangle& tri = sweep.triangle[t];
+    // All corners off the triangle's plane on one side: it cannot touch.
+    bool above = true, below = true;
+    for (const auto& corner : p) {
+      const double height = (corner - tri[0]).dot(sweep.unit_normal[t]);
+      above &= height > sweep.tolerance_m;
+      below &= height < -sweep.tolerance_m;
+    }
+    if (above || below) return false;
+    // Separating axes of a tetrahedron and a triangle: the face normals of both and the cross
+    // products of their edges. They meet (within the tolerance) when no axis separates them.
+    auto separated_along = [&](const Eigen::Vector3d& axis) {
+      const double length = axis.norm();
+      if (length < 1e-30) return false;
+      double tet_min = std::numeric_limits<double>::infinity(), tet_max = -tet_min;
+      for (const auto& corner : p) {
+        const double at = corner.dot(axis);
+        tet_min = std::min(tet_min, at);
+        tet_max = std::max(tet_max, at);
+      }
+      double tri_min = std::numeric_limits<double>::infinity(), tri_max = -tri_min;
+      for (const auto& corner : tri) {
+        const double at = corner.dot(axis);
+        tri_min = std::min(tri_min, at);
+        tri_max = std::max(tri_max, at);
+      }
+      const double slack = sweep.tolerance_m * length;
+      return tet_max < tri_min - slack || tri_max < tet_min - slack;
+    };
+    bool apart = false;
+    for (const auto& face : kTetFace) {
+      apart = separated_along((p[face[1]] - p[face[0]]).cross(p[face[2]] - p[face[0]]));
+      if (apart) break;
+    }
+    for (int i = 0; i < 3 && !apart; ++i) {
+      const Eigen::Vector3d side = tri[(i + 1) % 3] - tri[i];
+      for (const auto& edge : kEdge)
+        if ((apart = separated_along(side.cross(p[edge[1]] - p[edge[0]])))) break;
+    }
+    return !apart;
+  });
+}
+
+std::array<Eigen::Vector3d, 4> corners_at(const SimModel& model, const NodeArray& position,
+                                          std::size_t e) {
+  return {position.at(model.corner[0][e]), position.at(model.corner[1][e]),
+          position.at(model.corner[2][e]), position.at(model.corner[3][e])};
+}
+
+// Elements incident to node n (from the model's node → corner incidence).
+template <typename Visit>
+void for_each_element_of(const SimModel& model, NodeIndex n, Visit&& visit) {
+  for (std::int32_t s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s)
+    visit(static_cast<std::size_t>(model.node_slot_element[s]));
+}
+
+bool element_has_node(const SimModel& model, std::size_t e, NodeIndex n) {
+  for (int c = 0; c < 4; ++c)
+    if (model.corner[c][e] == n) return true;
+  return false;
+}
+
+// The copy of node n that element e (one of n's elements) has in `corner`, its corners after the
+// split; -1 if e does not have n.
+NodeIndex copy_in(const SimModel& model, const std::array<std::vector<NodeIndex>, 4>& corner,
+                  std::size_t e, NodeIndex n) {
+  for (int c = 0; c < 4; ++c)
+    if (model.corner[c][e] == n) return corner[c][e];
+  return -1;
+}
+
+// The element across face `face` of element e, if the face is interior.
+std::optional<std::size_t> find_neighbour_across(const SimModel& model, std::size_t e, int face) {
+  const NodeIndex a = model.corner[kTetFace[face][0]][e], b = model.corner[kTetFace[face][1]][e],
+                  c = model.corner[kTetFace[face][2]][e];
+  std::optional<std::size_t> found;
+  for_each_element_of(model, a, [&](std::size_t other) {
+    if (other != e && element_has_node(model, other, b) && element_has_node(model, other, c))
+      found = other;
+  });
+  return found;
+}
+
+// The elements across the faces of the elements a cut looks at, found once each.
+class FaceNeighbours {
+ public:
+  explicit FaceNeighbours(const SimModel& model)
+      : model_(model), across_(model.tet_count, {kUnknown, kUnknown, kUnknown, kUnknown}) {}
+  std::optional<std::size_t> operator()(std::size_t e, int face) {
+    std::int32_t& known = across_[e][face];
+    if (known == kUnknown) {
+      const auto found = find_neighbour_across(model_, e, face);
+      known = found ? static_cast<std::int32_t>(*found) : kNone;
+    }
+    if (known == kNone) return std::nullopt;
+    return static_cast<std::size_t>(known);
+  }
+
+ private:
+  static constexpr std::int32_t kUnknown = -2, kNone = -1;
+  const SimModel& model_;
+  std::vector<std::array<std::int32_t, 4>> across_;
+};
+
+using FaceKey = std::array<NodeIndex, 3>;  // sorted node indices
+FaceKey face_key(const SimModel& model, std::size_t e, int face) {
+  FaceKey key{model.corner[kTetFace[face][0]][e], model.corner[kTetFace[face][1]][e],
+              model.corner[kTetFace[face][2]][e]};
+  std::sort(key.begin(), key.end());
+  return key;
+}
+
+struct UnionFind {
+  std::vector<std::int32_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  std::int32_t find(std::int32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  }
+  void unite(std::int32_t a, std::int32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+// Whether the edge (n, m) lies on the boundary: a face holding it has no element across.
+bool edge_on_boundary(const SimModel& model, FaceNeighbours& neighbours, NodeIndex n, NodeIndex m) {
+  bool boundary = false;
+  for_each_element_of(model, n, [&](std::size_t e) {
+    if (!element_has_node(model, e, m)) return;
+    for (int f = 0; f < 4; ++f) {
+      bool holds_edge = false;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          holds_edge |=
+              model.corner[kTetFace[f][i]][e] == n && model.corner[kTetFace[f][j]][e] == m;
+      if (holds_edge && !neighbours(e, f)) boundary = true;
+    }
+  });
+  return boundary;
+}
+
+bool on_boundary(const SimModel& model, FaceNeighbours& neighbours, NodeIndex n) {
+  bool boundary = false;
+  for_each_element_of(model, n, [&](std::size_t e) {
+    for (int f = 0; f < 4; ++f) {
+      bool holds_node = false;
+      for (int i = 0; i < 3; ++i) holds_node |= model.corner[kTetFace[f][i]][e] == n;
+      if (holds_node && !neighbours(e, f)) boundary = true;
+    }
+  });
+  return boundary;
+}
+
+// Whether the arcs b → c of the triangles around a vertex chain into one closed cycle (the
+// vertex's boundary is one fan: a manifold surface there).
+bool arcs_form_one_cycle(const std::vector<std::array<NodeIndex, 2>>& arcs) {
+  std::size_t steps = 0;
+  NodeIndex at = arcs.front()[0];
+  do {
+    if (std::count_if(arcs.begin(), arcs.end(), [&](const auto& arc) { return arc[0] == at; }) != 1)
+      return false;
+    at = std::find_if(arcs.begin(), arcs.end(), [&](const auto& arc) {
+           return arc[0] == at;
+         })->at(1);
+    ++steps;
+  } while (at != arcs.front()[0] && steps <= arcs.size());
+  return steps == arcs.size() && at == arcs.front()[0];
+}
+
+struct ElementShape {
+  double volume_m3, min_height_m;
+};
+// Signed volume and smallest height (3V over the largest face), without tet_shape's angles.
+ElementShape shape_of(const std::array<Eigen::Vector3d, 4>& p) {
+  const double volume = signed_tet_volume(p[0], p[1], p[2], p[3]);
+  double largest_face_area = 0.0;
+  for (const auto& face : kTetFace)
+    largest_face_area = std::max(
+        largest_face_area, 0.5 * (p[face[1]] - p[face[0]]).cross(p[face[2]] - p[face[0]]).norm());
+  return {volume, 3.0 * std::abs(volume) / largest_face_area};
+}
+
+// The working geometry of a cut: rest and current positions with the snapped nodes moved.
+struct Geometry {
+  NodeArray rest_m, position_m, velocity_m_per_s;
+  std::vector<double> element_mass_kg;
+};
+
+double density_kg_per_m3(const SimModel& model, std::size_t e) {
+  return model.regions[model.region[e]].tissue.density_kg_per_m3;
+}
+
+// Moves node n to parameter s along its edge to node m, at rest and deformed (a point on an edge
+// is the same material point in every element holding the edge), when every element of n keeps
+// its shape. Returns whether it moved.
+bool try_snap(const SimModel& model, FaceNeighbours& neighbours, Geometry& geometry, NodeIndex n,
+              NodeIndex m, double s, double min_fraction) {
+  // A node on the surface moves only along the surface, so the organ keeps its shape.
+  if (on_boundary(model, neighbours, n) && !edge_on_boundary(model, neighbours, n, m)) return false;
+  const NodeArray* configurations[2] = {&geometry.rest_m, &geometry.position_m};
+  std::array<Eigen::Vector3d, 2> moved;
+  for (int k = 0; k < 2; ++k) {
+    const NodeArray& x = *configurations[k];
+    moved[k] = x.at(n) + s * (x.at(m) - x.at(n));
+  }
+  bool keeps_shape = true;
+  for_each_element_of(model, n, [&](std::size_t e) {
+    for (int k = 0; k < 2 && keeps_shape; ++k) {
+      auto p = corners_at(model, *configurations[k], e);
+      const ElementShape before = shape_of(p);
+      for (int c = 0; c < 4; ++c)
+        if (model.corner[c][e] == n) p[c] = moved[k];
+      const ElementShape after = shape_of(p);
+      keeps_shape = after.volume_m3 >= min_fraction * before.volume_m3 &&
+                    after.min_height_m >= min_fraction * before.min_height_m &&
+                    after.volume_m3 > 0.0;
+    }
+  });
+  if (!keeps_shape) return false;
+  // The elements around n keep their mass between them, shared by their new volumes (exactly
+  // density × volume inside the organ, where their volumes only move between them).
+  double mass = 0.0, weight = 0.0;
+  for_each_element_of(model, n, [&](std::size_t e) {
+    mass += geometry.element_mass_kg[e];
+    auto p = corners_at(model, geometry.rest_m, e);
+    for (int c = 0; c < 4; ++c)
+      if (model.corner[c][e] == n) p[c] = moved[0];
+    weight += density_kg_per_m3(model, e) * shape_of(p).volume_m3;
+  });
+  for_each_element_of(model, n, [&](std::size_t e) {
+    auto p = corners_at(model, geometry.rest_m, e);
+    for (int c = 0; c < 4; ++c)
+      if (model.corner[c][e] == n) p[c] = moved[0];
+    geometry.element_mass_kg[e] =
+        mass * density_kg_per_m3(model, e) * shape_of(p).volume_m3 / weight;
+  });
+  geometry.rest_m.set(n, moved[0]);
+  geometry.position_m.set(n, moved[1]);
+  const NodeArray& v = geometry.velocity_m_per_s;
+  geometry.velocity_m_per_s.set(n, v.at(n) + s * (v.at(m) - v.at(n)));
+  return true;
+}
+
+bool averages_pressure(const SimModel& model, std::size_t e) {
+  return model.effects.average_nodal_pressure &&
+         !(model.effects.viscous && model.viscous_parameters[model.region[e]]);
+}
+
+// Reference gradients of element e's shape functions, corner by corner.
+std::array<Eigen::Vector3d, 4> shape_gradients(const SimModel& model, std::size_t e) {
+  const Eigen::Matrix3d dm_inv = element_dm_inverse(model, e);
+  std::array<Eigen::Vector3d, 4> g;
+  for (int c = 1; c < 4; ++c) g[c] = dm_inv.row(c - 1).transpose();
+  g[0] = -(g[1] + g[2] + g[3]);
+  return g;
+}
+
+// Stiffness matrix of element e in its rest shape over its corners' displacements (12 × 12):
+// K_e = V·Gᵀ·A·G with A = ∂P/∂F and G the map from corner displacements to F (F_ij gains g_aj
+// per unit displacement of corner a along i), g_a the reference shape-function gradients. With
+// average nodal pressure the λ part is left to the nodes (local_max_frequency_rad_per_s).
+Eigen::Matrix<double, 12, 12> element_rest_stiffness(const SimModel& model, std::size_t e) {
+  const auto g = shape_gradients(model, e);
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  Eigen::Matrix<double, 9, 9> A = element_stress_tangent(model, e, I);
+  if (averages_pressure(model, e))
+    A -= neo_hookean::stress_tangent(I, 0.0, model.lame_lambda_pa[e]);
+  Eigen::Matrix<double, 9, 12> G = Eigen::Matrix<double, 9, 12>::Zero();
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) G(3 * i + j, 3 * a + i) = g[a](j);
+  const Eigen::Matrix<double, 9, 12> AG = A.lazyProduct(G);
+  const Eigen::Matrix<double, 12, 12> K = model.rest_volume_m3[e] * G.transpose().lazyProduct(AG);
+  return 0.5 * (K + K.transpose());
+}
+
+}  // namespace
+
+double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<NodeIndex>& nodes) {
+  std::vector<std::int32_t> local(model.node_count, -1);
+  std::vector<double> inv_sqrt_mass;
+  for (NodeIndex n : nodes)
+    if (local[n] < 0 && model.inverse_mass_per_kg[n] > 0.0) {
+      local[n] = static_cast<std::int32_t>(inv_sqrt_mass.size());
+      inv_sqrt_mass.push_back(std::sqrt(model.inverse_mass_per_kg[n]));
+    }
+  if (inv_sqrt_mass.empty()) return 0.0;
+  std::vector<std::size_t> elements;
+  std::vector<std::uint8_t> taken(model.tet_count, 0);
+  for (NodeIndex n : nodes)
+    for (std::int32_t s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
+      const auto e = static_cast<std::size_t>(model.node_slot_element[s]);
+      if (!taken[e]) elements.push_back(e), taken[e] = 1;
+    }
+  // A = M^(-1/2)·K·M^(-1/2) on the block, held element by element with the mass scaling taken
+  // in: a corner off the block reads and writes the padding dofs past the block's end (zero
+  // scaling), so the product has no branches.
+  const std::size_t dofs = 3 * inv_sqrt_mass.size();
+  const auto padding = static_cast<std::int32_t>(inv_sqrt_mass.size());
+  std::vector<Eigen::Matrix<double, 12, 12>> scaled_stiffness(elements.size());
+  std::vector<std::array<std::int32_t, 4>> element_local(elements.size());
+  for (std::size_t i = 0; i < elements.size(); ++i) {
+    Eigen::Matrix<double, 12, 1> scale;
+    for (int c = 0; c < 4; ++c) {
+      const std::int32_t at = local[model.corner[c][elements[i]]];
+      element_local[i][c] = at >= 0 ? at : padding;
+      scale.segment<3>(3 * c).setConstant(at >= 0 ? inv_sqrt_mass[at] : 0.0);
+    }
+    scaled_stiffness[i] =
+        scale.asDiagonal() * element_rest_stiffness(model, elements[i]) * scale.asDiagonal();
+  }
+  // Average nodal pressure: the volumetric energy Σ_n V_n·λ_n/2·δJ_n² of node n's volume-averaged
+  // J (V_n = W_n/4, W_n its elements' volume) adds λ_n/(4 W_n)·c_n·c_nᵀ, c_n = Σ_e V_e·∂J_e/∂u,
+  // for every node whose elements reach the free nodes. Held as (node, coefficient, c_n).
+  struct NodalVolumetric {
+    double coefficient;
+    std::vector<std::pair<std::int32_t, Eigen::Vector3d>> c;  // free local node, its part of c_n
+  };
+  std::vector<NodalVolumetric> volumetric;
+  if (model.effects.average_nodal_pressure) {
+    std::vector<std::array<Eigen::Vector3d, 4>> gradients(elements.size());
+    std::vector<std::int32_t> patch_index(model.tet_count, -1);
+    for (std::size_t i = 0; i < elements.size(); ++i) {
+      gradients[i] = shape_gradients(model, elements[i]);
+      patch_index[elements[i]] = static_cast<std::int32_t>(i);
+    }
+    std::vector<std::uint8_t> seen(model.node_count, 0);
+    for (std::size_t e : elements)
+      for (int k = 0; k < 4; ++k) {
+        const NodeIndex n = model.corner[k][e];
+        if (seen[n]) continue;
+        seen[n] = 1;
+        NodalVolumetric term{0.0, {}};
+        double volume = 0.0, lambda_volume = 0.0;
+        for (std::int32_t s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
+          const auto around = static_cast<std::size_t>(model.node_slot_element[s]);
+          if (!averages_pressure(model, around)) continue;
+          volume += model.rest_volume_m3[around];
+          lambda_volume += model.rest_volume_m3[around] * model.lame_lambda_pa[around];
+          if (!taken[around]) continue;  // no free corner
+          const auto& g = gradients[patch_index[around]];
+          for (int c = 0; c < 4; ++c) {
+            const std::int32_t at = local[model.corner[c][around]];
+            if (at >= 0) term.c.emplace_back(at, model.rest_volume_m3[around] * g[c]);
+          }
+        }
+        if (volume <= 0.0 || term.c.empty()) continue;
+        term.coefficient = lambda_volume / volume / (4.0 * volume);
+        for (auto& [at, c] : term.c) c *= inv_sqrt_mass[at];
+        volumetric.push_back(std::move(term));
+      }
+  }
+
+  // The product with A (u and au have the padding dofs at their end, u's zero).
+  auto apply = [&](const Eigen::VectorXd& u, Eigen::VectorXd& au) {
+    au.setZero();
+    for (std::size_t i = 0; i < elements.size(); ++i) {
+      const auto& at = element_local[i];
+      Eigen::Matrix<double, 12, 1> v;
+      for (int c = 0; c < 4; ++c) v.segment<3>(3 * c) = u.segment<3>(3 * at[c]);
+      const Eigen::Matrix<double, 12, 1> kv = scaled_stiffness[i].lazyProduct(v);
+      for (int c = 0; c < 4; ++c) au.segment<3>(3 * at[c]) += kv.segment<3>(3 * c);
+    }
+    for (const NodalVolumetric& term : volumetric) {
+      double c_dot_v = 0.0;
+      for (const auto& [at, c] : term.c) c_dot_v += c.dot(u.segment<3>(3 * at));
+      for (const auto& [at, c] : term.c) au.segment<3>(3 * at) += term.coefficient * c_dot_v * c;
+    }
+    au.tail<3>().setZero();
+  };
+  // Lanczos: the largest Ritz value is a lower bound on A's largest eigenvalue that converges far
+  // faster than power iteration. The cut's top modes stand well apart: it settles to rounding
+  // within 10-20 steps (measured on the bench-cut stroke), so it stops once five more steps have
+  // not moved it by 1e-10, or after 40.
+  constexpr int kMaxSteps = 40, kCheckEvery = 5;
+  constexpr double kSettled = 1e-10;
+  Eigen::VectorXd previous = Eigen::VectorXd::Zero(dofs + 3), current(dofs + 3), next(dofs + 3);
+  std::mt19937 random(12345);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (std::size_t i = 0; i < dofs; ++i) current[i] = uniform(random);
+  current.tail<3>().setZero();
+  current.normalize();
+  std::vector<double> alpha, beta;
+  auto largest_ritz_value = [&] {
+    const int k = static_cast<int>(alpha.size());
+    Eigen::MatrixXd tridiagonal = Eigen::MatrixXd::Zero(k, k);
+    for (int i = 0; i < k; ++i) {
+      tridiagonal(i, i) = alpha[i];
+      if (i + 1 < k) tridiagonal(i, i + 1) = tridiagonal(i + 1, i) = beta[i];
+    }
+    return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(tridiagonal, Eigen::EigenvaluesOnly)
+        .eigenvalues()
+        .maxCoeff();
+  };
+  double previous_beta = 0.0, checked = 0.0;
+  std::optional<double> settled;
+  for (int step = 0; step < kMaxSteps && step < static_cast<int>(dofs); ++step) {
+    apply(current, next);
+    next -= previous_beta * previous;
+    alpha.push_back(next.dot(current));
+    next -= alpha.back() * current;
+    previous_beta = next.norm();
+    if (!(previous_beta > 1e-12 * std::abs(alpha.back()))) break;
+    if ((step + 1) % kCheckEvery == 0) {
+      const double now = largest_ritz_value();
+      if (std::abs(now - checked) <= kSettled * std::abs(now)) {
+        settled = now;
+        break;
+      }
+      checked = now;
+    }
+    beta.push_back(previous_beta);
+    previous.swap(current);
+    current = next / previous_beta;
+  }
+  return std::sqrt(std::max(settled ? *settled : largest_ritz_value(), 0.0));
+}
+
+bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
+                          const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m) {
+  const Aabb edge_box = Aabb::around(edge_m[0], edge_m[1], reach_m);
+  const Eigen::Vector3d along = edge_m[1] - edge_m[0];
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const auto p = corners_at(model, position_m, e);
+    Aabb box;
+    for (const auto& q : p) box.grow(q);
+    if (!box.overlaps(edge_box)) continue;
+    // Clip the segment heel + t·along, t in [0, 1], by the element's four faces (Cyrus–Beck).
+    double t_in = 0.0, t_out = 1.0;
+    for (int f = 0; f < 4 && t_in <= t_out; ++f) {
+      const auto& face = kTetFace[f];
+      const Eigen::Vector3d& a = p[face[0]];
+      Eigen::Vector3d normal = (p[face[1]] - a).cross(p[face[2]] - a).normalized();
+      if ((p[f] - a).dot(normal) > 0.0) normal = -normal;  // outward: away from the fourth corner
+      const double height = normal.dot(edge_m[0] - a) - reach_m;  // > 0 outside the pushed face
+      const double rate = normal.dot(along);
+      if (rate == 0.0) {
+        if (height > 0.0) t_out = -1.0;
+      } else if (rate < 0.0) {
+        t_in = std::max(t_in, -height / rate);
+      } else {
+        t_out = std::min(t_out, -height / rate);
+      }
+    }
+    if (t_in <= t_out) return true;
+  }
+  return false;
+}
+
+CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
+                     const CuttingSettings& settings) {
+  if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
+  for (const auto& edge : stroke.edges_m)
+    if (!edge[0].allFinite() || !edge[1].allFinite())
+      throw std::invalid_argument("the blade's stroke is not finite");
+
+  CutResult result;
+  CutReport& report = result.report;
+  FaceNeighbours neighbours(model);
+
+  // A blade that did not move sweeps nothing.
+  const SweepSurface surface = sweep_surface(stroke);
+  if (surface.size() == 0) return result;
+
+  // 1. The elements the sweep touches, and those of them stressed past the threshold.
+  Aabb sweep_box;
+  for (const Aabb& box : surface.box) sweep_box.grow(box);
+  const std::size_t tets = model.tet_count;
+  std::vector<std::uint8_t> swept(tets, 0), over_threshold(tets, 0);
+  std::vector<std::size_t> zone;
+  auto is_over_threshold = [&](std::size_t e) -> std::uint8_t {
+    return settings.cutting_stress_pa == 0.0 ||
+           element_cutting_stress_pa(model, state, e) >= settings.cutting_stress_pa;
+  };
+  for (std::size_t e = 0; e < tets; ++e) {
+    const auto p = corners_at(model, state.position_m, e);
+    Aabb box;
+    for (const auto& q : p) box.grow(q);
+    if (!box.overlaps(sweep_box) || !tet_touches_sweep(p, box, surface)) continue;
+    swept[e] = 1;
+    zone.push_back(e);
+    over_threshold[e] = is_over_threshold(e);
+    report.elements_over_threshold += over_threshold[e];
+  }
+  report.elements_swept = zone.size();
+  if (report.elements_over_threshold == 0) return result;
+
+  // 2. Snap nodes onto the sweep where it crosses the edges of elements it will cut, nearest
+  // crossings first.
+  Geometry geometry{model.rest_position_m, state.position_m, state.velocity_m_per_s,
+                    model.element_mass_kg};
+  if (geometry.element_mass_kg.empty()) {
+    geometry.element_mass_kg.resize(tets);
+    for (std::size_t e = 0; e < tets; ++e)
+      geometry.element_mass_kg[e] = density_kg_per_m3(model, e) * model.rest_volume_m3[e];
+  }
+  struct Crossing {
+    NodeIndex node, other;
+    double s;           // along the edge from node to other
+    double distance_m;  // the move
+  };
+  std::vector<Crossing> crossings;
+  std::vector<std::array<NodeIndex, 2>> edges;
+  for (std::size_t e : zone)
+    if (over_threshold[e])
+      for (const auto& edge : kEdge) {
+        NodeIndex a = model.corner[edge[0]][e], b = model.corner[edge[1]][e];
+        edges.push_back({std::min(a, b), std::max(a, b)});
+      }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& [a, b] : edges) {
+    const auto s = surface.crossing(geometry.position_m.at(a), geometry.position_m.at(b));
+    if (!s) continue;
+    const double length = (geometry.position_m.at(b) - geometry.position_m.at(a)).norm();
+    if (*s <= settings.snap_fraction) crossings.push_back({a, b, *s, *s * length});
+    if (*s >= 1.0 - settings.snap_fraction)
+      crossings.push_back({b, a, 1.0 - *s, (1.0 - *s) * length});
+  }
+  // Shortest moves first (ties in node order, for the same cut on every run).
+  std::sort(crossings.begin(), crossings.end(), [](const Crossing& l, const Crossing& r) {
+    return std::tie(l.distance_m, l.node, l.other) < std::tie(r.distance_m, r.node, r.other);
+  });
+  std::vector<std::uint8_t> snapped(model.node_count, 0);
+  for (const Crossing& crossing : crossings) {
+    if (snapped[crossing.node] || model.is_fixed[crossing.node]) continue;
+    // An earlier snap may have moved either end: take the crossing as it is now.
+    const auto s = surface.crossing(geometry.position_m.at(crossing.node),
+                                    geometry.position_m.at(crossing.other));
+    if (!s || *s > settings.snap_fraction) continue;
+    if (try_snap(model, neighbours, geometry, crossing.node, crossing.other, *s,
+                 settings.snap_min_shape_fraction)) {
+      snapped[crossing.node] = 1;
+      ++report.snapped_nodes;
+    }
+  }
+
+  // Elements around a snapped node now touch the sweep too.
+  for (NodeIndex n = 0; n < static_cast<NodeIndex>(model.node_count); ++n) {
+    if (!snapped[n]) continue;
+    for_each_element_of(model, n, [&](std::size_t e) {
+      if (swept[e]) return;
+      swept[e] = 1;
+      zone.push_back(e);
+      over_threshold[e] = is_over_threshold(e);
+    });
+  }
+
+  // 3. Sides. A node on the sweep is on neither; an element lies on the side of its nodes off
+  // the sweep, or, when the sweep still passes through it, on the side of its centroid. An
+  // element the sweep enters but does not pass all the way through (the blade ends inside it)
+  // is not cut: the cut stops at its faces.
+  std::vector<std::int8_t> node_label(model.node_count, 2);  // 2: not yet known
+  auto label_of = [&](NodeIndex n) {
+    if (node_label[n] == 2) {
+      const Eigen::Vector3d p = geometry.position_m.at(n);
+      const auto [distance_m, nearest] = surface.nearest(p);
+      node_label[n] = distance_m <= surface.tolerance_m            ? 0
+                      : surface.side_distance_m(p, nearest) >= 0.0 ? 1
+                                                                   : -1;
+    }
+    return node_label[n];
+  };
+  std::vector<std::int8_t> element_side(tets, 0);
+  std::vector<std::uint8_t> cut_through(tets, 0);
+  for (std::size_t e : zone) {
+    bool plus = false, minus = false, through = true;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (int c = 0; c < 4; ++c) {
+      const int label = label_of(model.corner[c][e]);
+      plus |= label > 0;
+      minus |= label < 0;
+      centroid += 0.25 * geometry.position_m.at(model.corner[c][e]);
+    }
+    if (plus && minus)
+      for (const auto& edge : kEdge) {
+        const NodeIndex a = model.corner[edge[0]][e], b = model.corner[edge[1]][e];
+        if (label_of(a) * label_of(b) < 0)
+          through &=
+              surface.crossing(geometry.position_m.at(a), geometry.position_m.at(b)).has_value();
+      }
+    cut_through[e] = through;
+    element_side[e] =
+        plus && minus ? (surface.side_distance_m(centroid) >= 0.0 ? 1 : -1) : (plus ? 1 : -1);
+  }
+
+  // 4. The faces to separate: between elements on opposite sides, both settled (the sweep
+  // passed all the way through it, or it lies wholly on one side), one of them past the
+  // threshold. An element the blade is still inside holds its faces until the stroke has passed.
+  auto settled_side = [&](std::size_t e) -> int {
+    if (swept[e]) return cut_through[e] ? element_side[e] : 0;
+    int side = 0;
+    for (int c = 0; c < 4; ++c) {
+      const int label = label_of(model.corner[c][e]);
+      if (side != 0 && label != side) return 0;  // straddles the plane beyond the sweep
+      side = label;
+    }
+    return side;
+  };
+  std::vector<FaceKey> separated;
+  for (std::size_t a : zone) {
+    const int side_a = settled_side(a);
+    if (side_a == 0) continue;
+    for (int f = 0; f < 4; ++f) {
+      const auto b = neighbours(a, f);
+      if (!b || (swept[*b] && *b < a)) continue;
+      const int side_b = settled_side(*b);
+      if (side_b == 0 || side_b == side_a) continue;
+      if (!over_threshold[a] && !(swept[*b] && over_threshold[*b])) continue;
+      separated.push_back(face_key(model, a, f));
+    }
+  }
+  if (separated.empty()) return result;
+  std::sort(separated.begin(), separated.end());
+  auto is_separated = [&](const FaceKey& key) {
+    return std::binary_search(separated.begin(), separated.end(), key);
+  };
+
+  // 5. Copies of the nodes on separated faces: the elements around a node that stay joined
+  // through faces keep one copy between them. A copy whose boundary is not one fan of triangles
+  // (the cut reaches it from two sides without parting its elements: a pinched vertex or edge)
+  // would not be a manifold surface; the faces around it stay joined instead, until none is.
+  std::array<std::vector<NodeIndex>, 4> corner;
+  std::vector<NodeIndex> node_origin;
+  std::vector<NodeIndex> touched, pinched;
+  std::vector<std::size_t> around;
+  std::vector<std::array<NodeIndex, 2>> arcs;
+  std::vector<std::int32_t> component;
+  std::vector<NodeIndex> copy_of;
+  for (;;) {
+    touched.clear();
+    for (const FaceKey& key : separated) touched.insert(touched.end(), key.begin(), key.end());
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    corner = model.corner;
+    node_origin.resize(model.node_count);
+    std::iota(node_origin.begin(), node_origin.end(), 0);
+    pinched.clear();
+    for (NodeIndex n : touched) {
+      around.clear();
+      for_each_element_of(model, n, [&](std::size_t e) { around.push_back(e); });
+      UnionFind joined(around.size());
+      for (std::size_t i = 0; i < around.size(); ++i)
+        for (int f = 0; f < 4; ++f) {
+          const std::size_t e = around[i];
+          bool has_n = false;
+          for (int k = 0; k < 3; ++k) has_n |= model.corner[kTetFace[f][k]][e] == n;
+          if (!has_n) continue;
+          const auto other = neighbours(e, f);
+          if (!other || is_separated(face_key(model, e, f))) continue;
+          const auto j = std::find(around.begin(), around.end(), *other) - around.begin();
+          joined.unite(static_cast<std::int32_t>(i), static_cast<std::int32_t>(j));
+        }
+      component.resize(around.size());
+      for (std::size_t i = 0; i < around.size(); ++i)
+        component[i] = joined.find(static_cast<std::int32_t>(i));
+      // Component of the first element keeps n; each other component gets a copy.
+      for (std::size_t i = 0; i < around.size(); ++i) {
+        if (component[i] == 0) continue;
+        const std::size_t first = static_cast<std::size_t>(
+            std::find(component.begin(), component.end(), component[i]) - component.begin());
+        NodeIndex copy = -1;
+        if (first == i) {
+          copy = static_cast<NodeIndex>(node_origin.size());
+          node_origin.push_back(n);
+        } else {
+          copy = copy_in(model, corner, around[first], n);
+        }
+        for (int c = 0; c < 4; ++c)
+          if (model.corner[c][around[i]] == n) corner[c][around[i]] = copy;
+      }
+    }
+    // A separated face whose elements still share all three of its nodes parts nothing (the
+    // cut ends at it): it stays joined.
+    std::erase_if(separated, [&](const FaceKey& key) {
+      std::array<std::size_t, 2> pair{};
+      int found = 0;
+      for_each_element_of(model, key[0], [&](std::size_t e) {
+        if (found < 2 && element_has_node(model, e, key[1]) && element_has_node(model, e, key[2]))
+          pair[found++] = e;
+      });
+      for (NodeIndex n : key)
+        if (copy_in(model, corner, pair[0], n) != copy_in(model, corner, pair[1], n)) return false;
+      return true;
+    });
+    // Each copy's boundary around it, as the arcs b → c of its boundary faces (copy, b, c).
+    for (NodeIndex n : touched) {
+      around.clear();
+      for_each_element_of(model, n, [&](std::size_t e) { around.push_back(e); });
+      // The copy of n in each element around it; each copy's arcs are gathered once, from the
+      // first element that has it on.
+      copy_of.resize(around.size());
+      for (std::size_t i = 0; i < around.size(); ++i)
+        copy_of[i] = copy_in(model, corner, around[i], n);
+      bool is_pinched = false;
+      for (std::size_t first = 0; first < around.size() && !is_pinched; ++first) {
+        const NodeIndex copy = copy_of[first];
+        if (std::find(copy_of.begin(), copy_of.begin() + first, copy) != copy_of.begin() + first)
+          continue;
+        arcs.clear();
+        for (std::size_t i = first; i < around.size(); ++i) {
+          const std::size_t e = around[i];
+          if (copy_of[i] != copy) continue;
+          for (int f = 0; f < 4; ++f) {
+            std::array<NodeIndex, 3> face;
+            for (int k = 0; k < 3; ++k) face[k] = corner[kTetFace[f][k]][e];
+            const auto at = std::find(face.begin(), face.end(), copy) - face.begin();
+            if (at == 3) continue;
+            if (neighbours(e, f) && !is_separated(face_key(model, e, f))) continue;
+            arcs.push_back({face[(at + 1) % 3], face[(at + 2) % 3]});
+          }
+        }
+        if (arcs.empty()) continue;
+        is_pinched = !arcs_form_one_cycle(arcs);
+      }
+      if (is_pinched) pinched.push_back(n);
+    }
+    if (pinched.empty()) break;
+    // At a pinched node, the separated faces around it fall into groups joined through edges
+    // from it: keep the largest group when there are several (the others rejoin, to be cut as
+    // the stroke goes on), none when one group alone pinches it (against the organ's surface).
+    std::vector<FaceKey> rejoin;
+    for (NodeIndex n : pinched) {
+      std::vector<FaceKey> around_n;
+      for (const FaceKey& key : separated)
+        if (std::find(key.begin(), key.end(), n) != key.end()) around_n.push_back(key);
+      UnionFind groups(around_n.size());
+      for (std::size_t i = 0; i < around_n.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j) {
+          int shared = 0;
+          for (NodeIndex a : around_n[i])
+            shared += std::count(around_n[j].begin(), around_n[j].end(), a);
+          if (shared >= 2) groups.unite(static_cast<std::int32_t>(i), static_cast<std::int32_t>(j));
+        }
+      std::vector<std::size_t> size(around_n.size(), 0);
+      for (std::size_t i = 0; i < around_n.size(); ++i)
+        ++size[groups.find(static_cast<std::int32_t>(i))];
+      const auto largest = std::max_element(size.begin(), size.end()) - size.begin();
+      const bool several =
+          std::count_if(size.begin(), size.end(), [](std::size_t k) { return k > 0; }) > 1;
+      for (std::size_t i = 0; i < around_n.size(); ++i)
+        if (!several || groups.find(static_cast<std::int32_t>(i)) != largest)
+          rejoin.push_back(around_n[i]);
+    }
+    std::sort(rejoin.begin(), rejoin.end());
+    std::erase_if(separated, [&](const FaceKey& key) {
+      return std::binary_search(rejoin.begin(), rejoin.end(), key);
+    });
+    if (separated.empty()) return result;
+  }
+  if (separated.empty()) return result;
+  report.separated_faces = separated.size();
+  report.duplicated_nodes = node_origin.size() - model.node_count;
+
+  // 6. Pieces: elements joined through shared nodes. Pieces holding a fixed node stay (all of
+  // them: the surgeon's cut is not undone); without fixed nodes the largest stays.
+  const std::size_t nodes_after_split = node_origin.size();
+  UnionFind pieces(nodes_after_split);
+  for (std::size_t e = 0; e < tets; ++e)
+    for (int c = 1; c < 4; ++c) pieces.unite(corner[0][e], corner[c][e]);
+  std::vector<double> piece_volume(nodes_after_split, 0.0);
+  std::vector<std::uint8_t> piece_fixed(nodes_after_split, 0);
+  for (std::size_t e = 0; e < tets; ++e)
+    piece_volume[pieces.find(corner[0][e])] += model.rest_volume_m3[e];
+  bool any_fixed = false;
+  for (std::size_t n = 0; n < nodes_after_split; ++n)
+    if (model.is_fixed[node_origin[n]]) {
+      piece_fixed[pieces.find(static_cast<std::int32_t>(n))] = 1;
+      any_fixed = true;
+    }
+  std::int32_t largest = -1;
+  for (std::size_t n = 0; n < nodes_after_split; ++n)
+    if (piece_volume[n] > 0.0 && (largest < 0 || piece_volume[n] > piece_volume[largest]))
+      largest = static_cast<std::int32_t>(n);
+  auto keeps = [&](std::int32_t root) {
+    return any_fixed ? piece_fixed[root] != 0 : root == largest;
+  };
+
+  // 7. The new model: the kept elements (in their old order) and the nodes they use.
+  std::vector<TetIndex> element_origin;
+  element_origin.reserve(tets);
+  for (std::size_t e = 0; e < tets; ++e) {
+    if (keeps(pieces.find(corner[0][e]))) {
+      element_origin.push_back(static_cast<TetIndex>(e));
+    } else {
+      ++report.removed_elements;
+      report.resected_volume_m3 += shape_of(corners_at(model, geometry.rest_m, e)).volume_m3;
+      report.resected_mass_kg += geometry.element_mass_kg[e];
+    }
+  }
+  if (element_origin.empty())
+    return result;  // the sweep would take everything away (no fixed node): leave it whole
+  std::vector<NodeIndex> new_index(nodes_after_split, -1);
+  std::vector<NodeIndex> kept_node_origin;
+  for (TetIndex e : element_origin)
+    for (int c = 0; c < 4; ++c) {
+      const NodeIndex n = corner[c][e];
+      if (new_index[n] < 0) new_index[n] = 0;
+    }
+  for (std::size_t n = 0; n < nodes_after_split; ++n)
+    if (new_index[n] == 0) {
+      new_index[n] = static_cast<NodeIndex>(kept_node_origin.size());
+      kept_node_origin.push_back(static_cast<NodeIndex>(n));  // index after the split, for now
+    }
+  report.removed_nodes = nodes_after_split - kept_node_origin.size();
+
+  auto next = std::make_shared<SimModel>(model);
+  SimModel& m = *next;
+  m.node_count = kept_node_origin.size();
+  m.tet_count = element_origin.size();
+  auto take = [&](auto& per_element) {
+    if (per_element.empty()) return;
+    std::remove_reference_t<decltype(per_element)> kept(element_origin.size());
+    for (std::size_t i = 0; i < element_origin.size(); ++i)
+      kept[i] = per_element[element_origin[i]];
+    per_element = std::move(kept);
+  };
+  for (int c = 0; c < 4; ++c) {
+    m.corner[c].resize(element_origin.size());
+    for (std::size_t i = 0; i < element_origin.size(); ++i)
+      m.corner[c][i] = new_index[corner[c][element_origin[i]]];
+  }
+  for (auto& entry : m.dm_inverse) take(entry);
+  take(m.rest_volume_m3);
+  take(m.shear_modulus_pa);
+  take(m.lame_lambda_pa);
+  take(m.mooney_rivlin_c2_pa);
+  take(m.region);
+  take(m.fibre_parameters);
+  for (auto& family : m.fibre_direction) take(family);
+  if (m.cut_face_mask.empty()) m.cut_face_mask.assign(tets, 0);
+  take(m.cut_face_mask);
+  if (m.boundary_face_mask.empty()) {  // the first cut: the organ's surface
+    m.boundary_face_mask.assign(tets, 0);
+    for (std::size_t e = 0; e < tets; ++e)
+      for (int f = 0; f < 4; ++f)
+        if (!neighbours(e, f)) m.boundary_face_mask[e] |= std::uint8_t(1u << f);
+  }
+  take(m.boundary_face_mask);
+  m.element_mass_kg = std::move(geometry.element_mass_kg);
+  take(m.element_mass_kg);
+
+  m.rest_position_m.resize(m.node_count);
+  m.is_fixed.assign(m.node_count, 0);
+  std::vector<NodeIndex> origin(m.node_count);
+  for (std::size_t i = 0; i < m.node_count; ++i) {
+    const NodeIndex split = kept_node_origin[i];
+    origin[i] = node_origin[split];
+    m.rest_position_m.set(i, geometry.rest_m.at(origin[i]));
+    m.is_fixed[i] = model.is_fixed[origin[i]];
+  }
+
+  // Elements whose corners moved get their shape data again; the cut faces are marked.
+  std::vector<std::uint8_t> reshaped(m.tet_count, 0), on_cut(model.node_count, 0);
+  for (NodeIndex n : touched) on_cut[n] = 1;
+  for (std::size_t i = 0; i < m.tet_count; ++i) {
+    const std::size_t old = element_origin[i];
+    bool moved = false;
+    int corners_on_cut = 0;
+    for (int c = 0; c < 4; ++c) {
+      moved |= snapped[model.corner[c][old]] != 0;
+      corners_on_cut += on_cut[model.corner[c][old]];
+    }
+    if (corners_on_cut >= 3)
+      for (int f = 0; f < 4; ++f)
+        if (is_separated(face_key(model, old, f))) {
+          m.cut_face_mask[i] |= std::uint8_t(1u << f);
+          m.boundary_face_mask[i] |= std::uint8_t(1u << f);
+        }
+    reshaped[i] = moved;
+    if (!moved) continue;
+    const Eigen::Vector3d x0 = m.rest_position_m.at(m.corner[0][i]);
+    Eigen::Matrix3d dm;
+    for (int c = 1; c < 4; ++c) dm.col(c - 1) = m.rest_position_m.at(m.corner[c][i]) - x0;
+    const Eigen::Matrix3d inverse = dm.inverse();
+    for (int k = 0; k < 9; ++k) m.dm_inverse[k][i] = inverse(k / 3, k % 3);
+    m.rest_volume_m3[i] = dm.determinant() / 6.0;
+  }
+  m.lumped_mass_kg.assign(m.node_count, 0.0);
+  for (std::size_t i = 0; i < m.tet_count; ++i)
+    for (int c = 0; c < 4; ++c) m.lumped_mass_kg[m.corner[c][i]] += m.element_mass_kg[i] / 4.0;
+  m.inverse_mass_per_kg.resize(m.node_count);
+  for (std::size_t n = 0; n < m.node_count; ++n)
+    m.inverse_mass_per_kg[n] =
+        !m.is_fixed[n] && m.lumped_mass_kg[n] > 0.0 ? 1.0 / m.lumped_mass_kg[n] : 0.0;
+  build_node_incidence(m);
+
+  // The stable step: the mesh's largest frequency is the old one or one of the modes around the
+  // cut (see local_max_frequency_rad_per_s); the smallest height may only shrink.
+  NodeArray position;
+  position.resize(m.node_count);
+  for (std::size_t n = 0; n < m.node_count; ++n) position.set(n, geometry.position_m.at(origin[n]));
+  // The modes a cut raises sit on the nodes it split (less mass each) and the elements a snap
+  // reshaped.
+  std::vector<NodeIndex> around_cut;
+  for (std::size_t n = 0; n < m.node_count; ++n)
+    if (on_cut[origin[n]]) around_cut.push_back(static_cast<NodeIndex>(n));
+  for (std::size_t i = 0; i < m.tet_count; ++i) {
+    if (!reshaped[i]) continue;
+    std::array<Eigen::Vector3d, 4> p;
+    for (int c = 0; c < 4; ++c) {
+      around_cut.push_back(m.corner[c][i]);
+      p[c] = m.rest_position_m.at(m.corner[c][i]);
+    }
+    m.min_element_height_m = std::min(m.min_element_height_m, shape_of(p).min_height_m);
+  }
+  m.max_frequency_rad_per_s =
+      std::max(m.max_frequency_rad_per_s, local_max_frequency_rad_per_s(m, around_cut));
+  m.stable_time_step_s = stable_time_step_s(m, StepInputs{});
+
+  // 8. The state carried over: positions and velocities of each node's origin, the history of
+  // each element; the energy books open again on the new model.
+  SimState next_state = make_rest_state(m, state.force_scratch.workers);
+  for (std::size_t n = 0; n < m.node_count; ++n) {
+    next_state.position_m.set(n, position.at(n));
+    next_state.velocity_m_per_s.set(n, geometry.velocity_m_per_s.at(origin[n]));
+  }
+  if (m.effects.viscous)
+    for (std::size_t i = 0; i < m.tet_count; ++i)
+      next_state.viscous_history.copy_element(state.viscous_history,
+                                              static_cast<std::size_t>(element_origin[i]), i);
+  next_state.time_s = state.time_s;
+  next_state.step_count = state.step_count;
+  next_state.last_step_s = state.last_step_s;
+  next_state.max_speed_m_per_s = state.max_speed_m_per_s;
+  open_energy_books(m, next_state);
+
+  result.model = std::move(next);
+  result.state = std::move(next_state);
+  result.node_origin = std::move(origin);
+  result.element_origin = std::move(element_origin);
+  return result;
+}
+
+}  // namespace liversim

@@ -1,0 +1,291 @@
+#pragma once
+// Runs a simulation on its own thread in step with the wall clock, takes inputs (springs from a
+// dragged point) from other threads and publishes snapshots of the node positions.
+//
+// Time advances in whole steps of a fixed length (the model's integrator step, or its stable
+// explicit step when none is set): the wall time that passes is added to a backlog and the whole
+// steps in it are taken, at most max_steps_per_cycle at a time. When the machine cannot keep up,
+// the backlog beyond that cap is dropped, so simulated time runs slower than the wall clock instead
+// of the loop spiralling into ever longer catch-up cycles.
+
+#include "liversim/engine/forces.h"
+#include "liversim/engine/health.h"
+#include "liversim/engine/model.h"
+#include "liversim/engine/state.h"
+#include "liversim/haptics/servo_loop.h"
+#include "liversim/haptics/triple_buffer.h"
+#include "liversim/interaction/cutting.h"
+#include "liversim/interaction/simulation_input.h"
+#include "liversim/interaction/tools.h"
+#include "liversim/simulation/tissue_outcome.h"
+
+#include <atomic>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+namespace liversim {
+
+struct SimulationSnapshot {
+  NodeArray position_m;
+  double time_s = 0.0;
+  std::uint64_t step_count = 0;
+  // The tool (when tools are enabled and one is set): the tissue's force on it after the last
+  // step, whether the forceps hold tissue, and how many nodes its contact pushes.
+  Eigen::Vector3d tool_force_n = Eigen::Vector3d::Zero();
+  bool tool_grasping = false;
+  std::size_t tool_contacts = 0;
+  bool blade_cutting = false;  // the scalpel has broken into the tissue
+  // The tool acting in the last cycle (set_tool's, or the device's), for drawing.
+  std::optional<Tool> tool;
+  // The haptic device's newest frame (set_haptic_servo), which the device's tool follows.
+  std::optional<DeviceSample> device_sample;
+  // The model the positions belong to: a cut replaces it (and raises topology_version), so a
+  // reader rebuilds what it draws from the mesh when the version changes.
+  std::shared_ptr<const SimModel> model;
+  std::uint64_t topology_version = 0;
+  double resected_volume_m3 = 0.0;  // taken out by cuts since the start
+};
+
+struct RealtimeStats {
+  // Measured over the last statistics window (about a quarter of a second of wall time).
+  double steps_per_second = 0.0;  // integrator steps (substeps included)
+  double real_time_factor = 0.0;  // simulated seconds per wall-clock second
+  double step_s = 0.0;            // smallest step the integrator actually took
+  bool behind = false;            // the step cap bit: simulated time runs slower than real time
+
+  IntegratorKind integrator = IntegratorKind::central_difference;
+  std::string_view integrator_name;  // integrator_name(integrator); static storage
+  double requested_step_s = 0.0;     // the fixed step the loop advances by
+  // Largest local error estimate of the steps taken (m, node positions); NaN when the integrator
+  // gave none (e.g. right after a step change).
+  double error_estimate_m = std::numeric_limits<double>::quiet_NaN();
+  // Cost: wall seconds spent integrating per simulated second (below 1 keeps up with real time),
+  // and internal-force evaluations of the whole mesh per simulated second.
+  double wall_s_per_simulated_s = 0.0;
+  double force_evaluations_per_simulated_s = 0.0;
+  // An explicit scheme had to shorten the requested step to stay stable (it substepped).
+  bool stability_limited = false;
+  double dropped_s = 0.0;  // wall time dropped from the backlog since the start (see `behind`)
+
+  // Guards (health.h), since the start: attempts rolled back to the last good state, inputs
+  // refused as not finite, the last problem met, and whether the simulation gave up and halted
+  // (the liver stays as it last was good; a new simulation is needed to go on).
+  int rollbacks = 0;
+  int rejected_inputs = 0;
+  HealthProblem last_problem = HealthProblem::none;
+  bool halted = false;
+  // Energy books (energy.h), closed once per statistics window: energy created beyond the
+  // guard's tolerance (a scheme going unstable shows here before any NaN), and the share of the
+  // energy supplied that viscosity, plasticity and damping have taken out.
+  bool energy_created = false;
+  double dissipated_fraction = 0.0;
+};
+
+// The fixed-step clock of the real-time loop, without the loop: wall time is added, whole steps
+// come out, at most max_steps at a time; the rest of a backlog beyond the cap is dropped.
+class StepAccumulator {
+ public:
+  struct Due {
+    int steps = 0;           // whole steps to take now (at most max_steps)
+    bool capped = false;     // the cap bit and whole steps were dropped
+    double dropped_s = 0.0;  // backlog dropped by this call
+  };
+
+  // step_s > 0 and max_steps >= 1, else std::invalid_argument.
+  StepAccumulator(double step_s, int max_steps);
+
+  // Adds elapsed wall time (negative or non-finite values count as 0) and takes the steps due.
+  // The fraction of a step left over stays in the backlog.
+  Due add(double elapsed_s);
+
+  double step_s() const { return step_s_; }
+  int max_steps() const { return max_steps_; }
+  double backlog_s() const { return backlog_s_; }
+  // Wall time until the next whole step is due.
+  double time_to_next_step_s() const { return step_s_ - backlog_s_; }
+
+ private:
+  double step_s_;
+  int max_steps_;
+  double backlog_s_ = 0.0;
+};
+
+// The fixed step the real-time loop advances by: the model's integrator step, or its stable
+// explicit step when that is 0.
+double realtime_step_s(const SimModel& model);
+
+class RealtimeSimulation {
+ public:
+  struct Options {
+    std::size_t spring_capacity = 1024;
+    double cycle_s = 1.0 / 120.0;  // simulated time a cycle may cover, when max_steps_per_cycle=0
+    // Steps one cycle (one published snapshot) may take at most; 0: as many as fit in cycle_s
+    // (at least one).
+    int max_steps_per_cycle = 0;
+  };
+
+  RealtimeSimulation(std::shared_ptr<const SimModel> model, SimState initial_state);
+  RealtimeSimulation(std::shared_ptr<const SimModel> model, SimState initial_state,
+                     Options options);
+  ~RealtimeSimulation();
+  RealtimeSimulation(const RealtimeSimulation&) = delete;
+  RealtimeSimulation& operator=(const RealtimeSimulation&) = delete;
+
+  void start();
+  void stop();
+  bool running() const { return thread_.joinable(); }
+
+  // Replaces the springs acting on the liver (at most spring_capacity; extra ones are dropped and
+  // the call returns false).
+  bool set_springs(std::span<const NodeSpring> springs);
+  void clear_springs() { set_springs({}); }
+
+  // Tools (tools.h) touch `surface` (the model's boundary); call while stopped. From then on the
+  // tool set by set_tool acts at every step: its contact and grasp springs are recomputed from the
+  // deforming surface before each step, besides the springs above.
+  void enable_tools(const BoundarySurface& surface, ContactSettings contact = {},
+                    GraspSettings grasp = {});
+  bool tools_enabled() const { return tools_.has_value(); }
+  // From then on a scalpel cuts (cutting.h). Its blade presses on the tissue like any tool until
+  // the stress in an element it pushes reaches the cutting threshold; then the blade breaks in:
+  // it stops pushing (only the shaft still does), its edge at each cycle extends the stroke, and
+  // the tissue the stroke has passed through is separated. Taking the scalpel away or changing
+  // the tool ends the stroke. A cut replaces the model and state (see SimulationSnapshot::model)
+  // and drops the springs set by set_springs (their nodes may be gone). Call while stopped,
+  // after enable_tools.
+  void enable_cutting(CuttingSettings settings = {});
+  bool cutting_enabled() const { return cutting_.has_value(); }
+  // The tool's kind, pose and jaws from any thread (nothing: no tool in the scene); the newest
+  // is used from the next cycle on.
+  void set_tool(const std::optional<Tool>& tool);
+  // Publishes the local model of the force on the tool to `servo` after every cycle (none: the
+  // zero model), for the haptic device to render, and takes the device's newest frame from it
+  // each cycle (the only reader of ServoLoop::newest_frame while it runs). Call while stopped;
+  // null stops both.
+  void set_haptic_servo(ServoLoop* servo);
+  // From any thread: the haptic device holds this tool (nothing: it holds none). While one is set
+  // and a servo is attached, each cycle takes the device's newest frame, maps it into the scene
+  // (the servo's WorkspaceMapping) and uses device_tool() as the tool; set_tool is then ignored.
+  // Frames stamped before `from_servo_s` (servo clock) are not taken: the mouse puts the tool
+  // down where it presses, and a frame from before the press must not show it where it was.
+  void set_device_tool(const std::optional<DeviceToolSettings>& settings,
+                       double from_servo_s = -std::numeric_limits<double>::infinity());
+
+  // From any thread: from the next cycle on, each published cycle is observed by an outcome
+  // tracker, and cuts carry it over (a session's tissue damage, lift, resected volume). Off until
+  // asked: a scene without a session pays nothing for it.
+  void track_outcome(std::optional<Eigen::Vector3d> lift_point_m, DamageStrains damage = {});
+  // Goes on with tracking carried from another simulation of the same model (an integrator
+  // change): its elements must be this model's.
+  void track_outcome(OutcomeTracking carried);
+  void stop_tracking_outcome();
+  // A copy of the tracking so far; none when off or not yet begun (the first cycle after
+  // track_outcome begins it).
+  std::optional<OutcomeTracking> outcome() const;
+
+  // From any thread: keep (or stop keeping) every input the simulation takes from its next loop
+  // on, and take those kept so far.
+  void log_inputs(bool on);
+  std::vector<SimulationInput> take_input_log();
+  // While stopped: takes `inputs` (an input log of a simulation built from the same model and
+  // state, with the same tools and cutting enabled) exactly as the loop took them, and publishes
+  // a snapshot after each cycle as the loop does.
+  void replay(std::span<const SimulationInput> inputs);
+
+  // Consumer side (one thread, e.g. the UI): the newest snapshot, if one was published since.
+  bool update_snapshot() { return snapshots_.update(); }
+  const SimulationSnapshot& snapshot() const { return snapshots_.front(); }
+
+  // The simulation's own state and model; only while it is stopped (e.g. to carry positions and
+  // velocities over to a rebuilt model). While it runs, a cut may replace both: take the model
+  // from the snapshot.
+  const SimState& state() const { return state_; }
+
+  RealtimeStats stats() const;
+  const SimModel& model() const { return *model_; }
+  std::shared_ptr<const SimModel> shared_model() const { return model_; }
+  double step_s() const { return step_s_; }
+  int max_steps_per_cycle() const { return max_steps_per_cycle_; }
+
+ private:
+  void run();
+
+  std::shared_ptr<const SimModel> model_;
+  SimState state_;
+  Options options_;
+  double step_s_;
+  int max_steps_per_cycle_;
+  TripleBuffer<SimulationSnapshot> snapshots_;
+
+  std::mutex springs_mutex_;  // UI ↔ simulation only; never on the haptic servo path
+  std::vector<NodeSpring> pending_springs_;
+  bool springs_changed_ = false;
+  std::vector<NodeSpring> active_springs_;  // simulation thread's copy
+  std::optional<Tool> pending_tool_;        // under springs_mutex_
+  bool tool_changed_ = false;
+  std::optional<Tool> active_tool_;                        // simulation thread's copy
+  std::optional<DeviceToolSettings> pending_device_tool_;  // under springs_mutex_
+  bool device_tool_changed_ = false;
+  double pending_device_tool_from_s_ = 0.0;        // under springs_mutex_
+  std::optional<DeviceToolSettings> device_tool_;  // simulation thread's copy
+  double device_tool_from_s_ = 0.0;
+  std::optional<DeviceSample> device_sample_;  // the servo's newest frame
+  ServoLoop* haptic_servo_ = nullptr;
+  std::optional<ToolInteraction> tools_;  // simulation thread only once started
+  std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tool's
+  ContactSettings contact_settings_;
+  GraspSettings grasp_settings_;
+  std::optional<CuttingSettings> cutting_;
+  BladeStroke stroke_;            // simulation thread only
+  bool blade_in_tissue_ = false;  // the scalpel broke in: its blade passes and cuts
+  std::uint64_t topology_version_ = 0;
+  double resected_volume_m3_ = 0.0;
+  IntegratorKind integrator_kind_;  // the model's, fixed: stats() reads it from any thread
+  // Extends the stroke with the scalpel's edge, cuts, and swaps in the cut model and state.
+  void cut_with_scalpel(const Tool& scalpel);
+  void end_stroke();  // the blade is out: the next cut needs a new break-in
+  // Takes the inputs set from other threads (springs, tool, device tool) for the next cycle.
+  void take_inputs();
+  void change_tool(const std::optional<Tool>& tool);
+  void take_tool(const std::optional<Tool>& tool);  // the loop's: logged, then change_tool
+  // A cycle's steps, guarded, and the cut of a scalpel in the tissue after them.
+  GuardedReport advance_cycle(int steps, bool check_energy);
+  // The snapshot of the cycle just taken (and the force model to the servo, if any).
+  void publish_cycle();
+  void log_input(SimulationInput input);  // simulation thread, when logging_inputs_
+  std::atomic<bool> logging_inputs_{false};
+  std::mutex input_log_mutex_;              // UI ↔ simulation only
+  std::vector<SimulationInput> input_log_;  // under input_log_mutex_
+  double haptic_servo_period_s() const;
+
+  // Outcome tracking: asked for from any thread, begun and updated by the simulation thread.
+  mutable std::mutex outcome_mutex_;  // UI ↔ simulation only
+  std::optional<std::pair<std::optional<Eigen::Vector3d>, DamageStrains>> outcome_request_;
+  std::optional<OutcomeTracking> outcome_;
+  void observe_outcome();  // simulation thread, once per published cycle
+
+  std::atomic<bool> stop_requested_{false};
+  // Statistics, written by the simulation thread once per window; each field on its own (a reader
+  // may see fields of two neighbouring windows, which is harmless for a display).
+  std::atomic<double> steps_per_second_{0.0}, real_time_factor_{0.0}, smallest_step_s_{0.0};
+  std::atomic<double> error_estimate_m_{std::numeric_limits<double>::quiet_NaN()};
+  std::atomic<double> wall_s_per_simulated_s_{0.0}, force_evaluations_per_simulated_s_{0.0},
+      dropped_s_{0.0};
+  std::atomic<bool> behind_{false}, stability_limited_{false};
+  StateCheckpoint checkpoint_;  // simulation thread only
+  std::atomic<int> rollbacks_{0}, rejected_inputs_{0};
+  std::atomic<HealthProblem> last_problem_{HealthProblem::none};
+  std::atomic<bool> halted_{false};
+  std::atomic<bool> energy_created_{false};
+  std::atomic<double> dissipated_fraction_{0.0};
+  std::thread thread_;
+};
+
+}  // namespace liversim

@@ -1,0 +1,557 @@
+#include "liversim/simulation/realtime_simulation.h"
+
+#include "liversim/engine/integrator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace liversim {
+namespace {
+
+SimulationSnapshot snapshot_of(const SimState& state, std::shared_ptr<const SimModel> model) {
+  SimulationSnapshot snapshot;
+  snapshot.position_m = state.position_m;
+  snapshot.time_s = state.time_s;
+  snapshot.step_count = state.step_count;
+  snapshot.model = std::move(model);
+  return snapshot;
+}
+
+// Whole steps that fit in `cycle_s`, at least one: a step longer than a cycle is still taken.
+int steps_per_cycle(double cycle_s, double step_s) {
+  if (!(cycle_s > 0.0) || !std::isfinite(cycle_s)) return 1;
+  return static_cast<int>(std::clamp(std::ceil(cycle_s / step_s - 1e-9), 1.0, 1e6));
+}
+
+}  // namespace
+
+StepAccumulator::StepAccumulator(double step_s, int max_steps)
+    : step_s_(step_s), max_steps_(max_steps) {
+  if (!(step_s > 0.0) || !std::isfinite(step_s))
+    throw std::invalid_argument("real-time step must be a finite value > 0 s, not " +
+                                std::to_string(step_s));
+  if (max_steps < 1)
+    throw std::invalid_argument("real-time step cap must be at least 1 step per cycle, not " +
+                                std::to_string(max_steps));
+}
+
+StepAccumulator::Due StepAccumulator::add(double elapsed_s) {
+  if (std::isfinite(elapsed_s) && elapsed_s > 0.0) backlog_s_ += elapsed_s;
+  // A relative slack of 1e-9 step keeps wall times that sum to a whole step in floating point
+  // (10 × 0.1 ms) from coming out one step short.
+  const double whole = std::floor(backlog_s_ / step_s_ + 1e-9);
+  Due due;
+  if (whole > static_cast<double>(max_steps_)) {
+    due.steps = max_steps_;
+    due.capped = true;
+    due.dropped_s = (whole - max_steps_) * step_s_;
+  } else {
+    due.steps = static_cast<int>(whole);
+  }
+  backlog_s_ = std::max(0.0, backlog_s_ - whole * step_s_);
+  return due;
+}
+
+double realtime_step_s(const SimModel& model) {
+  return model.integrator.step_s > 0.0 ? model.integrator.step_s : model.stable_time_step_s;
+}
+
+RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
+                                       SimState initial_state)
+    : RealtimeSimulation(std::move(model), std::move(initial_state), Options{}) {}
+
+RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
+                                       SimState initial_state, Options options)
+    : model_(std::move(model)),
+      state_(std::move(initial_state)),
+      options_(options),
+      step_s_(realtime_step_s(*model_)),
+      max_steps_per_cycle_(options.max_steps_per_cycle > 0
+                               ? options.max_steps_per_cycle
+                               : steps_per_cycle(options.cycle_s, step_s_)),
+      snapshots_(snapshot_of(state_, model_)),
+      integrator_kind_(model_->integrator.kind) {
+  if (!(step_s_ > 0.0) || !std::isfinite(step_s_))
+    throw std::invalid_argument("the model has no usable time step (" + std::to_string(step_s_) +
+                                " s)");
+  pending_springs_.reserve(options_.spring_capacity);
+  active_springs_.reserve(options_.spring_capacity);
+  checkpoint_ = make_checkpoint(*model_);
+}
+
+RealtimeSimulation::~RealtimeSimulation() {
+  stop();
+}
+
+void RealtimeSimulation::start() {
+  if (thread_.joinable()) return;
+  stop_requested_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void RealtimeSimulation::stop() {
+  stop_requested_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+void RealtimeSimulation::enable_tools(const BoundarySurface& surface, ContactSettings contact,
+                                      GraspSettings grasp) {
+  if (running()) throw std::logic_error("enable_tools: stop the simulation first");
+  tools_.emplace(*model_, surface, contact, grasp);
+  contact_settings_ = contact;
+  grasp_settings_ = grasp;
+  // The set springs and at most two per surface node from the tool (hold and contact): no
+  // reallocation in a step.
+  step_springs_.reserve(options_.spring_capacity + 2 * surface.nodes.size());
+}
+
+void RealtimeSimulation::enable_cutting(CuttingSettings settings) {
+  if (running()) throw std::logic_error("enable_cutting: stop the simulation first");
+  if (!tools_) throw std::logic_error("enable_cutting: enable the tools first");
+  if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
+  cutting_ = settings;
+}
+
+void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
+  const auto edge = blade_edge_m(scalpel);
+  if (!blade_in_tissue_) {
+    if (!scalpel.blade_armed) return;
+    // Breaks in where an element the blade pushes is stressed to the cutting threshold.
+    double stress_pa = -1.0;
+    for (const NodeSpring& spring : tools_->springs())
+      for (std::int32_t s = model_->node_slot_begin[spring.node];
+           s < model_->node_slot_begin[spring.node + 1]; ++s)
+        stress_pa = std::max(
+            stress_pa, element_cutting_stress_pa(*model_, state_, model_->node_slot_element[s]));
+    if (stress_pa < cutting_->cutting_stress_pa) return;
+    blade_in_tissue_ = true;
+    stroke_.edges_m.assign(1, edge);
+    return;
+  }
+  // A new instant of the stroke once the edge has moved a tenth of a millimetre (a broken-in
+  // blade's stroke starts where it broke in).
+  const auto& last = stroke_.edges_m.back();
+  if ((edge[0] - last[0]).norm() < 1e-4 && (edge[1] - last[1]).norm() < 1e-4) return;
+  // Drawn out of the tissue, the blade has to break in again. Within a few millimetres of tissue
+  // it is still in: in its own cut the edge may touch no element.
+  constexpr double kBladeReachM = 0.003;
+  if (!blade_edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)) return end_stroke();
+  // Disarmed, the blade passes on without cutting; armed again, the stroke goes on from here.
+  if (!scalpel.blade_armed) {
+    stroke_.edges_m.assign(1, edge);
+    return;
+  }
+  stroke_.add(edge);
+  if (stroke_.edges_m.size() < 2) return;
+  // Once in, the edge cuts whatever it is drawn through: the stress at a sharp edge in the tissue
+  // (a crack front) is unbounded, which no element's average resolves, so the threshold decides
+  // only where the blade breaks in. Otherwise the tissue, relaxed around a still blade, would let
+  // the blade pass uncut.
+  CuttingSettings propagating = *cutting_;
+  propagating.cutting_stress_pa = 0.0;
+  CutResult cut = cut_tissue(*model_, state_, stroke_, propagating);
+  if (!cut.cut()) return;
+  {
+    std::lock_guard lock(outcome_mutex_);
+    if (outcome_) {
+      outcome_->tracker.carry_over(cut);
+      outcome_->model = cut.model;
+    }
+  }
+  model_ = std::move(cut.model);
+  state_ = std::move(cut.state);
+  checkpoint_ = make_checkpoint(*model_);
+  const BoundarySurface surface = boundary_surface(*model_);
+  tools_.emplace(*model_, surface, contact_settings_, grasp_settings_);
+  step_springs_.reserve(options_.spring_capacity + 2 * surface.nodes.size());
+  {
+    std::lock_guard lock(springs_mutex_);
+    pending_springs_.clear();
+    springs_changed_ = false;
+  }
+  active_springs_.clear();
+  ++topology_version_;
+  resected_volume_m3_ += cut.report.resected_volume_m3;
+}
+
+void RealtimeSimulation::track_outcome(std::optional<Eigen::Vector3d> lift_point_m,
+                                       DamageStrains damage) {
+  std::lock_guard lock(outcome_mutex_);
+  outcome_.reset();
+  outcome_request_.emplace(lift_point_m, damage);
+}
+
+void RealtimeSimulation::track_outcome(OutcomeTracking carried) {
+  std::lock_guard lock(outcome_mutex_);
+  outcome_request_.reset();
+  outcome_ = std::move(carried);
+}
+
+void RealtimeSimulation::stop_tracking_outcome() {
+  std::lock_guard lock(outcome_mutex_);
+  outcome_request_.reset();
+  outcome_.reset();
+}
+
+std::optional<OutcomeTracking> RealtimeSimulation::outcome() const {
+  std::lock_guard lock(outcome_mutex_);
+  return outcome_;
+}
+
+void RealtimeSimulation::observe_outcome() {
+  std::lock_guard lock(outcome_mutex_);
+  if (outcome_request_) {  // allocates once, when tracking begins
+    outcome_.emplace(
+        OutcomeTracking{OutcomeTracker(*model_, outcome_request_->first, outcome_request_->second),
+                        model_, model_});
+    outcome_request_.reset();
+  }
+  if (!outcome_) return;
+  outcome_->tracker.observe(*model_, state_.position_m);
+  outcome_->model = model_;
+}
+
+void RealtimeSimulation::end_stroke() {
+  stroke_.edges_m.clear();
+  blade_in_tissue_ = false;
+}
+
+double RealtimeSimulation::haptic_servo_period_s() const {
+  // Without a servo the model's damping is not used: any period will do.
+  return haptic_servo_ ? 1.0 / haptic_servo_->safety().nominal_rate_hz : 1e-3;
+}
+
+void RealtimeSimulation::set_haptic_servo(ServoLoop* servo) {
+  if (running()) throw std::logic_error("set_haptic_servo: stop the simulation first");
+  haptic_servo_ = servo;
+  device_sample_.reset();
+}
+
+void RealtimeSimulation::set_device_tool(const std::optional<DeviceToolSettings>& settings,
+                                         double from_servo_s) {
+  std::lock_guard lock(springs_mutex_);
+  pending_device_tool_ = settings;
+  pending_device_tool_from_s_ = from_servo_s;
+  device_tool_changed_ = true;
+  // The tool held so far goes with the change; a set_tool after this call counts.
+  pending_tool_.reset();
+  tool_changed_ = false;
+}
+
+void RealtimeSimulation::take_tool(const std::optional<Tool>& tool) {
+  if (logging_inputs_.load(std::memory_order_relaxed))
+    log_input({SimulationInput::Kind::tool, tool, {}, 0, false});
+  change_tool(tool);
+}
+
+void RealtimeSimulation::change_tool(const std::optional<Tool>& tool) {
+  const bool kind_changed = !tool || !active_tool_ || tool->kind != active_tool_->kind;
+  active_tool_ = tool;
+  if (!active_tool_ && tools_) tools_->release();
+  if (kind_changed || active_tool_->kind != ToolKind::scalpel) end_stroke();
+}
+
+void RealtimeSimulation::take_inputs() {
+  {
+    std::lock_guard lock(springs_mutex_);
+    if (springs_changed_) {
+      active_springs_.assign(pending_springs_.begin(), pending_springs_.end());  // no realloc
+      springs_changed_ = false;
+      if (logging_inputs_.load(std::memory_order_relaxed))  // a copy: only when logging
+        log_input({SimulationInput::Kind::springs, std::nullopt, active_springs_, 0, false});
+    }
+    if (device_tool_changed_) {
+      // The tool held so far goes: the device's appears with its first frame, or without a
+      // device, set_tool's next one.
+      device_tool_changed_ = false;
+      device_tool_ = pending_device_tool_;
+      device_tool_from_s_ = pending_device_tool_from_s_;
+      take_tool(std::nullopt);
+    }
+    if (tool_changed_) {
+      tool_changed_ = false;
+      if (!device_tool_) take_tool(pending_tool_);
+    }
+  }
+  ServoFrame frame;
+  if (haptic_servo_ && haptic_servo_->newest_frame(frame)) {
+    device_sample_ = frame.sample;
+    if (device_tool_ && frame.time_s >= device_tool_from_s_)
+      take_tool(device_tool(*device_tool_,
+                            haptic_servo_->mapping().scene_position_m(frame.sample.position_mm),
+                            frame.sample.buttons));
+  }
+}
+
+void RealtimeSimulation::set_tool(const std::optional<Tool>& tool) {
+  std::lock_guard lock(springs_mutex_);
+  pending_tool_ = tool;
+  tool_changed_ = true;
+}
+
+bool RealtimeSimulation::set_springs(std::span<const NodeSpring> springs) {
+  const std::size_t count = std::min(springs.size(), options_.spring_capacity);
+  std::lock_guard lock(springs_mutex_);
+  pending_springs_.assign(springs.begin(), springs.begin() + static_cast<std::ptrdiff_t>(count));
+  springs_changed_ = true;
+  return count == springs.size();
+}
+
+RealtimeStats RealtimeSimulation::stats() const {
+  RealtimeStats stats;
+  stats.steps_per_second = steps_per_second_.load();
+  stats.real_time_factor = real_time_factor_.load();
+  stats.step_s = smallest_step_s_.load();
+  stats.behind = behind_.load();
+  stats.integrator = integrator_kind_;
+  stats.integrator_name = integrator_name(integrator_kind_);
+  stats.requested_step_s = step_s_;
+  stats.error_estimate_m = error_estimate_m_.load();
+  stats.wall_s_per_simulated_s = wall_s_per_simulated_s_.load();
+  stats.force_evaluations_per_simulated_s = force_evaluations_per_simulated_s_.load();
+  stats.stability_limited = stability_limited_.load();
+  stats.dropped_s = dropped_s_.load();
+  stats.rollbacks = rollbacks_.load();
+  stats.rejected_inputs = rejected_inputs_.load();
+  stats.last_problem = last_problem_.load();
+  stats.halted = halted_.load();
+  stats.energy_created = energy_created_.load();
+  stats.dissipated_fraction = dissipated_fraction_.load();
+  return stats;
+}
+
+namespace {
+
+// The reports of consecutive guarded advances as one.
+void merge_guarded(GuardedReport& total, const GuardedReport& one) {
+  accumulate(total.steps, one.steps);
+  total.rollbacks += one.rollbacks;
+  if (one.problem != HealthProblem::none) total.problem = one.problem;
+  total.step_scale = one.step_scale;
+  total.gave_up = total.gave_up || one.gave_up;
+  total.inputs_rejected = total.inputs_rejected || one.inputs_rejected;
+  if (one.energy) {
+    total.energy = one.energy;
+    total.energy_created = one.energy_created;
+  }
+}
+
+}  // namespace
+
+GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
+  const SimModel& model = *model_;  // a cut may replace it between cycles
+  const bool tool_acts = tools_ && active_tool_;
+  // Guarded: a bad step goes back to the last good state and is retried with shorter steps; a
+  // bad input (a NaN from a device) is refused.
+  GuardOptions guard;
+  guard.check_energy = check_energy;
+  // A tool's springs follow the surface: recomputed before every step of the cycle.
+  auto tool_inputs = [&] {
+    step_springs_.assign(active_springs_.begin(), active_springs_.end());
+    const auto tool_springs = tools_->update(*active_tool_, state_.position_m, blade_in_tissue_);
+    step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
+    return StepInputs{{}, step_springs_};
+  };
+  GuardedReport guarded;
+  if (tool_acts) {
+    for (int s = 0; s < steps; ++s) {
+      GuardOptions step_guard = guard;
+      step_guard.check_energy = guard.check_energy && s == 0;
+      const GuardedReport one =
+          guarded_advance(model, state_, tool_inputs(), step_s_, checkpoint_, step_guard);
+      merge_guarded(guarded, one);
+      if (one.gave_up) break;
+    }
+  } else {
+    const StepInputs inputs{{}, active_springs_};
+    guarded = guarded_advance(model, state_, inputs, steps * step_s_, checkpoint_, guard);
+  }
+  if (guarded.energy) {
+    energy_created_ = guarded.energy_created;
+    const double supplied = guarded.energy->supplied_j();
+    dissipated_fraction_ = supplied > 0.0 ? guarded.energy->dissipated_j() / supplied : 0.0;
+  }
+  if (guarded.problem != HealthProblem::none) last_problem_ = guarded.problem;
+  rollbacks_ += guarded.rollbacks;
+  if (guarded.inputs_rejected) ++rejected_inputs_;
+  if (guarded.gave_up) halted_ = true;
+  if (cutting_ && tool_acts && active_tool_->kind == ToolKind::scalpel && !guarded.gave_up)
+    cut_with_scalpel(*active_tool_);
+  return guarded;
+}
+
+namespace {
+// Room for the loop's log between two takes (a display frame holds a few cycles), so that the
+// simulation thread appends without allocating: the caller of take_input_log allocates it.
+constexpr std::size_t kInputLogReserve = 256;
+}  // namespace
+
+void RealtimeSimulation::log_inputs(bool on) {
+  if (on) {
+    std::lock_guard lock(input_log_mutex_);
+    input_log_.reserve(kInputLogReserve);
+  }
+  logging_inputs_.store(on);
+}
+
+std::vector<SimulationInput> RealtimeSimulation::take_input_log() {
+  std::vector<SimulationInput> fresh;
+  fresh.reserve(kInputLogReserve);
+  std::lock_guard lock(input_log_mutex_);
+  std::swap(fresh, input_log_);
+  return fresh;
+}
+
+void RealtimeSimulation::log_input(SimulationInput input) {
+  std::lock_guard lock(input_log_mutex_);
+  // A device moves the tool at every loop, many times between cycles: a tool of the same kind
+  // replacing one that no cycle used has the same effect as both (change_tool), so it replaces it.
+  if (input.kind == SimulationInput::Kind::tool && input.tool && !input_log_.empty()) {
+    SimulationInput& last = input_log_.back();
+    if (last.kind == SimulationInput::Kind::tool && last.tool &&
+        last.tool->kind == input.tool->kind) {
+      last.tool = input.tool;
+      return;
+    }
+  }
+  input_log_.push_back(std::move(input));
+}
+
+void RealtimeSimulation::replay(std::span<const SimulationInput> inputs) {
+  if (running()) throw std::logic_error("replay needs the simulation stopped");
+  for (const SimulationInput& input : inputs) switch (input.kind) {
+      case SimulationInput::Kind::tool:
+        change_tool(input.tool);
+        break;
+      case SimulationInput::Kind::springs:
+        // A log from another model (or a damaged one) must not index past this one's nodes.
+        for (const NodeSpring& spring : input.springs)
+          if (spring.node < 0 || static_cast<std::size_t>(spring.node) >= model_->node_count)
+            throw std::invalid_argument("replay: a spring holds node " +
+                                        std::to_string(spring.node) + " of a model of " +
+                                        std::to_string(model_->node_count) + " nodes");
+        active_springs_.assign(input.springs.begin(), input.springs.end());
+        break;
+      case SimulationInput::Kind::cycle:
+        if (halted_.load()) break;
+        advance_cycle(input.steps, input.check_energy);
+        publish_cycle();  // as the live loop does: the snapshot shows the replayed cycle
+        break;
+    }
+}
+
+void RealtimeSimulation::publish_cycle() {
+  const bool tool_acts = tools_ && active_tool_;
+  SimulationSnapshot& out = snapshots_.back();
+  // Same size: copies without allocating (a cut's new size allocates once).
+  out.position_m.x = state_.position_m.x;
+  out.position_m.y = state_.position_m.y;
+  out.position_m.z = state_.position_m.z;
+  out.time_s = state_.time_s;
+  out.step_count = state_.step_count;
+  // The local model of the force on the tool: its F0 is the snapshot's tool force.
+  const LocalForceModel force_model =
+      tool_acts ? tool_force_model(tools_->springs(), state_.position_m,
+                                   active_tool_->pose.origin_m, haptic_servo_period_s())
+                : LocalForceModel{};
+  out.tool_force_n = force_model.force_n;
+  out.tool_grasping = tool_acts && tools_->grasping();
+  out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
+  out.blade_cutting = tool_acts && blade_in_tissue_;
+  out.tool = tool_acts ? active_tool_ : std::nullopt;
+  out.device_sample = device_sample_;
+  if (haptic_servo_) haptic_servo_->publish(force_model);
+  observe_outcome();
+  out.model = model_;
+  out.topology_version = topology_version_;
+  out.resected_volume_m3 = resected_volume_m3_;
+  snapshots_.publish();
+}
+
+void RealtimeSimulation::run() {
+  using Clock = std::chrono::steady_clock;
+  using Seconds = std::chrono::duration<double>;
+  StepAccumulator clock(step_s_, max_steps_per_cycle_);
+  auto last_cycle = Clock::now();
+
+  // The statistics window: what the integrator reported, the wall time it took and whether the
+  // cap bit, since the window began.
+  constexpr double kWindowS = 0.25;
+  const auto empty_window = [] {
+    StepReport report;
+    report.error_estimate_m = std::numeric_limits<double>::quiet_NaN();  // none yet
+    return report;
+  };
+  auto window_start = last_cycle;
+  double window_sim_start_s = state_.time_s;
+  std::uint64_t window_start_steps = state_.step_count;
+  StepReport window_report = empty_window();
+  double window_integrating_s = 0.0;
+  bool window_capped = false;
+  bool close_books = false;  // close the energy books with the next advance
+  double dropped_s = 0.0;
+
+  while (!stop_requested_.load(std::memory_order_relaxed)) {
+    take_inputs();
+    const auto cycle_start = Clock::now();
+    const StepAccumulator::Due due = clock.add(Seconds(cycle_start - last_cycle).count());
+    last_cycle = cycle_start;
+    if (due.capped) {
+      window_capped = true;
+      dropped_s += due.dropped_s;
+    }
+    if (due.steps > 0 && !halted_.load(std::memory_order_relaxed)) {
+      const bool check_energy = close_books;  // one pass over the elements, once per window
+      close_books = false;
+      if (logging_inputs_.load(std::memory_order_relaxed))
+        log_input(
+            {SimulationInput::Kind::cycle,
+             std::nullopt,
+             {},
+             due.steps,
+             check_energy,
+             haptic_servo_ ? haptic_servo_->now_s() : std::numeric_limits<double>::quiet_NaN()});
+      const GuardedReport guarded = advance_cycle(due.steps, check_energy);
+      window_integrating_s += Seconds(Clock::now() - cycle_start).count();
+      accumulate(window_report, guarded.steps);
+      publish_cycle();
+    } else {
+      // Sleep towards the next step, but wake often enough to stop and to pick up springs.
+      const double sleep_s = std::clamp(clock.time_to_next_step_s(), 0.5e-3, 2e-3);
+      std::this_thread::sleep_for(Seconds(sleep_s));
+    }
+
+    const auto now = Clock::now();
+    const double window_s = Seconds(now - window_start).count();
+    if (window_s >= kWindowS) {
+      close_books = true;
+      const double simulated_s = state_.time_s - window_sim_start_s;
+      steps_per_second_ = static_cast<double>(state_.step_count - window_start_steps) / window_s;
+      real_time_factor_ = simulated_s / window_s;
+      if (window_report.substeps > 0) {
+        smallest_step_s_ = window_report.smallest_substep_s;
+        error_estimate_m_ = window_report.error_estimate_m;
+        stability_limited_ = window_report.stability_limited_steps > 0;
+      }
+      if (simulated_s > 0.0) {
+        wall_s_per_simulated_s_ = window_integrating_s / simulated_s;
+        force_evaluations_per_simulated_s_ = window_report.force_evaluations / simulated_s;
+      }
+      behind_ = window_capped;
+      dropped_s_ = dropped_s;
+      window_start = now;
+      window_sim_start_s = state_.time_s;
+      window_start_steps = state_.step_count;
+      window_report = empty_window();
+      window_integrating_s = 0.0;
+      window_capped = false;
+    }
+  }
+}
+
+}  // namespace liversim
