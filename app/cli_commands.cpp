@@ -110,7 +110,7 @@ ExperimentScene build_scene(int tet_count, const IntegratorSettings& integrator,
   options.integrator = integrator;
   if (viscoelastic) {
     // material-test's assumed split of the seed's E = 3500 Pa (docs/viscous-tissue.md).
-    options.regions[0].viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
+    options.regions[0].viscoelastic = kSeedViscoelastic;
   }
   const auto start = std::chrono::steady_clock::now();
   built.model = build_model(built.scene.mesh, options);

@@ -124,8 +124,8 @@ TissueSpec MaterialPanel::requestedTissue() const {
   tissue.elastic.poisson_ratio = poissonRatio_->value();
   tissue.elastic.density_kg_per_m3 = density_->value();
   if (effects_.viscoelastic && tissue.viscoelastic) {
-    tissue.viscoelastic->e1_pa = e1_->value();
-    tissue.viscoelastic->e2_pa = tissue.elastic.youngs_modulus_pa - e1_->value();
+    tissue.viscoelastic =
+        with_maxwell_arm(*tissue.viscoelastic, e1_->value(), tissue.elastic.youngs_modulus_pa);
     tissue.viscoelastic->eta1_pa_s = eta1_->value();
   }
   if (effects_.viscoplastic && tissue.viscoplastic)
@@ -144,7 +144,8 @@ void MaterialPanel::request() {
   if (youngsModulusKpa_->value() != shownModulusKpa_ && effects_.viscoelastic &&
       inUse_.viscoelastic && shownModulusKpa_ > 0.0) {
     refreshing_ = true;
-    e1_->setValue(e1_->value() * youngsModulusKpa_->value() / shownModulusKpa_);
+    const ViscoelasticParameters shown{e1_->value(), shownModulusKpa_ * 1e3 - e1_->value(), 0.0};
+    e1_->setValue(with_instantaneous_modulus(shown, youngsModulusKpa_->value() * 1e3).e1_pa);
     refreshing_ = false;
   }
   shownModulusKpa_ = youngsModulusKpa_->value();

@@ -17,7 +17,7 @@ TEST(Performance, StateForAnEffectIsHeldOnlyWhenItIsOn) {
   ModelOptions elastic;
   const SimModel plain = build_model(mesh, elastic);
   ModelOptions viscous = elastic;
-  viscous.regions[0].viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
+  viscous.regions[0].viscoelastic = kSeedViscoelastic;
   const SimModel with_arm = build_model(mesh, viscous);
   ModelOptions fibres = elastic;
   fibres.regions[0].fibres = FibreParameters{1000.0, 2.0};

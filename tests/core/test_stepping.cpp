@@ -103,7 +103,7 @@ TEST_F(SteppingFixture, EveryIntegratorAdvancesWithoutAllocating) {
     ModelOptions options;
     options.fixed_nodes = mesh_->node_sets.at("ligament");
     options.regions[0].tissue = TissueMaterial{3500.0, 0.45, 1060.0};
-    options.regions[0].viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
+    options.regions[0].viscoelastic = kSeedViscoelastic;
     options.regions[0].viscoplastic = ViscoplasticParameters{50.0, 500.0, 0.5};
     options.integrator.kind = kind;
     options.integrator.step_s = is_explicit(kind) ? 0.0 : 0.002;

@@ -95,7 +95,7 @@ TEST(Tangent, ElementWithTwoFibreFamiliesAndALesionRegion) {
 // (keep 1, weight 0) and a backward-Euler step (keep 1/(1+θ), weight θ/(1+θ)), and below the
 // collapse limit where the arm is frozen.
 TEST(Tangent, ViscoelasticRateForm) {
-  const ViscousTissueParameters parameters{{2000.0, 1500.0, 2000.0}, 0.45, std::nullopt};
+  const ViscousTissueParameters parameters{kSeedViscoelastic, 0.45, std::nullopt};
   const ViscousTissueStep step(parameters, 0.0);
   std::mt19937 random(31);
   Eigen::Matrix3d fp_inverse = random_deformation(random, 1.0);  // isochoric
@@ -122,7 +122,7 @@ TEST(Tangent, ViscoelasticRateForm) {
 // The two forms of the arm describe one state: with Q = S_e − H, the rate form's stress at the
 // committed deformation equals the incremental update's instantaneous (Δt = 0) stress.
 TEST(ViscousRateForm, AgreesWithTheIncrementalUpdateOnOneState) {
-  const ViscousTissueParameters parameters{{2000.0, 1500.0, 2000.0}, 0.45, std::nullopt};
+  const ViscousTissueParameters parameters{kSeedViscoelastic, 0.45, std::nullopt};
   ViscousTissueState state;
   std::mt19937 random(37);
   const Eigen::Matrix3d F1 = random_deformation(random, 1.1), F2 = random_deformation(random, 0.9);

@@ -20,7 +20,7 @@ using testing::block_mesh;
 RegionMaterial viscous_tissue(std::optional<ViscoplasticParameters> plastic = std::nullopt) {
   RegionMaterial region;
   region.tissue = TissueMaterial{3500.0, 0.3, 1060.0};
-  region.viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
+  region.viscoelastic = kSeedViscoelastic;
   region.viscoplastic = plastic;
   return region;
 }

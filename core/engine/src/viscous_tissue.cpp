@@ -388,4 +388,23 @@ double UniaxialDriver::step_to_nominal_stress(double nominal_stress_pa, double d
   return axial_stretch_;
 }
 
+ViscoelasticParameters seed_viscoelastic_split(double youngs_modulus_pa) {
+  const double seed_e_pa = kSeedViscoelastic.instantaneous_modulus_pa();
+  return {youngs_modulus_pa * kSeedViscoelastic.e1_pa / seed_e_pa,
+          youngs_modulus_pa * kSeedViscoelastic.e2_pa / seed_e_pa, kSeedViscoelastic.eta1_pa_s};
+}
+
+ViscoelasticParameters with_instantaneous_modulus(const ViscoelasticParameters& law,
+                                                  double youngs_modulus_pa) {
+  const double old_e_pa = law.instantaneous_modulus_pa();
+  if (!(old_e_pa > 0.0)) return seed_viscoelastic_split(youngs_modulus_pa);
+  const double scale = youngs_modulus_pa / old_e_pa;
+  return {law.e1_pa * scale, law.e2_pa * scale, law.eta1_pa_s};
+}
+
+ViscoelasticParameters with_maxwell_arm(const ViscoelasticParameters& law, double e1_pa,
+                                        double youngs_modulus_pa) {
+  return {e1_pa, youngs_modulus_pa - e1_pa, law.eta1_pa_s};
+}
+
 }  // namespace liversim

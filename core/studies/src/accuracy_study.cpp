@@ -63,7 +63,7 @@ void apply_study_effects(StudyEffects effects, ModelOptions& options) {
       region.viscoplastic = ViscoplasticParameters{20.0, 500.0, 0.5};
       [[fallthrough]];
     case StudyEffects::viscoelastic:
-      region.viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
+      region.viscoelastic = kSeedViscoelastic;
       break;
     case StudyEffects::fibres:
       region.fibres = FibreParameters{1000.0, 2.0};

@@ -205,7 +205,7 @@ std::vector<StabilityRun> yield_cycles_case(const StabilitySuiteOptions&) {
        {IntegratorKind::central_difference, IntegratorKind::rk4, IntegratorKind::backward_euler}) {
     ModelOptions options;
     options.regions[0].tissue = TissueMaterial{3500.0, 0.45, 1060.0};
-    options.regions[0].viscoelastic = ViscoelasticParameters{2000.0, 1500.0, 2000.0};
+    options.regions[0].viscoelastic = kSeedViscoelastic;
     options.regions[0].viscoplastic = ViscoplasticParameters{yield, 500.0, 0.3};
     options.fixed_nodes = nodes_on_plane(mesh, 0, 0.0);
     options.mass_damping_per_s = 20.0;

@@ -36,6 +36,21 @@ struct ViscoelasticParameters {
   }
 };
 
+// The seed's parenchyma split into its arms: E = E1 + E2 = 3500 Pa with E1 : E2 = 4 : 3, and
+// η1 = 2000 Pa·s (τ = η1/E1 = 1 s). The seed gives E and the arms' roles, not this split; it is
+// the split every study and default here assumes (docs/viscous-tissue.md).
+inline constexpr ViscoelasticParameters kSeedViscoelastic{2000.0, 1500.0, 2000.0};
+
+// The seed's split of another instantaneous modulus E: E1 = 4/7·E, E2 = 3/7·E, its η1.
+ViscoelasticParameters seed_viscoelastic_split(double youngs_modulus_pa);
+// E = E1 + E2 is the tissue's Young's modulus. A new E scales both arms by E_new/E_old, so the
+// relaxation keeps its shape (τ changes with E1); without an old E (≤ 0) the seed's split is taken.
+ViscoelasticParameters with_instantaneous_modulus(const ViscoelasticParameters& law,
+                                                  double youngs_modulus_pa);
+// A new Maxwell arm E1 with E held: E2 = E − E1 follows.
+ViscoelasticParameters with_maxwell_arm(const ViscoelasticParameters& law, double e1_pa,
+                                        double youngs_modulus_pa);
+
 // Seed Eq. 4: above the yield limit σs a viscoplastic element in series creeps by
 // (σ − σs)·tⁿ/η2, σ being the von Mises equivalent of the Kirchhoff stress in 3-D.
 struct ViscoplasticParameters {
