@@ -1,16 +1,11 @@
 #include "record_command.h"
 
 #include "cli_commands.h"
-#include "liversim/engine/model_building.h"
 #include "liversim/haptics/emulated_devices.h"
 #include "liversim/haptics/haptics.h"
-#include "liversim/haptics/servo_loop.h"
 #include "liversim/meshing/default_scene.h"
 #include "liversim/scenario/scenario.h"
-#include "liversim/sessions/session_recorder.h"
-#include "liversim/sessions/session_recording.h"
-#include "liversim/sessions/session_replay.h"
-#include "liversim/simulation/realtime_simulation.h"
+#include "liversim/station/workstation.h"
 #include "liversim/storage/sqlite_session_store.h"
 
 #include <CLI/CLI.hpp>
@@ -102,44 +97,17 @@ int wait_for_stop_signal(const sigset_t& stop, double seconds) {
   return signal > 0 ? signal : 0;
 }
 
-// The scene a session runs: a scenario's (its exact text is stored with the session) or free
-// practice on the built-in liver.
-struct RecordedScene {
-  std::optional<Scenario> scenario;
-  std::string scenario_text;
-  fs::path scenario_folder;
-  SceneSetup setup;
-};
-
-// Reads the scenario (its errors are thrown, each naming its field); the scene is built later.
-RecordedScene read_recorded_scenario(const RecordOptions& options) {
-  RecordedScene scene;
-  if (!options.scenario) return scene;
-  const fs::path& file = *options.scenario;
-  ScenarioReading reading = read_scenario_file(file);
-  if (!reading.scenario) {
-    std::string message = "cannot open the scenario " + file.string() + ":";
-    for (const ScenarioError& error : reading.errors) message += "\n  " + error.text();
-    throw std::runtime_error(message);
-  }
-  scene.scenario = std::move(reading.scenario);
-  std::ifstream in(file, std::ios::binary);
-  scene.scenario_text.assign(std::istreambuf_iterator<char>(in), {});
-  scene.scenario_folder = fs::absolute(file).parent_path();
-  return scene;
-}
-
 // The tool the device holds (none: the hand), checked against the tools the scenario allows.
-std::optional<ToolKind> held_tool(const RecordOptions& options, const RecordedScene& scene) {
+std::optional<ToolKind> held_tool(const RecordOptions& options, const Scenario* scenario) {
   if (options.tool == "hand") return std::nullopt;
   const std::optional<ToolKind> kind = tool_kind(options.tool);
   if (!kind)
     throw std::invalid_argument("--tool " + options.tool +
                                 " is unknown: expected hand, probe, forceps or scalpel");
-  if (scene.scenario && std::find(scene.scenario->tools.begin(), scene.scenario->tools.end(),
-                                  *kind) == scene.scenario->tools.end()) {
+  if (scenario &&
+      std::find(scenario->tools.begin(), scenario->tools.end(), *kind) == scenario->tools.end()) {
     std::string allowed;
-    for (const ToolKind tool : scene.scenario->tools)
+    for (const ToolKind tool : scenario->tools)
       allowed += (allowed.empty() ? "" : ", ") + std::string(tool_name(tool));
     throw std::invalid_argument("--tool " + options.tool + " is not a tool the scenario " +
                                 options.scenario->string() + " allows (it allows: hand" +
@@ -148,63 +116,32 @@ std::optional<ToolKind> held_tool(const RecordOptions& options, const RecordedSc
   return kind;
 }
 
-std::int64_t unix_ms_now() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-SessionStart session_start(const RecordOptions& options, const RecordedScene& scene,
-                           const HapticDevice& device, const WorkspaceMapping& mapping) {
-  SessionStart start;
-  if (options.trainee) {
-    start.trainee = *options.trainee;
-  } else {
-    const char* user = std::getenv("USER");
-    start.trainee = user != nullptr && *user != '\0' ? user : "Trainee";
-  }
-  ReplaySetup replay;
-  replay.integrator = scene.setup.model_options.integrator;
-  if (scene.scenario) {
-    start.scenario_title = scene.scenario->title;
-    start.scenario_text = scene.scenario_text;
-    replay.scenario_folder = scene.scenario_folder.string();
-  } else {
-    start.scenario_title = "Free practice";
-    start.scenario_text = free_practice_text(scene.setup.mesh.tet_count());
-    replay.built_in_liver_tets = scene.setup.built_in_liver_tets;
-  }
-  start.replay = replay;
-  start.device = device.name();
-  start.started_unix_ms = unix_ms_now();
-  start.mapping = mapping;
-  return start;
-}
-
+// A session recorded headless by the workstation's own station (core/station): the display frames
+// are this loop's, at the workstation's rate.
 int record(const RecordOptions& options) {
   const sigset_t stop_signals = block_stop_signals();  // before any thread starts
 
   // Input first (a bad file is said before anything slow), then the database, then the scene.
-  std::unique_ptr<TrajectoryDevice> device;
-  RecordedScene scene;
+  std::vector<TrajectoryPoint> script;
+  std::optional<OpenedScenario> scenario;
   std::optional<ToolKind> tool;
   try {
-    // Its errors name the file and the line.
-    std::vector<TrajectoryPoint> points = load_trajectory(options.trajectory);
-    try {
-      // Named as the workstation names a scripted device.
-      device = std::make_unique<TrajectoryDevice>(
-          "Scripted: " + options.trajectory.filename().string(), std::move(points));
-    } catch (const std::exception& e) {
-      throw std::invalid_argument("cannot play the trajectory " + options.trajectory.string() +
-                                  ": " + e.what());
+    script = load_trajectory(options.trajectory);  // its errors name the file and the line
+    if (options.scenario) {
+      auto read = read_scenario_to_run(*options.scenario);
+      if (auto* errors = std::get_if<std::vector<ScenarioError>>(&read)) {
+        std::string message = "cannot open the scenario " + options.scenario->string() + ":";
+        for (const ScenarioError& error : *errors) message += "\n  " + error.text();
+        throw std::runtime_error(message);
+      }
+      scenario = std::get<OpenedScenario>(std::move(read));
     }
-    scene = read_recorded_scenario(options);
-    tool = held_tool(options, scene);
+    tool = held_tool(options, scenario ? &scenario->scenario : nullptr);
   } catch (const std::exception& e) {
     return fail(e.what());
   }
-  const double duration_s = options.duration_s.value_or(device->duration_s());
+  const double duration_s =
+      options.duration_s.value_or(script.empty() ? 0.0 : script.back().time_s);
   if (!(duration_s > 0.0))
     return fail("the trajectory " + options.trajectory.string() +
                 " lasts 0 s: give the session's length with --duration");
@@ -218,122 +155,109 @@ int record(const RecordOptions& options) {
     return 1;
   }
 
-  std::shared_ptr<const SimModel> model;
+  // What the station reports, on this thread.
+  const Eigen::Quaterniond view_axes = opening_view_device_axes();
+  std::optional<StorageError> failure;
+  std::string not_saved;
+  std::string device_fault;
+  std::optional<SessionMetricsOutcome> metrics;
+  StationListener listener;
+  listener.device_tool = [&]() -> std::optional<DeviceToolSettings> {
+    if (!tool) return std::nullopt;
+    DeviceToolSettings held;
+    held.kind = *tool;
+    held.orientation = tool_orientation_from_view(view_axes);
+    return held;
+  };
+  listener.trainee = [&] { return options.trainee.value_or(default_trainee_name()); };
+  listener.recording_refused = [&](const StorageError& e) { failure = e; };
+  listener.recording_stopped = [&](const StorageError& e) { failure = e; };
+  listener.session_not_saved = [&](const std::string& error) { not_saved = error; };
+  listener.device_stopped = [&](DeviceChoice, const std::string&, const std::string& fault) {
+    device_fault = fault;
+  };
+  listener.session_metrics_stored = [&](const SessionMetricsOutcome& outcome) {
+    metrics = outcome;
+  };
+
+  std::unique_ptr<Workstation> station;
   try {
-    scene.setup = scene.scenario ? build_scene(*scene.scenario, scene.scenario_folder)
-                                 : default_scene(options.tet_count);
-    model =
-        std::make_shared<const SimModel>(build_model(scene.setup.mesh, scene.setup.model_options));
+    const fs::path folder = scenario ? scenario->file.parent_path() : fs::path();
+    SceneSetup setup =
+        scenario ? build_scene(scenario->scenario, folder) : default_scene(options.tet_count);
+    station = std::make_unique<Workstation>(std::move(setup), std::move(scenario), listener);
   } catch (const std::exception& e) {
     return fail("cannot build the scene" +
                 (options.scenario ? " of " + options.scenario->string() : std::string()) + ": " +
                 e.what());
   }
-  const Scenario* scenario = scene.scenario ? &*scene.scenario : nullptr;
-
+  station->use_sessions(std::move(store), options.database);
   // A device not calibrated: the workstation's first-use mapping in its opening view.
-  const Eigen::Quaterniond view_axes = opening_view_device_axes();
-  ServoLoop::Options servo_options;
-  servo_options.mapping = first_use_mapping(scene.setup.mesh.rest_position_m, view_axes);
-  ServoLoop servo(*device, servo_options);
-  // The session starts from rest with its simulation's input logged, so that it can be replayed.
-  std::unique_ptr<RealtimeSimulation> simulation =
-      make_scene_simulation(model, scene.setup.visual.surface);
-  simulation->set_haptic_servo(&servo);
-  if (tool) {
-    DeviceToolSettings held;
-    held.kind = *tool;
-    held.orientation = tool_orientation_from_view(view_axes);
-    simulation->set_device_tool(held);
-  }
-  simulation->log_inputs(true);
-
-  const SessionStart start = session_start(options, scene, *device, servo.mapping());
-  const std::uint64_t dropped_before = skip_earlier_servo_frames(servo);
-  std::unique_ptr<SessionRecorder> recorder;
-  try {
-    recorder = std::make_unique<SessionRecorder>(
-        *store, start, [&servo](ServoFrame& frame) { return servo.next_logged_frame(frame); });
-  } catch (const StorageError& e) {
-    std::cerr << "liversim-cli: error: " << e.what() << '\n';
+  const WorkspaceMapping mapping =
+      first_use_mapping(station->setup().mesh.rest_position_m, view_axes);
+  if (const std::optional<DeviceRefusal> refusal = station->use_device(
+          DeviceChoice::scripted, mapping, std::move(script), options.trajectory))
+    return fail("cannot play the trajectory " + options.trajectory.string() + ": " +
+                refusal->detail);
+  if (failure) {
+    std::cerr << "liversim-cli: error: " << failure->what() << '\n';
     return 1;
   }
-  recorder->record_event({servo.now_s(), SessionEventKind::tool_selected,
-                          tool ? std::string(tool_name(*tool)) : "hand"});
-  track_session_outcome(*simulation, scenario);
-  SessionEventWatch watch(scenario);
+  const std::int64_t session = *station->recording_session();
 
-  std::cout << "recording session " << recorder->session() << " to " << options.database.string()
-            << ": " << start.scenario_title << " (" << scene.setup.mesh.tet_count()
-            << " tetrahedra), " << device->name() << ", tool " << options.tool << ", "
-            << number(duration_s) << " s" << std::endl;
-  simulation->start();
-  servo.start();
+  std::cout << "recording session " << session << " to " << options.database.string() << ": "
+            << (station->scenario() ? station->scenario()->scenario.title : "Free practice") << " ("
+            << station->setup().mesh.tet_count() << " tetrahedra), " << station->device_name()
+            << ", tool " << options.tool << ", " << number(duration_s) << " s" << std::endl;
+  ServoLoop& servo = *station->servo();
   const double begin_s = servo.now_s();
   double next_progress_s = begin_s + options.progress_s.value_or(INFINITY);
-  std::uint64_t shown_topology = 0;
-  std::vector<SessionEvent> events;
   int stop_signal = 0;
-  std::optional<StorageError> failure;
   while (true) {
     const double now_s = servo.now_s();
     if (now_s - begin_s >= duration_s) break;
     stop_signal =
         wait_for_stop_signal(stop_signals, std::min(kFramePeriodS, duration_s - (now_s - begin_s)));
     if (stop_signal != 0) break;
-    recorder->record_inputs(simulation->take_input_log());
-    if ((failure = recorder->failure())) break;
-    if (simulation->update_snapshot()) {
-      const SimulationSnapshot& snapshot = simulation->snapshot();
-      const bool cut = snapshot.topology_version != shown_topology && snapshot.model;
-      if (cut) shown_topology = snapshot.topology_version;
-      events.clear();
-      watch.observe(servo.now_s(), snapshot, simulation->stats(), cut, events);
-      for (SessionEvent& event : events) recorder->record_event(std::move(event));
-    }
-    if (const std::string fault = servo.device_fault(); !fault.empty()) {
-      // As the workstation: the session ends with what it recorded.
-      recorder->record_event({servo.now_s(), SessionEventKind::device_fault, fault});
-      std::cerr << "liversim-cli: the device stopped: " << fault << '\n';
+    station->frame();
+    if (failure) break;
+    if (!device_fault.empty()) {
+      // As the workstation: the session ended with what it recorded; the mouse took over.
+      std::cerr << "liversim-cli: the device stopped: " << device_fault << '\n';
       break;
     }
     if (servo.now_s() >= next_progress_s) {
       const ResidentMemory memory = resident_memory();
       std::cout << std::fixed << std::setprecision(2) << "elapsed " << servo.now_s() - begin_s
-                << " s: " << recorder->frames_written() << " frames committed, VmRSS "
+                << " s: " << station->recorded_frames() << " frames committed, VmRSS "
                 << std::setprecision(1) << memory.now_mib << " MiB, VmHWM " << memory.peak_mib
                 << " MiB" << std::endl;
       std::cout.unsetf(std::ios::floatfield);
       next_progress_s += *options.progress_s;
     }
   }
-
-  // The servo first: its last command is a zero force, and its last frames are kept.
-  servo.stop();
-  simulation->stop();
-  simulation->log_inputs(false);
-  recorder->record_inputs(simulation->take_input_log());
-  const std::optional<OutcomeTracking> outcome = simulation->outcome();
-  simulation->stop_tracking_outcome();
+  // The servo's last command is a zero force, and its last frames are kept.
+  station->stop();
   if (failure) return storage_failure(failure->what());
-  const SessionServoFigures figures =
-      servo_figures(servo.stats(), servo.dropped_log_frames() - dropped_before);
-  if (!recorder->finish(unix_ms_now(), figures)) return storage_failure(recorder->error());
-  const std::int64_t session = recorder->session();
-  const std::int64_t frames = recorder->frames_written();
-  recorder.reset();
-  std::vector<MetricValue> metrics;
-  try {
-    metrics = store_session_metrics(*store, session, outcome, scenario, servo.mapping());
-  } catch (const StorageError& e) {
-    return storage_failure(e.what());
-  }
+  if (!not_saved.empty()) return storage_failure(not_saved);
+  station->finish_metrics();
+  if (!metrics || !metrics->stored)
+    return storage_failure(metrics && metrics->storage_problem ? metrics->storage_problem->what()
+                           : metrics                           ? metrics->problem
+                                                               : "no metrics were stored");
+  const SessionSummary summary = [&] {
+    for (const SessionSummary& s : station->sessions()->sessions())
+      if (s.id == session) return s;
+    return SessionSummary{};
+  }();
+  const double rate_hz = summary.servo ? summary.servo->rate_hz : 0.0;
   std::cout << "recorded session " << session << " (complete"
             << (stop_signal == SIGINT    ? ", ended by SIGINT"
                 : stop_signal == SIGTERM ? ", ended by SIGTERM"
                                          : "")
-            << "): " << frames << " frames, servo " << number(figures.rate_hz) << " Hz, "
-            << metrics.size() << " metrics stored in " << options.database.string() << std::endl;
+            << "): " << summary.frame_count << " frames, servo " << number(rate_hz) << " Hz, "
+            << metrics->metrics.size() << " metrics stored in " << options.database.string()
+            << std::endl;
   return 0;
 }
 

@@ -237,8 +237,7 @@ int main(int argc, char** argv) {
     if (options.scenario) {
       const std::filesystem::path file = std::filesystem::absolute(options.scenario_file);
       setup = liversim::build_scene(*options.scenario, file.parent_path());
-      opened = liversim::OpenedScenario{std::move(*options.scenario),
-                                        QString::fromStdString(file.string()),
+      opened = liversim::OpenedScenario{std::move(*options.scenario), file,
                                         std::move(options.scenario_text)};
     } else {
       setup = liversim::default_scene(options.tet_count);

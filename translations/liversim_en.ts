@@ -12,23 +12,6 @@
     </message>
 </context>
 <context>
-    <name>liversim::MainWindow</name>
-    <message numerus="yes">
-        <source>Training centre: %1 not reached, %n session(s) waiting</source>
-        <translation>
-            <numerusform>Training centre: %1 not reached, %n session waiting</numerusform>
-            <numerusform>Training centre: %1 not reached, %n sessions waiting</numerusform>
-        </translation>
-    </message>
-    <message numerus="yes">
-        <source>Training centre: up to date at %1, %n session(s) uploaded</source>
-        <translation>
-            <numerusform>Training centre: up to date at %1, %n session uploaded</numerusform>
-            <numerusform>Training centre: up to date at %1, %n sessions uploaded</numerusform>
-        </translation>
-    </message>
-</context>
-<context>
     <name>liversim::ScenarioEditor</name>
     <message numerus="yes">
         <source>%n ball(s)</source>
@@ -52,6 +35,23 @@
         <translation>
             <numerusform>, %n hidden</numerusform>
             <numerusform>, %n hidden</numerusform>
+        </translation>
+    </message>
+</context>
+<context>
+    <name>liversim::TrainingCentreControl</name>
+    <message numerus="yes">
+        <source>Training centre: %1 not reached, %n session(s) waiting</source>
+        <translation>
+            <numerusform>Training centre: %1 not reached, %n session waiting</numerusform>
+            <numerusform>Training centre: %1 not reached, %n sessions waiting</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>Training centre: up to date at %1, %n session(s) uploaded</source>
+        <translation>
+            <numerusform>Training centre: up to date at %1, %n session uploaded</numerusform>
+            <numerusform>Training centre: up to date at %1, %n sessions uploaded</numerusform>
         </translation>
     </message>
 </context>

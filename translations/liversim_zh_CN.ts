@@ -493,6 +493,105 @@
     </message>
 </context>
 <context>
+    <name>liversim::DeviceControl</name>
+    <message>
+        <source>Trajectory to play</source>
+        <translation>要播放的轨迹</translation>
+    </message>
+    <message>
+        <source>Trajectories (*.txt *.trajectory);;All files (*)</source>
+        <translation>轨迹文件 (*.txt *.trajectory);;所有文件 (*)</translation>
+    </message>
+    <message>
+        <source>Choose a trajectory file to play.</source>
+        <translation>请选择要播放的轨迹文件。</translation>
+    </message>
+    <message>
+        <source>Cannot play the trajectory: %1</source>
+        <translation>无法播放轨迹：%1</translation>
+    </message>
+    <message>
+        <source>The Phantom Omni is not available: %1</source>
+        <translation>Phantom Omni 不可用：%1</translation>
+    </message>
+    <message>
+        <source>Choose a recorded session to replay.</source>
+        <translation>请选择要回放的训练记录。</translation>
+    </message>
+    <message>
+        <source>Cannot run the device: %1</source>
+        <translation>无法运行设备：%1</translation>
+    </message>
+    <message>
+        <source>The mouse moves the tool: press on the liver to put the tool chosen in the Tool panel there.</source>
+        <translation>由鼠标移动器械：在肝脏上按下鼠标，即可将“器械”面板中所选的器械放到该处。</translation>
+    </message>
+    <message>
+        <source>%1 moves the tool chosen in the Tool panel.</source>
+        <translation>由 %1 移动“器械”面板中所选的器械。</translation>
+    </message>
+    <message>
+        <source>The device</source>
+        <translation>设备</translation>
+    </message>
+    <message>
+        <source>%1 stopped: %2. The mouse moves the tool now; choose the device again once it is back.</source>
+        <translation>%1已停止：%2。现在由鼠标移动器械；设备恢复后请重新选择它。</translation>
+    </message>
+    <message>
+        <source>the scripted device</source>
+        <translation>脚本设备</translation>
+    </message>
+    <message>
+        <source>the device</source>
+        <translation>设备</translation>
+    </message>
+    <message>
+        <source>calibrated</source>
+        <translation>已校准</translation>
+    </message>
+    <message>
+        <source>not calibrated: put the stylus in its inkwell (or move it through its whole range), then open this dialog again</source>
+        <translation>未校准：请将触笔放入笔座（或在其整个活动范围内移动一遍），然后重新打开此对话框</translation>
+    </message>
+    <message>
+        <source>There is no sessions database.</source>
+        <translation>没有训练记录数据库。</translation>
+    </message>
+    <message>
+        <source>Session %1 is not yours to replay: trainees replay their own sessions (an instructor may replay any).</source>
+        <translation>会话 %1 不属于您，无法回放：学员只能回放自己的会话（教师可回放任何会话）。</translation>
+    </message>
+    <message>
+        <source>Session %1 is not replayed: reading it was cancelled.</source>
+        <translation>会话 %1 未回放：读取已取消。</translation>
+    </message>
+    <message>
+        <source>Session %1 has no device input to replay.</source>
+        <translation>训练记录 %1 没有可回放的设备输入。</translation>
+    </message>
+    <message>
+        <source>Cannot replay session %1: %2</source>
+        <translation>无法回放训练记录 %1：%2</translation>
+    </message>
+    <message>
+        <source>%1: %2, %3, %4 (%5)</source>
+        <translation>%1: %2，%3，%4（%5）</translation>
+    </message>
+    <message>
+        <source>No recorded session has device input to replay.</source>
+        <translation>没有包含可回放设备输入的训练记录。</translation>
+    </message>
+    <message>
+        <source>Replay a session</source>
+        <translation>回放训练记录</translation>
+    </message>
+    <message>
+        <source>Session:</source>
+        <translation>训练记录：</translation>
+    </message>
+</context>
+<context>
     <name>liversim::DevicePanel</name>
     <message>
         <source>Mouse and keyboard</source>
@@ -646,14 +745,6 @@
     <message>
         <source>Device</source>
         <translation>设备</translation>
-    </message>
-    <message>
-        <source>Trajectory to play</source>
-        <translation>要播放的轨迹</translation>
-    </message>
-    <message>
-        <source>Trajectories (*.txt *.trajectory);;All files (*)</source>
-        <translation>轨迹文件 (*.txt *.trajectory);;所有文件 (*)</translation>
     </message>
     <message>
         <source>Drag the liver with the left mouse button; drag the background to turn the view, wheel to zoom.</source>
@@ -872,38 +963,6 @@ The scene that was running goes on.</source>
         <translation>没有训练记录数据库。</translation>
     </message>
     <message>
-        <source>Cannot replay session %1: %2</source>
-        <translation>无法回放训练记录 %1：%2</translation>
-    </message>
-    <message>
-        <source>Session %1 has no device input to replay.</source>
-        <translation>训练记录 %1 没有可回放的设备输入。</translation>
-    </message>
-    <message>
-        <source>Replay of session %1</source>
-        <translation>回放训练记录 %1</translation>
-    </message>
-    <message>
-        <source>%1: %2, %3, %4 (%5)</source>
-        <translation>%1: %2，%3，%4（%5）</translation>
-    </message>
-    <message>
-        <source>No recorded session has device input to replay.</source>
-        <translation>没有包含可回放设备输入的训练记录。</translation>
-    </message>
-    <message>
-        <source>Replay a session</source>
-        <translation>回放训练记录</translation>
-    </message>
-    <message>
-        <source>Session:</source>
-        <translation>训练记录：</translation>
-    </message>
-    <message>
-        <source>Free practice</source>
-        <translation>自由练习</translation>
-    </message>
-    <message>
         <source>Trainee</source>
         <translation>学员</translation>
     </message>
@@ -958,62 +1017,6 @@ The scene that was running goes on.</source>
     <message>
         <source>The session&apos;s metrics were not stored: %1</source>
         <translation>训练记录的指标未保存：%1</translation>
-    </message>
-    <message>
-        <source>The Phantom Omni is not available: %1</source>
-        <translation>Phantom Omni 不可用：%1</translation>
-    </message>
-    <message>
-        <source>Choose a recorded session to replay.</source>
-        <translation>请选择要回放的训练记录。</translation>
-    </message>
-    <message>
-        <source>Choose a trajectory file to play.</source>
-        <translation>请选择要播放的轨迹文件。</translation>
-    </message>
-    <message>
-        <source>Scripted: %1</source>
-        <translation>脚本：%1</translation>
-    </message>
-    <message>
-        <source>Cannot play the trajectory: %1</source>
-        <translation>无法播放轨迹：%1</translation>
-    </message>
-    <message>
-        <source>Cannot run the device: %1</source>
-        <translation>无法运行设备：%1</translation>
-    </message>
-    <message>
-        <source>The mouse moves the tool: press on the liver to put the tool chosen in the Tool panel there.</source>
-        <translation>由鼠标移动器械：在肝脏上按下鼠标，即可将“器械”面板中所选的器械放到该处。</translation>
-    </message>
-    <message>
-        <source>%1 moves the tool chosen in the Tool panel.</source>
-        <translation>由 %1 移动“器械”面板中所选的器械。</translation>
-    </message>
-    <message>
-        <source>The device</source>
-        <translation>设备</translation>
-    </message>
-    <message>
-        <source>%1 stopped: %2. The mouse moves the tool now; choose the device again once it is back.</source>
-        <translation>%1已停止：%2。现在由鼠标移动器械；设备恢复后请重新选择它。</translation>
-    </message>
-    <message>
-        <source>the scripted device</source>
-        <translation>脚本设备</translation>
-    </message>
-    <message>
-        <source>the device</source>
-        <translation>设备</translation>
-    </message>
-    <message>
-        <source>calibrated</source>
-        <translation>已校准</translation>
-    </message>
-    <message>
-        <source>not calibrated: put the stylus in its inkwell (or move it through its whole range), then open this dialog again</source>
-        <translation>未校准：请将触笔放入笔座（或在其整个活动范围内移动一遍），然后重新打开此对话框</translation>
     </message>
     <message>
         <source>Se&amp;ttings</source>
@@ -1108,10 +1111,6 @@ The scene that was running goes on.</source>
         <translation>修改组织参数期间肝脏被切开；请重新输入。</translation>
     </message>
     <message>
-        <source>Session %1 is not replayed: reading it was cancelled.</source>
-        <translation>会话 %1 未回放：读取已取消。</translation>
-    </message>
-    <message>
         <source>Not applied: a model is being built. Try again when it is done.</source>
         <translation>未应用：正在构建模型。请在完成后重试。</translation>
     </message>
@@ -1160,10 +1159,6 @@ The scene that was running goes on.</source>
         <translation>添加教师账户(&amp;A)…</translation>
     </message>
     <message>
-        <source>Session %1 is not yours to replay: trainees replay their own sessions (an instructor may replay any).</source>
-        <translation>会话 %1 不属于您，无法回放：学员只能回放自己的会话（教师可回放任何会话）。</translation>
-    </message>
-    <message>
         <source>Reviewing every trainee&apos;s sessions is for instructors: log in first (Settings ▸ Instructor Mode).</source>
         <translation>查看所有学员的会话仅限教师：请先登录（设置 ▸ 教师模式）。</translation>
     </message>
@@ -1198,38 +1193,6 @@ The scene that was running goes on.</source>
     <message>
         <source>Upload finished sessions to the training centre&apos;s server and pull its scenarios</source>
         <translation>将已结束的训练上传到培训中心服务器，并获取其发布的情景</translation>
-    </message>
-    <message>
-        <source>There is no sessions database to upload from.</source>
-        <translation>没有可供上传的训练数据库。</translation>
-    </message>
-    <message>
-        <source>Training centre: not connected (Settings ▸ Training Centre Server…)</source>
-        <translation>培训中心：未连接（设置 ▸ 培训中心服务器…）</translation>
-    </message>
-    <message>
-        <source>Training centre: connecting to %1…</source>
-        <translation>培训中心：正在连接 %1…</translation>
-    </message>
-    <message numerus="yes">
-        <source>Training centre: %1 not reached, %n session(s) waiting</source>
-        <translation>
-            <numerusform>培训中心：无法连接 %1，%n 次训练等待上传</numerusform>
-        </translation>
-    </message>
-    <message numerus="yes">
-        <source>Training centre: up to date at %1, %n session(s) uploaded</source>
-        <translation>
-            <numerusform>培训中心：%1 时已同步，已上传 %n 次训练</numerusform>
-        </translation>
-    </message>
-    <message>
-        <source>No training centre server is set (Settings ▸ Training Centre Server…).</source>
-        <translation>尚未设置培训中心服务器（设置 ▸ 培训中心服务器…）。</translation>
-    </message>
-    <message>
-        <source>%1 is not an instructor on the server.</source>
-        <translation>%1 不是服务器上的教员。</translation>
     </message>
 </context>
 <context>
@@ -2595,6 +2558,41 @@ Simulated: %2.
     <message>
         <source>Force on the tool: %1 N</source>
         <translation>器械受力：%1 N</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::TrainingCentreControl</name>
+    <message>
+        <source>There is no sessions database to upload from.</source>
+        <translation>没有可供上传的训练数据库。</translation>
+    </message>
+    <message>
+        <source>Training centre: not connected (Settings ▸ Training Centre Server…)</source>
+        <translation>培训中心：未连接（设置 ▸ 培训中心服务器…）</translation>
+    </message>
+    <message>
+        <source>Training centre: connecting to %1…</source>
+        <translation>培训中心：正在连接 %1…</translation>
+    </message>
+    <message numerus="yes">
+        <source>Training centre: %1 not reached, %n session(s) waiting</source>
+        <translation>
+            <numerusform>培训中心：无法连接 %1，%n 次训练等待上传</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>Training centre: up to date at %1, %n session(s) uploaded</source>
+        <translation>
+            <numerusform>培训中心：%1 时已同步，已上传 %n 次训练</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>No training centre server is set (Settings ▸ Training Centre Server…).</source>
+        <translation>尚未设置培训中心服务器（设置 ▸ 培训中心服务器…）。</translation>
+    </message>
+    <message>
+        <source>%1 is not an instructor on the server.</source>
+        <translation>%1 不是服务器上的教员。</translation>
     </message>
 </context>
 <context>

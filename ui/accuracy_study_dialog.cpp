@@ -199,7 +199,7 @@ AccuracyStudyDialog::AccuracyStudyDialog(QWidget* parent) : QDialog(parent) {
 
 AccuracyStudyDialog::~AccuracyStudyDialog() {
   cancelRequested_ = true;
-  if (worker_.joinable()) worker_.join();
+  if (worker_.started()) worker_.wait();
 }
 
 AccuracyStudyOptions AccuracyStudyDialog::requestedOptions() const {
@@ -229,7 +229,7 @@ bool AccuracyStudyDialog::start() {
   cancelRequested_ = false;
   setRunning(true);
   setStatus(tr("Starting…"), false);
-  worker_ = std::thread([this, options] {
+  worker_.start([this, options] {
     auto result = std::make_shared<std::optional<AccuracyStudyResult>>();
     QString error;
     bool wasCancelled = false;
@@ -297,7 +297,7 @@ void AccuracyStudyDialog::showProgress(const StudyProgressReport& report) {
 
 void AccuracyStudyDialog::finish(std::optional<AccuracyStudyResult> result, const QString& error,
                                  bool wasCancelled) {
-  worker_.join();  // its last act was to post this
+  worker_.wait();  // its last act was to post this
   setRunning(false);
   if (wasCancelled) {
     progress_->setValue(0);

@@ -11,7 +11,7 @@
 
 #include <atomic>
 #include <optional>
-#include <thread>
+#include "liversim/engine/background_job.h"
 
 class QCheckBox;
 class QComboBox;
@@ -39,7 +39,7 @@ class AccuracyStudyDialog : public QDialog {
   bool start();
   void cancel();
   // Until finish() has taken the worker's result and joined it.
-  bool running() const { return worker_.joinable(); }
+  bool running() const { return worker_.started(); }
 
   const std::optional<AccuracyStudyResult>& result() const { return result_; }
   // The status line: progress, the outcome, or what went wrong.
@@ -78,7 +78,7 @@ class AccuracyStudyDialog : public QDialog {
   std::optional<AccuracyStudyResult> result_;
   std::atomic<bool> cancelRequested_{false};
   // Last: joined first when the dialog goes, while the object its reports are posted to lives.
-  std::thread worker_;
+  BackgroundJob worker_;
 };
 
 }  // namespace liversim

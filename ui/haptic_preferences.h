@@ -3,6 +3,7 @@
 // (QSettings, group "haptics") so that a trainee's calibration survives a restart.
 
 #include "liversim/haptics/haptics.h"
+#include "liversim/station/workstation.h"
 
 #include <QString>
 
@@ -12,9 +13,7 @@ class QSettings;
 
 namespace liversim {
 
-// replay: the device input of a recorded session (never restored at start, as a script).
-enum class DeviceChoice { mouse, openhaptics, scripted, replay };
-
+// A replay is never restored at start, nor a script (played on request only).
 struct HapticPreferences {
   DeviceChoice device = DeviceChoice::mouse;
   QString trajectory_file;  // the scripted device's

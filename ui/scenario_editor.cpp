@@ -139,7 +139,7 @@ ScenarioEditor::ScenarioEditor(QWidget* parent) : QMainWindow(parent) {
 
 ScenarioEditor::~ScenarioEditor() {
   *alive_ = false;
-  if (costWorker_.joinable()) costWorker_.join();
+  if (costWorker_.started()) costWorker_.wait();
   overlay_.reset();
 }
 
@@ -469,11 +469,9 @@ QWidget* ScenarioEditor::buildTissuePanel() {
         [&](Scenario& s) {
           const double old = s.parenchyma.elastic.youngs_modulus_pa;
           s.parenchyma.elastic.youngs_modulus_pa = kpa * 1e3;
-          // With viscoelasticity E = E1 + E2: both arms scale with it.
-          if (auto& ve = s.parenchyma.viscoelastic; ve && old > 0.0) {
-            ve->e1_pa *= kpa * 1e3 / old;
-            ve->e2_pa *= kpa * 1e3 / old;
-          }
+          // With viscoelasticity E = E1 + E2: both arms follow.
+          if (auto& ve = s.parenchyma.viscoelastic; ve && old > 0.0)
+            ve = with_instantaneous_modulus(*ve, kpa * 1e3);
         },
         kYoungsModulus);
   });
@@ -509,14 +507,12 @@ QWidget* ScenarioEditor::buildTissuePanel() {
             s.effects.viscoelastic = on;
             if (!on) s.effects.viscoplastic = false;  // it needs viscoelasticity
             // The seed's split of E and its η1 when none was set (kept when switched off).
-            if (on && !t.viscoelastic)
-              t.viscoelastic = ViscoelasticParameters{e * 4 / 7, e * 3 / 7, 2000.0};
+            if (on && !t.viscoelastic) t.viscoelastic = seed_viscoelastic_split(e);
             break;
           case 2:
             s.effects.viscoplastic = on;
             if (on) s.effects.viscoelastic = true;
-            if (on && !t.viscoelastic)
-              t.viscoelastic = ViscoelasticParameters{e * 4 / 7, e * 3 / 7, 2000.0};
+            if (on && !t.viscoelastic) t.viscoelastic = seed_viscoelastic_split(e);
             if (on && !t.viscoplastic) t.viscoplastic = ViscoplasticParameters{50.0, 2000.0, 0.5};
             break;
           case 3:
@@ -551,9 +547,8 @@ QWidget* ScenarioEditor::buildTissuePanel() {
   law(viscoelasticE1_, parameter::e1, 1.0, " Pa", 0, "viscoelasticE1", tr("Maxwell arm E1"),
       kViscoelasticE1, [](TissueSpec& t, double v) {
         // E = E1 + E2 stays the parenchyma's E.
-        if (!t.viscoelastic) return;
-        t.viscoelastic->e1_pa = v;
-        t.viscoelastic->e2_pa = t.elastic.youngs_modulus_pa - v;
+        if (t.viscoelastic)
+          t.viscoelastic = with_maxwell_arm(*t.viscoelastic, v, t.elastic.youngs_modulus_pa);
       });
   viscoelasticE1_->setToolTip(viscoelasticE1_->toolTip() +
                               tr(" E2 = E − E1 follows, so that E stays the parenchyma's."));
@@ -1472,11 +1467,11 @@ void ScenarioEditor::measureCost() {
   costScenario_ = document_.scenario();
   costBusy_ = true;
   costAgain_ = false;
-  if (costWorker_.joinable()) costWorker_.join();
+  if (costWorker_.started()) costWorker_.wait();
   cost_->setText(stepsPerSecond_
                      ? tr("%1 steps/s — measuring again…").arg(*stepsPerSecond_, 0, 'f', 0)
                      : tr("Measuring the cost…"));
-  costWorker_ = std::thread(
+  costWorker_.start(
       [this, scenario = document_.scenario(), folder = document_.organFolder(), alive = alive_] {
         std::optional<double> rate;
         double realTime = 0.0;

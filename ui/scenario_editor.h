@@ -15,7 +15,7 @@
 #include <atomic>
 #include <memory>
 #include <optional>
-#include <thread>
+#include "liversim/engine/background_job.h"
 
 class QAction;
 class QActionGroup;
@@ -234,7 +234,7 @@ class ScenarioEditor : public QMainWindow {
   QDoubleSpinBox* lift_ = nullptr;
 
   // The cost measurement on its worker.
-  std::thread costWorker_;
+  BackgroundJob costWorker_;
   bool costBusy_ = false;
   bool costAgain_ = false;                // the scenario changed during the measurement
   std::optional<Scenario> costScenario_;  // measured, or being measured

@@ -157,8 +157,8 @@ SessionReplayWindow::SessionReplayWindow(SessionStore* openStore, const QString&
                    .arg(session);
   if (problem_.isEmpty()) {
     statusLabel_->setText(tr("Building the session's scene…"));
-    builder_ = std::thread([this, setup = *setup, inputs = std::move(inputs),
-                            scenario_text = std::move(scenario_text)]() mutable {
+    builder_.start([this, setup = *setup, inputs = std::move(inputs),
+                    scenario_text = std::move(scenario_text)]() mutable {
       std::shared_ptr<SessionReplay> replay;
       QString error;
       try {
@@ -178,13 +178,13 @@ SessionReplayWindow::SessionReplayWindow(SessionStore* openStore, const QString&
 
 SessionReplayWindow::~SessionReplayWindow() {
   timer_.stop();
-  if (builder_.joinable()) builder_.join();
+  if (builder_.started()) builder_.wait();
   if (scene_) viewport_->renderWindow()->RemoveRenderer(scene_->renderer());
 }
 
 void SessionReplayWindow::finishBuilding(std::shared_ptr<SessionReplay> replay,
                                          const QString& error) {
-  builder_.join();
+  builder_.wait();
   if (!replay) {
     problem_ = tr("Session %1 cannot be replayed: %2").arg(session_).arg(error);
     updateControls();

@@ -16,8 +16,8 @@
 
 #include <cstdint>
 #include <memory>
-#include <thread>
 #include <vector>
+#include "liversim/engine/background_job.h"
 
 class QCheckBox;
 class QChartView;
@@ -108,7 +108,7 @@ class SessionReplayWindow : public QWidget {
   double largestForceN_ = 0.1;
   QTimer timer_;
   QElapsedTimer wall_;
-  std::thread builder_;
+  BackgroundJob builder_;
 };
 
 }  // namespace liversim

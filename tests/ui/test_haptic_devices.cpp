@@ -5,7 +5,6 @@
 // missing when it does not, and a fatal fault handing the tool back to the mouse.
 #include <gtest/gtest.h>
 
-#include <dlfcn.h>
 #include <QAction>
 #include <QComboBox>
 #include <QDir>
@@ -35,6 +34,10 @@
 #include "storage_messages.h"
 #include "tool_panel.h"
 #include "wait_limits.h"
+
+#ifdef LIVERSIM_FAKE_HD_LIBRARY
+#include "../openhaptics/fake_hd_hooks.h"
+#endif
 
 namespace liversim {
 namespace {
@@ -186,11 +189,11 @@ TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
   ASSERT_TRUE(QTest::qWaitFor([&] { return !snapshot().tool.has_value(); }, kTimeoutMs));
 }
 
-// A device session is recorded to the sessions database: from choosing the device to choosing
-// the mouse again, its servo frames (the scripted trajectory's positions), the tool chosen and the
-// servo's figures; the session reads back complete. A file that cannot be a database is refused
-// with its name, and the workstation goes on without recording.
-TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
+// The window's part of recording (the recording itself: tests/station): a device session's
+// metrics reported with the sessionMetricsStored signal once stored off the UI thread, the result
+// in the Scenario panel, and a file that cannot be a database named in the status bar with what to
+// do about it, the device running without recording.
+TEST_F(DeviceTest, TheWindowReportsASessionsMetricsAndNamesAFileThatIsNoDatabase) {
   openWindow();
   const QString database = folder_.filePath("sessions.sqlite");
   ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
@@ -202,72 +205,22 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
   ASSERT_TRUE(window_->recordingSession().has_value()) << window_->sessionsProblem().toStdString();
   const std::int64_t session = *window_->recordingSession();
-  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 600; }, kTimeoutMs));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 300; }, kTimeoutMs));
   QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
   ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
   EXPECT_FALSE(window_->recordingSession().has_value());
-  // The metrics are computed off the UI thread, then reported.
   ASSERT_TRUE(metricsStored.wait(kTimeoutMs));
   EXPECT_EQ(metricsStored.first().at(0).toLongLong(), session);
   EXPECT_TRUE(metricsStored.first().at(1).toBool());
   EXPECT_TRUE(window_->sessionsProblem().isEmpty()) << window_->sessionsProblem().toStdString();
-
-  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
-  const std::vector<SessionSummary> sessions = store.sessions();
-  ASSERT_EQ(sessions.size(), 1u);
-  EXPECT_EQ(sessions[0].id, session);
-  EXPECT_EQ(sessions[0].status, SessionStatus::complete);
-  EXPECT_EQ(sessions[0].scenario_title, "Free practice");
-  EXPECT_NE(sessions[0].device.find("trajectory.txt"), std::string::npos) << sessions[0].device;
-  ASSERT_TRUE(sessions[0].mapping) << "the session keeps its workspace mapping";
-  EXPECT_EQ(sessions[0].mapping->scale, window_->hapticPreferences().mapping.scale);
-  ASSERT_TRUE(sessions[0].servo.has_value());
-  const std::vector<ServoFrame> frames = store.frames(session);
-  // Every tick of the servo is a frame of the session; the figures are those the servo published
-  // last, up to 50 ms (about 50 ticks) before it stopped.
-  EXPECT_GE(frames.size(), sessions[0].servo->ticks);
-  EXPECT_LE(frames.size(), sessions[0].servo->ticks + 100);
-  EXPECT_EQ(sessions[0].servo->dropped_frames, 0u);
-  ASSERT_GT(frames.size(), 600u);
-  // The frames are the trajectory's: at the start point, then at the end point with the button.
-  EXPECT_LT((frames.back().sample.position_mm - end_mm).norm(), 1e-9);
-  EXPECT_EQ(frames.back().sample.buttons, 1u);
-  for (const ServoFrame& frame : frames) {
-    const double along =
-        (frame.sample.position_mm - start_mm).dot((end_mm - start_mm).normalized());
-    ASSERT_GE(along, -1e-9);
-    ASSERT_LE(along, 10.0 + 1e-9);
-  }
-  const std::vector<SessionEvent> events = store.events(session);
-  ASSERT_FALSE(events.empty());
-  EXPECT_EQ(events[0].kind, SessionEventKind::tool_selected);
-  EXPECT_EQ(events[0].detail, "forceps");
-  // The trace's metrics, stored at the end: the tip went straight, one way, so its path is the
-  // distance from the first frame to the last, times the workspace scale in the scene.
-  const std::vector<MetricValue> metrics = store.metrics(session);
-  const auto path = std::find_if(metrics.begin(), metrics.end(),
-                                 [](const MetricValue& m) { return m.name == "path_length_mm"; });
-  ASSERT_NE(path, metrics.end());
-  const double straight_mm =
-      window_->hapticPreferences().mapping.scale *
-      (frames.back().sample.position_mm - frames.front().sample.position_mm).norm();
-  EXPECT_GT(straight_mm, 0.0);
-  EXPECT_NEAR(path->value, straight_mm, 1e-9 * straight_mm);
-  // With the simulation's metrics of free practice: no task, so damage and resected volume only.
-  EXPECT_EQ(metrics.size(), trace_metric_values(TraceMetrics{}).size() + 2);
-  for (const char* name : {"tissue_damage_mm3", "resected_volume_mm3"}) {
-    const auto it = std::find_if(metrics.begin(), metrics.end(),
-                                 [&](const MetricValue& m) { return m.name == name; });
-    ASSERT_NE(it, metrics.end()) << name;
-    EXPECT_EQ(it->value, 0.0) << name << ": the forceps only moved through the air";
-  }
+  EXPECT_TRUE(window_->scenarioPanel()->resultText().contains("free practice: no rubric"))
+      << window_->scenarioPanel()->resultText().toStdString();
 
   const QString not_a_database = folder_.filePath("notes.txt");
   std::ofstream(not_a_database.toStdString()) << "not a database\n";
   EXPECT_FALSE(window_->setSessionsDatabase(not_a_database));
   EXPECT_TRUE(window_->sessionsProblem().contains("notes.txt"))
       << window_->sessionsProblem().toStdString();
-  // What to do about it is said too.
   EXPECT_TRUE(window_->sessionsProblem().contains(storageAdvice(StorageProblem::not_a_database)))
       << window_->sessionsProblem().toStdString();
   ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
@@ -275,10 +228,10 @@ TEST_F(DeviceTest, ADeviceSessionIsRecordedToTheSessionsDatabase) {
   EXPECT_NE(window_->servo(), nullptr) << "the device runs without recording";
 }
 
-// The sessions database deleted while a device session is recorded: the trainee is told at once
-// that the session is no longer saved and what to do, the simulation goes on, and the next start
-// (the database opened again at its path) records anew.
-TEST_F(DeviceTest, ADatabaseDeletedMidSessionIsSaidAtOnceAndTheNextStartRecords) {
+// The sessions database deleted while a device session is recorded: the trainee is told at once,
+// in the Device panel and by the recordingStopped signal, that the session is no longer saved and
+// what to do (the station's part, and the next session recorded whole: tests/station).
+TEST_F(DeviceTest, ADatabaseDeletedMidSessionIsSaidAtOnceWithWhatToDo) {
   openWindow();
   const QString database = folder_.filePath("sessions.sqlite");
   ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
@@ -287,6 +240,7 @@ TEST_F(DeviceTest, ADatabaseDeletedMidSessionIsSaidAtOnceAndTheNextStartRecords)
   ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
   ASSERT_TRUE(window_->recordingSession().has_value()) << window_->sessionsProblem().toStdString();
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 300; }, kTimeoutMs));
+  QSignalSpy stopped(window_.get(), &MainWindow::recordingStopped);
   for (const char* suffix : {"", "-wal", "-shm"}) QFile::remove(database + suffix);
   ASSERT_TRUE(QTest::qWaitFor(
       [&] { return window_->devicePanel()->statusText().contains("Recording stopped"); },
@@ -295,64 +249,8 @@ TEST_F(DeviceTest, ADatabaseDeletedMidSessionIsSaidAtOnceAndTheNextStartRecords)
   const QString said = window_->devicePanel()->statusText();
   EXPECT_TRUE(said.contains("deleted")) << said.toStdString();
   EXPECT_TRUE(said.contains(storageAdvice(StorageProblem::deleted))) << said.toStdString();
-  const double time_s = snapshot().time_s;
-  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().time_s > time_s + 0.05; }, kTimeoutMs))
-      << "the simulation stopped with the recording";
-  // The next start: a new database at the same path, and a new session recorded whole.
-  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
-  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
-  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted, file));
-  ASSERT_TRUE(window_->recordingSession().has_value());
-  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 300; }, kTimeoutMs));
-  QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
-  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
-  ASSERT_TRUE(metricsStored.wait(kTimeoutMs));
-  EXPECT_TRUE(metricsStored.first().at(1).toBool()) << window_->sessionsProblem().toStdString();
-  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
-  ASSERT_EQ(store.sessions().size(), 1u);
-  EXPECT_EQ(store.sessions()[0].status, SessionStatus::complete);
-  EXPECT_GT(store.sessions()[0].frame_count, 0);
-}
-
-// The simulation's events reach the session: scripted forceps closing on the top of the liver
-// (the device's button), holding, and opening again record a grasp, then a release.
-TEST_F(DeviceTest, AGraspAndReleaseByTheDeviceAreSessionEvents) {
-  useSceneMillimetres();
-  openWindow();
-  const QString database = folder_.filePath("sessions.sqlite");
-  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
-  window_->toolPanel()->setTool(ToolKind::forceps);
-  // First where the view holds the forceps: the grasp point's offset from the device's point.
-  const Eigen::Vector3d above_mm = topOfTheMiddle_mm() + Eigen::Vector3d(0, 0, 40);
-  ASSERT_TRUE(window_->useDevice(DeviceChoice::scripted,
-                                 writeTrajectory({{0.0, above_mm, 0}, {600.0, above_mm, 0}})));
-  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().tool.has_value(); }, kTimeoutMs));
-  Tool closed = *snapshot().tool;
-  closed.jaw_opening = 0.0;
-  const Eigen::Vector3d grasp_offset_m = forceps_grasp_point_m(closed) - closed.pose.origin_m;
-  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
-  // Then the grasp point on the top, jaws closed from 0.3 s to 1.5 s.
-  const Eigen::Vector3d at_mm = topOfTheMiddle_mm() - grasp_offset_m * 1e3;
-  ASSERT_TRUE(window_->useDevice(
-      DeviceChoice::scripted,
-      writeTrajectory({{0.0, at_mm, 0}, {0.3, at_mm, 1}, {1.5, at_mm, 0}, {600.0, at_mm, 0}})));
-  ASSERT_TRUE(window_->recordingSession().has_value());
-  const std::int64_t session = *window_->recordingSession();
-  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().tool_grasping; }, kTimeoutMs))
-      << "the forceps took no hold";
-  ASSERT_TRUE(QTest::qWaitFor([&] { return !snapshot().tool_grasping; }, kTimeoutMs))
-      << "the forceps did not let go";
-  QTest::qWait(100);  // a display frame or two after the release
-  QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
-  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
-  ASSERT_TRUE(metricsStored.wait(kTimeoutMs));
-  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
-  std::vector<SessionEventKind> kinds;
-  for (const SessionEvent& e : store.events(session))
-    if (e.kind == SessionEventKind::grasp || e.kind == SessionEventKind::release)
-      kinds.push_back(e.kind);
-  const std::vector<SessionEventKind> expected{SessionEventKind::grasp, SessionEventKind::release};
-  EXPECT_EQ(kinds, expected);
+  ASSERT_EQ(stopped.size(), 1);
+  EXPECT_EQ(stopped.first().first().toString(), said);
 }
 
 // Palpation, the shipped scenario: the scripted probe held just off the liver's surface where it is
@@ -512,10 +410,10 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
       << review->problem().toStdString();
 }
 
-// A recorded session's device input plays back through the servo, at its original rate, along
-// the recorded line to its end; the replay is not recorded again, and a session that is not there
-// is refused with its number.
-TEST_F(DeviceTest, ARecordedSessionReplaysItsDeviceInputAndIsNotRecordedAgain) {
+// The window's replay of a recorded session (the replay itself: tests/station): said in the
+// Device panel, not recorded again; a session that is not there is refused with its number and
+// the replay in use stays.
+TEST_F(DeviceTest, ARecordedSessionIsReplayedFromTheWindowAndAMissingOneIsNamed) {
   openWindow();
   const QString database = folder_.filePath("replay.sqlite");
   ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
@@ -533,26 +431,17 @@ TEST_F(DeviceTest, ARecordedSessionReplaysItsDeviceInputAndIsNotRecordedAgain) {
   EXPECT_FALSE(window_->recordingSession().has_value()) << "a replay was recorded";
   EXPECT_TRUE(window_->devicePanel()->statusText().contains("Replay of session"))
       << window_->devicePanel()->statusText().toStdString();
-  // The replayed device reaches the recorded end, having stayed on the recorded line.
-  const Eigen::Vector3d along = (end_mm - start_mm).normalized();
   ASSERT_TRUE(QTest::qWaitFor(
       [&] {
         const auto sample = snapshot().device_sample;
-        if (!sample) return false;
-        const Eigen::Vector3d off = sample->position_mm - start_mm;
-        EXPECT_LT((off - off.dot(along) * along).norm(), 1e-9) << "off the recorded line";
-        return (sample->position_mm - end_mm).norm() < 1e-9;
+        return sample && (sample->position_mm - end_mm).norm() < 1e-9;
       },
       kTimeoutMs));
-  EXPECT_EQ(snapshot().device_sample->buttons, 1u);
 
   EXPECT_FALSE(window_->replaySession(session + 40));
   EXPECT_TRUE(window_->devicePanel()->statusText().contains(QString::number(session + 40)))
       << window_->devicePanel()->statusText().toStdString();
   EXPECT_EQ(window_->device(), DeviceChoice::replay) << "the replay in use stays";
-  ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
-  SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
-  EXPECT_EQ(store.sessions().size(), 1u);
 }
 
 TEST_F(DeviceTest, ABadTrajectoryFileIsNamedWithItsLineAndTheDeviceInUseStays) {
@@ -609,21 +498,11 @@ TEST_F(DeviceTest, CalibrationPutsTheStylusJustInFrontOfTheLiverAndIsRemembered)
 }
 
 #ifdef LIVERSIM_FAKE_HD_LIBRARY
-// The fake runtime's test hooks (fake_hd.cpp), looked up in the loaded library.
-template <class Function>
-Function fakeHook(const char* name) {
-  void* library = dlopen(LIVERSIM_FAKE_HD_LIBRARY, RTLD_NOW | RTLD_NOLOAD);
-  if (library == nullptr) return nullptr;
-  auto function = reinterpret_cast<Function>(dlsym(library, name));
-  dlclose(library);  // still loaded: the driver never unloads it
-  return function;
-}
+using test::fakeHook;
 
 TEST_F(DeviceTest, TheOmniIsOfferedWhenItOpensAndAFatalFaultHandsTheToolBackToTheMouse) {
   qputenv("LIVERSIM_OPENHAPTICS_LIBRARY", LIVERSIM_FAKE_HD_LIBRARY);
   openWindow();
-  const QString database = folder_.filePath("sessions.sqlite");
-  ASSERT_TRUE(window_->setSessionsDatabase(database)) << window_->sessionsProblem().toStdString();
   DevicePanel* panel = window_->devicePanel();
   ASSERT_TRUE(panel->openHapticsOffered()) << panel->openHapticsToolTip().toStdString();
   window_->toolPanel()->setTool(ToolKind::probe);
@@ -645,20 +524,7 @@ TEST_F(DeviceTest, TheOmniIsOfferedWhenItOpensAndAFatalFaultHandsTheToolBackToTh
   double force_n[3];
   last_force(force_n);
   EXPECT_EQ(Eigen::Vector3d(force_n[0], force_n[1], force_n[2]), Eigen::Vector3d::Zero());
-  // The session of the unplugged device ended with what it recorded until then, and the fault.
-  {
-    SqliteSessionStore store(database.toStdString(), SqliteSessionStore::Access::read_only);
-    const std::vector<SessionSummary> sessions = store.sessions();
-    ASSERT_EQ(sessions.size(), 1u);
-    EXPECT_EQ(sessions[0].status, SessionStatus::complete);
-    EXPECT_GT(sessions[0].frame_count, 200);
-    EXPECT_EQ(static_cast<std::int64_t>(store.frames(sessions[0].id).size()),
-              sessions[0].frame_count);
-    const std::vector<SessionEvent> events = store.events(sessions[0].id);
-    EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const SessionEvent& e) {
-      return e.kind == SessionEventKind::device_fault && !e.detail.empty();
-    })) << "the fault is not among the session's events";
-  }
+  // Its session ended whole with the fault among its events (tests/station).
   // Plugged in again: choosing it opens it anew.
   ASSERT_TRUE(window_->useDevice(DeviceChoice::openhaptics)) << panel->statusText().toStdString();
   EXPECT_TRUE(panel->openHapticsOffered());

@@ -467,7 +467,7 @@ TEST(ScenarioEditorInTheWorkstation, TryItRunsTheEditedScenarioAndTheEditorStart
   ASSERT_TRUE(opened.first().first().toBool());
   ASSERT_TRUE(window.scenario());
   EXPECT_EQ(window.scenario()->scenario, editor->document().scenario());
-  EXPECT_TRUE(window.scenario()->file.isEmpty());  // not saved
+  EXPECT_TRUE(window.scenario()->file.empty());  // not saved
   // What a session records is the scenario as tried.
   const ScenarioReading recorded = read_scenario(window.scenario()->text);
   ASSERT_TRUE(recorded.scenario);

@@ -76,8 +76,8 @@ class SessionReplayWindowTest : public ::testing::Test {
     const std::string text = write_scenario(scenario_);
     const QString absolute = QFileInfo(kSmallScenario).absoluteFilePath();
     SceneSetup setup = build_scene(scenario_, QFileInfo(absolute).absolutePath().toStdString());
-    window_ =
-        std::make_unique<MainWindow>(std::move(setup), OpenedScenario{scenario_, absolute, text});
+    window_ = std::make_unique<MainWindow>(std::move(setup),
+                                           OpenedScenario{scenario_, absolute.toStdString(), text});
     window_->show();
     ASSERT_TRUE(QTest::qWaitForWindowExposed(window_.get()));
     ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().time_s > 0.0; }, kTimeoutMs));
