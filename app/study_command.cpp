@@ -298,7 +298,7 @@ std::function<std::optional<int>()> add_study_command(CLI::App& app) {
 
   const auto run_stability = add_stability_study(*study);
 
-  return [options, study, accuracy, run_stability]() -> std::optional<int> {
+  return [options, accuracy, run_stability]() -> std::optional<int> {
     if (auto exit_code = run_stability()) return exit_code;
     if (!accuracy->parsed()) return std::nullopt;
     // The exact command that produced the report, for the report itself.

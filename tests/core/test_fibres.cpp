@@ -105,7 +105,7 @@ TEST(Fibres, UniaxialTensionAlongTheFibreMatchesTheAnalyticAnswer) {
   const FibreParameters fibres{2000.0, 3.0};
   const TetMesh mesh = block_mesh(3, 2, 2, {0.03, 0.02, 0.02}, 0.2);
   ModelOptions options;
-  options.regions[0] = {tissue, fibres};
+  options.regions[0] = {tissue, fibres, std::nullopt, std::nullopt};
   options.fibre_field.first_family = {kAlongX};
   const SimModel model = build_model(mesh, options);
   ASSERT_TRUE(model.effects.fibres);
@@ -136,9 +136,9 @@ TEST(Fibres, AcrossTheFibreTheResponseIsThePlainBaseMaterial) {
   TissueMaterial tissue{3500.0, 0.49, 1060.0};
   const TetMesh mesh = block_mesh(1, 1, 1, {0.01, 0.01, 0.01});
   ModelOptions with_fibres, without_fibres;
-  with_fibres.regions[0] = {tissue, FibreParameters{2000.0, 3.0}};
+  with_fibres.regions[0] = {tissue, FibreParameters{2000.0, 3.0}, std::nullopt, std::nullopt};
   with_fibres.fibre_field.first_family = {Eigen::Vector3d::UnitY()};
-  without_fibres.regions[0] = {tissue, std::nullopt};
+  without_fibres.regions[0] = {tissue, std::nullopt, std::nullopt, std::nullopt};
   const SimModel a = build_model(mesh, with_fibres), b = build_model(mesh, without_fibres);
   // Stretched along x: the y fibres shorten (I4 = t² < 1) and switch off.
   const UniaxialAnswer answer = analytic_uniaxial(1.3, tissue, FibreParameters{});
@@ -229,7 +229,8 @@ TEST(Regions, AStiffLesionDeformsTenTimesLessUnderTheSameStress) {
   }
   ModelOptions options;
   options.regions[0].tissue = TissueMaterial{3500.0, 0.0, 1060.0};
-  options.regions.push_back({TissueMaterial{35000.0, 0.0, 1060.0}, std::nullopt});
+  options.regions.push_back(
+      {TissueMaterial{35000.0, 0.0, 1060.0}, std::nullopt, std::nullopt, std::nullopt});
   options.mass_damping_per_s = 150.0;
   const SimModel model = build_model(mesh, options);
   const std::vector<PointLoad> loads = testing::end_face_tension(mesh, sigma);

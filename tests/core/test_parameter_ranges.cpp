@@ -19,7 +19,9 @@ TEST(ParameterRanges, EveryRangeIsWellFormedAndFoundByItsKey) {
   for (const ParameterRange& range : tissue_parameter_ranges()) {
     EXPECT_TRUE(std::isfinite(range.min) && std::isfinite(range.max)) << range.name;
     EXPECT_LT(range.min, range.max) << range.name;
-    if (range.log_scale) EXPECT_GT(range.min, 0.0) << range.name;
+    if (range.log_scale) {
+      EXPECT_GT(range.min, 0.0) << range.name;
+    }
     EXPECT_FALSE(range.why.empty()) << range.name;
     EXPECT_DOUBLE_EQ(range.at_fraction(0.0), range.min) << range.name;
     EXPECT_DOUBLE_EQ(range.at_fraction(1.0), range.max) << range.name;

@@ -35,15 +35,23 @@ std::vector<SimulationInput> every_kind_of_input() {
   forceps.jaw_opening = 0.25;
   forceps.blade_armed = false;
   forceps.geometry.jaw_length_m = 0.0175;
-  SimulationInput tool{SimulationInput::Kind::tool, forceps};
-  SimulationInput no_tool{SimulationInput::Kind::tool, std::nullopt};
-  SimulationInput springs{SimulationInput::Kind::springs,
-                          std::nullopt,
-                          {{7, {0.1, 0.2, 0.3}, 300.0, 2.5}, {123456, {-1e-9, 0.0, 5e300}, 1.0}}};
-  SimulationInput no_springs{SimulationInput::Kind::springs};
-  SimulationInput cycle{
-      SimulationInput::Kind::cycle, std::nullopt, {}, 17, true, 12.345678901234567};
-  SimulationInput untimed_cycle{SimulationInput::Kind::cycle, std::nullopt, {}, 1, false};
+  const auto input = [](SimulationInput::Kind kind) {
+    SimulationInput made;
+    made.kind = kind;
+    return made;
+  };
+  SimulationInput tool = input(SimulationInput::Kind::tool);
+  tool.tool = forceps;
+  const SimulationInput no_tool = input(SimulationInput::Kind::tool);
+  SimulationInput springs = input(SimulationInput::Kind::springs);
+  springs.springs = {{7, {0.1, 0.2, 0.3}, 300.0, 2.5}, {123456, {-1e-9, 0.0, 5e300}, 1.0}};
+  const SimulationInput no_springs = input(SimulationInput::Kind::springs);
+  SimulationInput cycle = input(SimulationInput::Kind::cycle);
+  cycle.steps = 17;
+  cycle.check_energy = true;
+  cycle.servo_time_s = 12.345678901234567;
+  SimulationInput untimed_cycle = input(SimulationInput::Kind::cycle);
+  untimed_cycle.steps = 1;
   return {tool, springs, cycle, no_tool, no_springs, untimed_cycle};
 }
 
@@ -289,7 +297,8 @@ TEST_F(SessionReplayTest, ASeekBackStartsFromRestAndASeekOnGoesOnFromThere) {
 }
 
 TEST_F(SessionReplayTest, ALogOfAnotherModelOrWithoutTimedCyclesIsRefused) {
-  SimulationInput far{SimulationInput::Kind::springs};
+  SimulationInput far;
+  far.kind = SimulationInput::Kind::springs;
   far.springs.push_back({static_cast<NodeIndex>(scene_->mesh.node_count() + 5), {0, 0, 0}, 1.0});
   const SimulationInput cycle{SimulationInput::Kind::cycle, std::nullopt, {}, 1, false, 1.0};
   SessionReplay replay(*scene_, {far, cycle});

@@ -75,7 +75,8 @@ TEST(Tangent, ElementWithTwoFibreFamiliesAndALesionRegion) {
   mesh.region[3] = 1;
   ModelOptions options;
   options.regions[0].fibres = FibreParameters{600.0, 2.0};
-  options.regions.push_back({TissueMaterial{35000.0, 0.45, 1100.0}, std::nullopt});
+  options.regions.push_back(
+      {TissueMaterial{35000.0, 0.45, 1100.0}, std::nullopt, std::nullopt, std::nullopt});
   options.fibre_field.first_family = {Eigen::Vector3d(1, 1, 0)};
   options.fibre_field.second_family = {Eigen::Vector3d(1, -1, 0.3)};
   const SimModel model = build_model(mesh, options);

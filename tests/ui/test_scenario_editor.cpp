@@ -221,8 +221,9 @@ TEST_F(ScenarioEditorTest, PaintingAStrokeHoldsTheSurfaceUnderItAsOneStep) {
     ASSERT_TRUE(hit);
     EXPECT_LT((hit->point_m - to_metres(balls[i].centre_mm)).norm(), 2e-3);
     // Half a brush radius apart at least: a stroke, not a pile.
-    if (i > 0)
+    if (i > 0) {
       EXPECT_GE((to_metres(balls[i].centre_mm) - to_metres(balls[i - 1].centre_mm)).norm(), 4e-3);
+    }
   }
   EXPECT_EQ(editor_->overlay()->shown_fixed_ball_count(), balls.size());
   // The painted balls hold nodes in the built model.

@@ -319,8 +319,8 @@ ElasticEvaluation combine_chunks(const ForceScratch& scratch, double* dissipated
 }
 
 // The plain viscous loop takes a viscous model whose every region is viscous, committing a step.
-bool plain_viscous_loop_applies(const SimModel& model, const EffectSet& on,
-                                const ViscousContext& viscous) {
+[[maybe_unused]] bool plain_viscous_loop_applies(const SimModel& model, const EffectSet& on,
+                                                 const ViscousContext& viscous) {
   if (on.mooney_rivlin || viscous.arm != nullptr) return false;
   for (const auto& parameters : model.viscous_parameters)
     if (!parameters) return false;

@@ -203,13 +203,16 @@ void for_each_tool_double(Tool& tool, Visit&& visit) {
 class ByteWriter {
  public:
   void u8(std::uint8_t value) { bytes_.push_back(value); }
+  // Through a local copy rather than resize-then-write, which GCC 12 misreads as an overflow.
   void u32(std::uint32_t value) {
-    bytes_.resize(bytes_.size() + 4);
-    put_u32(bytes_.data() + bytes_.size() - 4, value);
+    std::uint8_t raw[4];
+    put_u32(raw, value);
+    bytes_.insert(bytes_.end(), raw, raw + 4);
   }
   void f64(double value) {
-    bytes_.resize(bytes_.size() + 8);
-    put_f64(bytes_.data() + bytes_.size() - 8, value);
+    std::uint8_t raw[8];
+    put_f64(raw, value);
+    bytes_.insert(bytes_.end(), raw, raw + 8);
   }
   std::vector<std::uint8_t>& bytes() { return bytes_; }
 

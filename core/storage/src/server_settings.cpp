@@ -177,11 +177,15 @@ std::string server_url(const ServerSettings& s) {
   std::string url = "postgresql://";
   if (!s.user.empty()) url += percent_encoded(s.user) + "@";
   const bool socket_folder = s.host.starts_with('/');
+  // Appended piece by piece: GCC 12 misreads `"[" + s.host` as overlapping copies (-Wrestrict).
   if (!socket_folder) {
-    url += s.host.find(':') != std::string::npos ? "[" + s.host + "]" : percent_encoded(s.host);
-    url += ":" + std::to_string(s.port);
+    if (s.host.find(':') != std::string::npos)
+      url.append("[").append(s.host).append("]");
+    else
+      url += percent_encoded(s.host);
+    url.append(":").append(std::to_string(s.port));
   }
-  url += "/" + percent_encoded(s.database);
+  url.append("/").append(percent_encoded(s.database));
   std::string options = "sslmode=" + s.ssl_mode;
   if (socket_folder)
     options += "&host=" + percent_encoded(s.host) + "&port=" + std::to_string(s.port);

@@ -71,7 +71,7 @@ struct IntegratorSettings {
 
 struct ModelOptions {
   // Region r of the mesh (TetMesh::region) is made of regions[r]; region 0 is the parenchyma.
-  std::vector<RegionMaterial> regions{RegionMaterial{}};
+  std::vector<RegionMaterial> regions = std::vector<RegionMaterial>(1);
   FibreField fibre_field;
   bool average_nodal_pressure = false;  // see EffectSet
   std::vector<NodeIndex> fixed_nodes;   // held at their rest position (e.g. ligament attachment)
