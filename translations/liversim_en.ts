@@ -12,7 +12,7 @@
     </message>
 </context>
 <context>
-    <name>liversim::ScenarioEditor</name>
+    <name>liversim::EditorTissuePanel</name>
     <message numerus="yes">
         <source>%n ball(s)</source>
         <translation>

@@ -659,6 +659,607 @@
     </message>
 </context>
 <context>
+    <name>liversim::EditorGradingPanel</name>
+    <message>
+        <source>Metric</source>
+        <translation>指标</translation>
+    </message>
+    <message>
+        <source>Weight</source>
+        <translation>权重</translation>
+    </message>
+    <message>
+        <source>Pass if</source>
+        <translation>通过条件</translation>
+    </message>
+    <message>
+        <source>Threshold</source>
+        <translation>阈值</translation>
+    </message>
+    <message>
+        <source>The rubric: each criterion passes when its metric is at most or at least the threshold; the score is the passed criteria&apos;s share of the weights</source>
+        <translation>评分标准：每项标准在其指标不超过或不低于阈值时通过；得分为已通过标准的权重占总权重的比例</translation>
+    </message>
+    <message>
+        <source>Add criterion</source>
+        <translation>添加标准</translation>
+    </message>
+    <message>
+        <source>Remove</source>
+        <translation>移除</translation>
+    </message>
+    <message>
+        <source>Add a criterion</source>
+        <translation>添加标准</translation>
+    </message>
+    <message>
+        <source>Remove a criterion</source>
+        <translation>移除标准</translation>
+    </message>
+    <message>
+        <source>Tissue stretched past 1 + this is damaged (graded): 0.05 to 2</source>
+        <translation>组织拉伸超过 1 + 此值即视为损伤（计入评分）：0.05 至 2</translation>
+    </message>
+    <message>
+        <source>Damage in tension</source>
+        <translation>拉伸损伤</translation>
+    </message>
+    <message>
+        <source>Change the damage strain</source>
+        <translation>更改损伤应变</translation>
+    </message>
+    <message>
+        <source>Tissue squeezed below 1 − this is damaged (graded): 0.05 to 0.95</source>
+        <translation>组织压缩至 1 − 此值以下即视为损伤（计入评分）：0.05 至 0.95</translation>
+    </message>
+    <message>
+        <source>Damage in compression</source>
+        <translation>压缩损伤</translation>
+    </message>
+    <message>
+        <source>Pick on the organ</source>
+        <translation>在器官上选取</translation>
+    </message>
+    <message>
+        <source>Retraction: click where the lobe is to be grasped</source>
+        <translation>牵拉：单击肝叶上要抓取的位置</translation>
+    </message>
+    <message>
+        <source>Grasp point</source>
+        <translation>抓取点</translation>
+    </message>
+    <message>
+        <source>Retraction: how far to lift: 5 to 100 mm</source>
+        <translation>牵拉：提起的高度，5 至 100 mm</translation>
+    </message>
+    <message>
+        <source>Lift</source>
+        <translation>提起高度</translation>
+    </message>
+    <message>
+        <source>Change the lift</source>
+        <translation>更改提起高度</translation>
+    </message>
+    <message>
+        <source>(%1, %2, %3) mm</source>
+        <translation>(%1, %2, %3) mm</translation>
+    </message>
+    <message>
+        <source>retraction tasks only</source>
+        <translation>仅用于牵拉任务</translation>
+    </message>
+    <message>
+        <source>The criterion&apos;s weight in the score</source>
+        <translation>该标准在得分中的权重</translation>
+    </message>
+    <message>
+        <source>at most</source>
+        <translation>不超过</translation>
+    </message>
+    <message>
+        <source>at least</source>
+        <translation>不低于</translation>
+    </message>
+    <message>
+        <source>The threshold, in the metric&apos;s unit</source>
+        <translation>阈值，单位与指标相同</translation>
+    </message>
+    <message>
+        <source>Change a criterion&apos;s metric</source>
+        <translation>更改标准的指标</translation>
+    </message>
+    <message>
+        <source>Change a criterion&apos;s weight</source>
+        <translation>更改标准的权重</translation>
+    </message>
+    <message>
+        <source>Change a criterion&apos;s rule</source>
+        <translation>更改标准的规则</translation>
+    </message>
+    <message>
+        <source>Change a criterion&apos;s threshold</source>
+        <translation>更改标准的阈值</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::EditorLesionPanel</name>
+    <message>
+        <source>Add</source>
+        <translation>添加</translation>
+    </message>
+    <message>
+        <source>A new lesion at the organ&apos;s centre (or use Place lesion)</source>
+        <translation>在器官中心新建一个病灶（或使用“放置病灶”）</translation>
+    </message>
+    <message>
+        <source>Remove</source>
+        <translation>移除</translation>
+    </message>
+    <message>
+        <source>Remove the lesion</source>
+        <translation>移除病灶</translation>
+    </message>
+    <message>
+        <source>The lesion&apos;s name, which the task refers to</source>
+        <translation>病灶名称，供任务引用</translation>
+    </message>
+    <message>
+        <source>Name</source>
+        <translation>名称</translation>
+    </message>
+    <message>
+        <source>Rename the lesion</source>
+        <translation>重命名病灶</translation>
+    </message>
+    <message>
+        <source>The lesion&apos;s centre along the scene&apos;s %1 axis</source>
+        <translation>病灶中心在场景 %1 轴上的坐标</translation>
+    </message>
+    <message>
+        <source>The lesion&apos;s semi-axis along the scene&apos;s %1 axis (Shift-drag the lesion in the view to resize it)</source>
+        <translation>病灶沿场景 %1 轴的半轴长（在视图中按住 Shift 拖动病灶可调整其大小）</translation>
+    </message>
+    <message>
+        <source>Move the lesion</source>
+        <translation>移动病灶</translation>
+    </message>
+    <message>
+        <source>Resize the lesion</source>
+        <translation>调整病灶大小</translation>
+    </message>
+    <message>
+        <source>Centre (x, y, z)</source>
+        <translation>中心 (x, y, z)</translation>
+    </message>
+    <message>
+        <source>Semi-axes</source>
+        <translation>半轴</translation>
+    </message>
+    <message>
+        <source>Young&apos;s modulus of the lesion (instantaneous, with viscoelasticity): %1 to %2 times the parenchyma&apos;s. %3</source>
+        <translation>病灶的杨氏模量（启用粘弹性时为瞬时模量）：为实质的 %1 至 %2 倍。%3</translation>
+    </message>
+    <message>
+        <source>Stiffness E</source>
+        <translation>刚度 E</translation>
+    </message>
+    <message>
+        <source>Change the lesion&apos;s stiffness</source>
+        <translation>更改病灶刚度</translation>
+    </message>
+    <message>
+        <source>Yield limit</source>
+        <translation>屈服极限</translation>
+    </message>
+    <message>
+        <source>Change the lesion&apos;s yield limit</source>
+        <translation>更改病灶屈服极限</translation>
+    </message>
+    <message>
+        <source>Viscosity η1</source>
+        <translation>粘度 η1</translation>
+    </message>
+    <message>
+        <source>Change the lesion&apos;s viscosity</source>
+        <translation>更改病灶粘度</translation>
+    </message>
+    <message>
+        <source>Hidden from the trainee</source>
+        <translation>对学员隐藏</translation>
+    </message>
+    <message>
+        <source>Not drawn in the workstation (palpation tasks)</source>
+        <translation>不在工作站中显示（触诊任务）</translation>
+    </message>
+    <message>
+        <source>Hide the lesion</source>
+        <translation>隐藏病灶</translation>
+    </message>
+    <message>
+        <source>Show the lesion</source>
+        <translation>显示病灶</translation>
+    </message>
+    <message>
+        <source>the parenchyma&apos;s</source>
+        <translation>同实质</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::EditorOrganPanel</name>
+    <message>
+        <source>Built-in liver</source>
+        <translation>内置肝脏</translation>
+    </message>
+    <message>
+        <source>Surface model (OBJ, STL, PLY, glTF, FBX, 3DS)</source>
+        <translation>表面模型 (OBJ, STL, PLY, glTF, FBX, 3DS)</translation>
+    </message>
+    <message>
+        <source>Tetrahedral mesh (.inp, .msh)</source>
+        <translation>四面体网格 (.inp, .msh)</translation>
+    </message>
+    <message>
+        <source>Organ</source>
+        <translation>器官</translation>
+    </message>
+    <message>
+        <source>Change the organ</source>
+        <translation>更改器官</translation>
+    </message>
+    <message>
+        <source>The organ&apos;s file: relative to the scenario&apos;s folder, or absolute</source>
+        <translation>器官文件：相对于场景所在文件夹的路径，或绝对路径</translation>
+    </message>
+    <message>
+        <source>Choose…</source>
+        <translation>选择…</translation>
+    </message>
+    <message>
+        <source>File</source>
+        <translation>文件</translation>
+    </message>
+    <message>
+        <source>Choose the organ&apos;s file</source>
+        <translation>选择器官文件</translation>
+    </message>
+    <message>
+        <source>The organ&apos;s file</source>
+        <translation>器官文件</translation>
+    </message>
+    <message>
+        <source>Organ files (%1);;All files (*)</source>
+        <translation>器官文件 (%1);;所有文件 (*)</translation>
+    </message>
+    <message>
+        <source>The unit of the surface model&apos;s lengths (never guessed)</source>
+        <translation>表面模型的长度单位（不会自动推测）</translation>
+    </message>
+    <message>
+        <source>Length unit</source>
+        <translation>长度单位</translation>
+    </message>
+    <message>
+        <source>Change the organ&apos;s unit</source>
+        <translation>更改器官单位</translation>
+    </message>
+    <message>
+        <source>Elements of the organ&apos;s mesh: 1000 to 50000 (more is more accurate and slower: see the cost in Tissue and effects)</source>
+        <translation>器官网格的单元数：1000 至 50000（越多越精确，也越慢：计算开销见“组织与效应”）</translation>
+    </message>
+    <message>
+        <source>Elements</source>
+        <translation>单元数</translation>
+    </message>
+    <message>
+        <source>Change the element count</source>
+        <translation>更改单元数</translation>
+    </message>
+    <message>
+        <source>A node set of the mesh file held fixed (empty: none)</source>
+        <translation>网格文件中保持固定的节点集（留空：无）</translation>
+    </message>
+    <message>
+        <source>Fixed node set</source>
+        <translation>固定节点集</translation>
+    </message>
+    <message>
+        <source>Change the fixed node set</source>
+        <translation>更改固定节点集</translation>
+    </message>
+    <message>
+        <source>Change the integrator</source>
+        <translation>更改时间积分器</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::EditorTaskPanel</name>
+    <message>
+        <source>Title</source>
+        <translation>标题</translation>
+    </message>
+    <message>
+        <source>Change the title</source>
+        <translation>更改标题</translation>
+    </message>
+    <message>
+        <source>Description</source>
+        <translation>描述</translation>
+    </message>
+    <message>
+        <source>Change the description</source>
+        <translation>更改描述</translation>
+    </message>
+    <message>
+        <source>Palpate a hidden lesion</source>
+        <translation>触诊隐藏病灶</translation>
+    </message>
+    <message>
+        <source>Retract a lobe</source>
+        <translation>牵拉肝叶</translation>
+    </message>
+    <message>
+        <source>Resect a lesion</source>
+        <translation>切除病灶</translation>
+    </message>
+    <message>
+        <source>Task</source>
+        <translation>任务</translation>
+    </message>
+    <message>
+        <source>Change the task</source>
+        <translation>更改任务</translation>
+    </message>
+    <message>
+        <source>Shown to the trainee</source>
+        <translation>向学员显示</translation>
+    </message>
+    <message>
+        <source>Instructions</source>
+        <translation>任务说明</translation>
+    </message>
+    <message>
+        <source>Change the instructions</source>
+        <translation>更改任务说明</translation>
+    </message>
+    <message>
+        <source>The time the trainee has: 10 s to 2 h</source>
+        <translation>学员可用的时间：10 s 至 2 h</translation>
+    </message>
+    <message>
+        <source>Time limit</source>
+        <translation>时限</translation>
+    </message>
+    <message>
+        <source>Change the time limit</source>
+        <translation>更改时限</translation>
+    </message>
+    <message>
+        <source>The lesion to find or to resect</source>
+        <translation>要查找或切除的病灶</translation>
+    </message>
+    <message>
+        <source>Lesion</source>
+        <translation>病灶</translation>
+    </message>
+    <message>
+        <source>Choose the task&apos;s lesion</source>
+        <translation>选择任务的病灶</translation>
+    </message>
+    <message>
+        <source>Resection: the least distance from the cut to the lesion</source>
+        <translation>切除：切口与病灶之间的最小距离</translation>
+    </message>
+    <message>
+        <source>Margin</source>
+        <translation>切缘</translation>
+    </message>
+    <message>
+        <source>Change the margin</source>
+        <translation>更改切缘</translation>
+    </message>
+    <message>
+        <source>Clear</source>
+        <translation>清除</translation>
+    </message>
+    <message>
+        <source>Clear the planned plane</source>
+        <translation>清除计划平面</translation>
+    </message>
+    <message>
+        <source>Planned plane</source>
+        <translation>计划平面</translation>
+    </message>
+    <message>
+        <source>Allow a tool</source>
+        <translation>允许使用器械</translation>
+    </message>
+    <message>
+        <source>Withdraw a tool</source>
+        <translation>禁用器械</translation>
+    </message>
+    <message>
+        <source>Tools</source>
+        <translation>器械</translation>
+    </message>
+    <message>
+        <source>A force on the tissue above this is excessive (graded)</source>
+        <translation>作用于组织的力超过此值即为过大（计入评分）</translation>
+    </message>
+    <message>
+        <source>Safe force</source>
+        <translation>安全力</translation>
+    </message>
+    <message>
+        <source>Change the safe force</source>
+        <translation>更改安全力</translation>
+    </message>
+    <message>
+        <source>through (%1, %2, %3) mm, normal (%4, %5, %6)</source>
+        <translation>经过 (%1, %2, %3) mm，法向 (%4, %5, %6)</translation>
+    </message>
+    <message>
+        <source>none: draw it across the organ (Draw plane)</source>
+        <translation>无：请在器官上绘制（“绘制平面”）</translation>
+    </message>
+    <message>
+        <source>resection tasks only</source>
+        <translation>仅用于切除任务</translation>
+    </message>
+</context>
+<context>
+    <name>liversim::EditorTissuePanel</name>
+    <message>
+        <source>Parenchyma E</source>
+        <translation>实质 E</translation>
+    </message>
+    <message>
+        <source>Change the parenchyma&apos;s stiffness</source>
+        <translation>更改实质刚度</translation>
+    </message>
+    <message>
+        <source>Poisson&apos;s ratio ν</source>
+        <translation>泊松比 ν</translation>
+    </message>
+    <message>
+        <source>Change Poisson&apos;s ratio</source>
+        <translation>更改泊松比</translation>
+    </message>
+    <message>
+        <source>Effects simulated (an effect off costs nothing)</source>
+        <translation>仿真的效应（关闭的效应不产生计算开销）</translation>
+    </message>
+    <message>
+        <source>Near-incompressibility (averaged pressure)</source>
+        <translation>近不可压缩性（平均压力）</translation>
+    </message>
+    <message>
+        <source>Viscoelasticity (relaxation, creep)</source>
+        <translation>粘弹性（松弛、蠕变）</translation>
+    </message>
+    <message>
+        <source>Viscoplasticity above the yield limit</source>
+        <translation>超过屈服极限后的粘塑性</translation>
+    </message>
+    <message>
+        <source>Fibre anisotropy (HGO)</source>
+        <translation>纤维各向异性 (HGO)</translation>
+    </message>
+    <message>
+        <source>Switch an effect on</source>
+        <translation>开启效应</translation>
+    </message>
+    <message>
+        <source>Switch an effect off</source>
+        <translation>关闭效应</translation>
+    </message>
+    <message>
+        <source>Steps per second of this scenario on this machine, measured now: its model stepped for half a second under a 0.5 N pull</source>
+        <translation>此场景在本机上每秒的步数，即时测量：模型在 0.5 N 拉力下推进半秒</translation>
+    </message>
+    <message>
+        <source>Laws of the effects</source>
+        <translation>效应的本构参数</translation>
+    </message>
+    <message>
+        <source>Change %1</source>
+        <translation>更改%1</translation>
+    </message>
+    <message>
+        <source>Maxwell arm E1</source>
+        <translation>Maxwell 支路 E1</translation>
+    </message>
+    <message>
+        <source> E2 = E − E1 follows, so that E stays the parenchyma&apos;s.</source>
+        <translation> E2 = E − E1 随之确定，使 E 保持为实质的值。</translation>
+    </message>
+    <message>
+        <source>Maxwell arm η1</source>
+        <translation>Maxwell 支路 η1</translation>
+    </message>
+    <message>
+        <source>Yield limit σs</source>
+        <translation>屈服极限 σs</translation>
+    </message>
+    <message>
+        <source>Viscoplastic η2</source>
+        <translation>粘塑性 η2</translation>
+    </message>
+    <message>
+        <source>Creep index n</source>
+        <translation>蠕变指数 n</translation>
+    </message>
+    <message>
+        <source>Fibre k1</source>
+        <translation>纤维 k1</translation>
+    </message>
+    <message>
+        <source>Fibre k2</source>
+        <translation>纤维 k2</translation>
+    </message>
+    <message>
+        <source>Fibre direction</source>
+        <translation>纤维方向</translation>
+    </message>
+    <message>
+        <source>The fibres&apos; reference direction (normalised on saving)</source>
+        <translation>纤维的参考方向（保存时归一化）</translation>
+    </message>
+    <message>
+        <source>Change the fibre direction</source>
+        <translation>更改纤维方向</translation>
+    </message>
+    <message>
+        <source>Across the view</source>
+        <translation>沿视图横向</translation>
+    </message>
+    <message>
+        <source>Fibres along the screen&apos;s horizontal, as the organ is seen now</source>
+        <translation>按器官当前的视角，使纤维沿屏幕水平方向</translation>
+    </message>
+    <message>
+        <source>Set the fibre direction</source>
+        <translation>设置纤维方向</translation>
+    </message>
+    <message>
+        <source>Fixed regions</source>
+        <translation>固定区域</translation>
+    </message>
+    <message>
+        <source>Radius of the painting brush (Paint fixed)</source>
+        <translation>涂刷画笔的半径（涂刷固定区）</translation>
+    </message>
+    <message>
+        <source>Brush</source>
+        <translation>画笔</translation>
+    </message>
+    <message>
+        <source>Clear painted</source>
+        <translation>清除涂刷</translation>
+    </message>
+    <message>
+        <source>Clear the painted fixed regions</source>
+        <translation>清除涂刷的固定区域</translation>
+    </message>
+    <message>
+        <source>Painted</source>
+        <translation>已涂刷</translation>
+    </message>
+    <message>
+        <source>Coronary ligament (built-in liver)</source>
+        <translation>冠状韧带（内置肝脏）</translation>
+    </message>
+    <message>
+        <source>Change the ligament</source>
+        <translation>更改韧带</translation>
+    </message>
+    <message numerus="yes">
+        <source>%n ball(s)</source>
+        <translation>
+            <numerusform>%n 个球形区域</numerusform>
+        </translation>
+    </message>
+</context>
+<context>
     <name>liversim::ForceTrace</name>
     <message>
         <source>Force on the tool over the last %1 s</source>
@@ -1448,44 +2049,8 @@ The scene that was running goes on.</source>
         <translation>在工作站中按当前状态运行该场景</translation>
     </message>
     <message>
-        <source>Add</source>
-        <translation>添加</translation>
-    </message>
-    <message>
-        <source>A new lesion at the organ&apos;s centre (or use Place lesion)</source>
-        <translation>在器官中心新建一个病灶（或使用“放置病灶”）</translation>
-    </message>
-    <message>
-        <source>Remove</source>
-        <translation>移除</translation>
-    </message>
-    <message>
         <source>Add a lesion</source>
         <translation>添加病灶</translation>
-    </message>
-    <message>
-        <source>Remove the lesion</source>
-        <translation>移除病灶</translation>
-    </message>
-    <message>
-        <source>The lesion&apos;s name, which the task refers to</source>
-        <translation>病灶名称，供任务引用</translation>
-    </message>
-    <message>
-        <source>Name</source>
-        <translation>名称</translation>
-    </message>
-    <message>
-        <source>Rename the lesion</source>
-        <translation>重命名病灶</translation>
-    </message>
-    <message>
-        <source>The lesion&apos;s centre along the scene&apos;s %1 axis</source>
-        <translation>病灶中心在场景 %1 轴上的坐标</translation>
-    </message>
-    <message>
-        <source>The lesion&apos;s semi-axis along the scene&apos;s %1 axis (Shift-drag the lesion in the view to resize it)</source>
-        <translation>病灶沿场景 %1 轴的半轴长（在视图中按住 Shift 拖动病灶可调整其大小）</translation>
     </message>
     <message>
         <source>Move the lesion</source>
@@ -1494,510 +2059,6 @@ The scene that was running goes on.</source>
     <message>
         <source>Resize the lesion</source>
         <translation>调整病灶大小</translation>
-    </message>
-    <message>
-        <source>Centre (x, y, z)</source>
-        <translation>中心 (x, y, z)</translation>
-    </message>
-    <message>
-        <source>Semi-axes</source>
-        <translation>半轴</translation>
-    </message>
-    <message>
-        <source>Young&apos;s modulus of the lesion (instantaneous, with viscoelasticity): %1 to %2 times the parenchyma&apos;s. %3</source>
-        <translation>病灶的杨氏模量（启用粘弹性时为瞬时模量）：为实质的 %1 至 %2 倍。%3</translation>
-    </message>
-    <message>
-        <source>Stiffness E</source>
-        <translation>刚度 E</translation>
-    </message>
-    <message>
-        <source>Change the lesion&apos;s stiffness</source>
-        <translation>更改病灶刚度</translation>
-    </message>
-    <message>
-        <source>Yield limit</source>
-        <translation>屈服极限</translation>
-    </message>
-    <message>
-        <source>Change the lesion&apos;s yield limit</source>
-        <translation>更改病灶屈服极限</translation>
-    </message>
-    <message>
-        <source>Viscosity η1</source>
-        <translation>粘度 η1</translation>
-    </message>
-    <message>
-        <source>Change the lesion&apos;s viscosity</source>
-        <translation>更改病灶粘度</translation>
-    </message>
-    <message>
-        <source>Hidden from the trainee</source>
-        <translation>对学员隐藏</translation>
-    </message>
-    <message>
-        <source>Not drawn in the workstation (palpation tasks)</source>
-        <translation>不在工作站中显示（触诊任务）</translation>
-    </message>
-    <message>
-        <source>Hide the lesion</source>
-        <translation>隐藏病灶</translation>
-    </message>
-    <message>
-        <source>Show the lesion</source>
-        <translation>显示病灶</translation>
-    </message>
-    <message>
-        <source>Title</source>
-        <translation>标题</translation>
-    </message>
-    <message>
-        <source>Change the title</source>
-        <translation>更改标题</translation>
-    </message>
-    <message>
-        <source>Description</source>
-        <translation>描述</translation>
-    </message>
-    <message>
-        <source>Change the description</source>
-        <translation>更改描述</translation>
-    </message>
-    <message>
-        <source>Palpate a hidden lesion</source>
-        <translation>触诊隐藏病灶</translation>
-    </message>
-    <message>
-        <source>Retract a lobe</source>
-        <translation>牵拉肝叶</translation>
-    </message>
-    <message>
-        <source>Resect a lesion</source>
-        <translation>切除病灶</translation>
-    </message>
-    <message>
-        <source>Change the task</source>
-        <translation>更改任务</translation>
-    </message>
-    <message>
-        <source>Shown to the trainee</source>
-        <translation>向学员显示</translation>
-    </message>
-    <message>
-        <source>Instructions</source>
-        <translation>任务说明</translation>
-    </message>
-    <message>
-        <source>Change the instructions</source>
-        <translation>更改任务说明</translation>
-    </message>
-    <message>
-        <source>The time the trainee has: 10 s to 2 h</source>
-        <translation>学员可用的时间：10 s 至 2 h</translation>
-    </message>
-    <message>
-        <source>Time limit</source>
-        <translation>时限</translation>
-    </message>
-    <message>
-        <source>Change the time limit</source>
-        <translation>更改时限</translation>
-    </message>
-    <message>
-        <source>The lesion to find or to resect</source>
-        <translation>要查找或切除的病灶</translation>
-    </message>
-    <message>
-        <source>Lesion</source>
-        <translation>病灶</translation>
-    </message>
-    <message>
-        <source>Choose the task&apos;s lesion</source>
-        <translation>选择任务的病灶</translation>
-    </message>
-    <message>
-        <source>Resection: the least distance from the cut to the lesion</source>
-        <translation>切除：切口与病灶之间的最小距离</translation>
-    </message>
-    <message>
-        <source>Margin</source>
-        <translation>切缘</translation>
-    </message>
-    <message>
-        <source>Change the margin</source>
-        <translation>更改切缘</translation>
-    </message>
-    <message>
-        <source>Clear</source>
-        <translation>清除</translation>
-    </message>
-    <message>
-        <source>Clear the planned plane</source>
-        <translation>清除计划平面</translation>
-    </message>
-    <message>
-        <source>Planned plane</source>
-        <translation>计划平面</translation>
-    </message>
-    <message>
-        <source>Allow a tool</source>
-        <translation>允许使用器械</translation>
-    </message>
-    <message>
-        <source>Withdraw a tool</source>
-        <translation>禁用器械</translation>
-    </message>
-    <message>
-        <source>Tools</source>
-        <translation>器械</translation>
-    </message>
-    <message>
-        <source>A force on the tissue above this is excessive (graded)</source>
-        <translation>作用于组织的力超过此值即为过大（计入评分）</translation>
-    </message>
-    <message>
-        <source>Safe force</source>
-        <translation>安全力</translation>
-    </message>
-    <message>
-        <source>Change the safe force</source>
-        <translation>更改安全力</translation>
-    </message>
-    <message>
-        <source>Parenchyma E</source>
-        <translation>实质 E</translation>
-    </message>
-    <message>
-        <source>Change the parenchyma&apos;s stiffness</source>
-        <translation>更改实质刚度</translation>
-    </message>
-    <message>
-        <source>Poisson&apos;s ratio ν</source>
-        <translation>泊松比 ν</translation>
-    </message>
-    <message>
-        <source>Change Poisson&apos;s ratio</source>
-        <translation>更改泊松比</translation>
-    </message>
-    <message>
-        <source>Effects simulated (an effect off costs nothing)</source>
-        <translation>仿真的效应（关闭的效应不产生计算开销）</translation>
-    </message>
-    <message>
-        <source>Near-incompressibility (averaged pressure)</source>
-        <translation>近不可压缩性（平均压力）</translation>
-    </message>
-    <message>
-        <source>Viscoelasticity (relaxation, creep)</source>
-        <translation>粘弹性（松弛、蠕变）</translation>
-    </message>
-    <message>
-        <source>Viscoplasticity above the yield limit</source>
-        <translation>超过屈服极限后的粘塑性</translation>
-    </message>
-    <message>
-        <source>Fibre anisotropy (HGO)</source>
-        <translation>纤维各向异性 (HGO)</translation>
-    </message>
-    <message>
-        <source>Switch an effect on</source>
-        <translation>开启效应</translation>
-    </message>
-    <message>
-        <source>Switch an effect off</source>
-        <translation>关闭效应</translation>
-    </message>
-    <message>
-        <source>Steps per second of this scenario on this machine, measured now: its model stepped for half a second under a 0.5 N pull</source>
-        <translation>此场景在本机上每秒的步数，即时测量：模型在 0.5 N 拉力下推进半秒</translation>
-    </message>
-    <message>
-        <source>Laws of the effects</source>
-        <translation>效应的本构参数</translation>
-    </message>
-    <message>
-        <source>Change %1</source>
-        <translation>更改%1</translation>
-    </message>
-    <message>
-        <source>Maxwell arm E1</source>
-        <translation>Maxwell 支路 E1</translation>
-    </message>
-    <message>
-        <source> E2 = E − E1 follows, so that E stays the parenchyma&apos;s.</source>
-        <translation> E2 = E − E1 随之确定，使 E 保持为实质的值。</translation>
-    </message>
-    <message>
-        <source>Maxwell arm η1</source>
-        <translation>Maxwell 支路 η1</translation>
-    </message>
-    <message>
-        <source>Yield limit σs</source>
-        <translation>屈服极限 σs</translation>
-    </message>
-    <message>
-        <source>Viscoplastic η2</source>
-        <translation>粘塑性 η2</translation>
-    </message>
-    <message>
-        <source>Creep index n</source>
-        <translation>蠕变指数 n</translation>
-    </message>
-    <message>
-        <source>Fibre k1</source>
-        <translation>纤维 k1</translation>
-    </message>
-    <message>
-        <source>Fibre k2</source>
-        <translation>纤维 k2</translation>
-    </message>
-    <message>
-        <source>Fibre direction</source>
-        <translation>纤维方向</translation>
-    </message>
-    <message>
-        <source>The fibres&apos; reference direction (normalised on saving)</source>
-        <translation>纤维的参考方向（保存时归一化）</translation>
-    </message>
-    <message>
-        <source>Change the fibre direction</source>
-        <translation>更改纤维方向</translation>
-    </message>
-    <message>
-        <source>Across the view</source>
-        <translation>沿视图横向</translation>
-    </message>
-    <message>
-        <source>Fibres along the screen&apos;s horizontal, as the organ is seen now</source>
-        <translation>按器官当前的视角，使纤维沿屏幕水平方向</translation>
-    </message>
-    <message>
-        <source>Set the fibre direction</source>
-        <translation>设置纤维方向</translation>
-    </message>
-    <message>
-        <source>Fixed regions</source>
-        <translation>固定区域</translation>
-    </message>
-    <message>
-        <source>Radius of the painting brush (Paint fixed)</source>
-        <translation>涂刷画笔的半径（涂刷固定区）</translation>
-    </message>
-    <message>
-        <source>Brush</source>
-        <translation>画笔</translation>
-    </message>
-    <message>
-        <source>Clear painted</source>
-        <translation>清除涂刷</translation>
-    </message>
-    <message>
-        <source>Clear the painted fixed regions</source>
-        <translation>清除涂刷的固定区域</translation>
-    </message>
-    <message>
-        <source>Painted</source>
-        <translation>已涂刷</translation>
-    </message>
-    <message>
-        <source>Coronary ligament (built-in liver)</source>
-        <translation>冠状韧带（内置肝脏）</translation>
-    </message>
-    <message>
-        <source>Change the ligament</source>
-        <translation>更改韧带</translation>
-    </message>
-    <message>
-        <source>Built-in liver</source>
-        <translation>内置肝脏</translation>
-    </message>
-    <message>
-        <source>Surface model (OBJ, STL, PLY, glTF, FBX, 3DS)</source>
-        <translation>表面模型 (OBJ, STL, PLY, glTF, FBX, 3DS)</translation>
-    </message>
-    <message>
-        <source>Tetrahedral mesh (.inp, .msh)</source>
-        <translation>四面体网格 (.inp, .msh)</translation>
-    </message>
-    <message>
-        <source>Organ</source>
-        <translation>器官</translation>
-    </message>
-    <message>
-        <source>Change the organ</source>
-        <translation>更改器官</translation>
-    </message>
-    <message>
-        <source>The organ&apos;s file: relative to the scenario&apos;s folder, or absolute</source>
-        <translation>器官文件：相对于场景所在文件夹的路径，或绝对路径</translation>
-    </message>
-    <message>
-        <source>Choose…</source>
-        <translation>选择…</translation>
-    </message>
-    <message>
-        <source>File</source>
-        <translation>文件</translation>
-    </message>
-    <message>
-        <source>Choose the organ&apos;s file</source>
-        <translation>选择器官文件</translation>
-    </message>
-    <message>
-        <source>The organ&apos;s file</source>
-        <translation>器官文件</translation>
-    </message>
-    <message>
-        <source>Organ files (%1);;All files (*)</source>
-        <translation>器官文件 (%1);;所有文件 (*)</translation>
-    </message>
-    <message>
-        <source>The unit of the surface model&apos;s lengths (never guessed)</source>
-        <translation>表面模型的长度单位（不会自动推测）</translation>
-    </message>
-    <message>
-        <source>Length unit</source>
-        <translation>长度单位</translation>
-    </message>
-    <message>
-        <source>Change the organ&apos;s unit</source>
-        <translation>更改器官单位</translation>
-    </message>
-    <message>
-        <source>Elements of the organ&apos;s mesh: 1000 to 50000 (more is more accurate and slower: see the cost in Tissue and effects)</source>
-        <translation>器官网格的单元数：1000 至 50000（越多越精确，也越慢：计算开销见“组织与效应”）</translation>
-    </message>
-    <message>
-        <source>Elements</source>
-        <translation>单元数</translation>
-    </message>
-    <message>
-        <source>Change the element count</source>
-        <translation>更改单元数</translation>
-    </message>
-    <message>
-        <source>A node set of the mesh file held fixed (empty: none)</source>
-        <translation>网格文件中保持固定的节点集（留空：无）</translation>
-    </message>
-    <message>
-        <source>Fixed node set</source>
-        <translation>固定节点集</translation>
-    </message>
-    <message>
-        <source>Change the fixed node set</source>
-        <translation>更改固定节点集</translation>
-    </message>
-    <message>
-        <source>Change the integrator</source>
-        <translation>更改时间积分器</translation>
-    </message>
-    <message>
-        <source>Metric</source>
-        <translation>指标</translation>
-    </message>
-    <message>
-        <source>Weight</source>
-        <translation>权重</translation>
-    </message>
-    <message>
-        <source>Pass if</source>
-        <translation>通过条件</translation>
-    </message>
-    <message>
-        <source>Threshold</source>
-        <translation>阈值</translation>
-    </message>
-    <message>
-        <source>The rubric: each criterion passes when its metric is at most or at least the threshold; the score is the passed criteria&apos;s share of the weights</source>
-        <translation>评分标准：每项标准在其指标不超过或不低于阈值时通过；得分为已通过标准的权重占总权重的比例</translation>
-    </message>
-    <message>
-        <source>Add criterion</source>
-        <translation>添加标准</translation>
-    </message>
-    <message>
-        <source>Add a criterion</source>
-        <translation>添加标准</translation>
-    </message>
-    <message>
-        <source>Remove a criterion</source>
-        <translation>移除标准</translation>
-    </message>
-    <message>
-        <source>Tissue stretched past 1 + this is damaged (graded): 0.05 to 2</source>
-        <translation>组织拉伸超过 1 + 此值即视为损伤（计入评分）：0.05 至 2</translation>
-    </message>
-    <message>
-        <source>Damage in tension</source>
-        <translation>拉伸损伤</translation>
-    </message>
-    <message>
-        <source>Change the damage strain</source>
-        <translation>更改损伤应变</translation>
-    </message>
-    <message>
-        <source>Tissue squeezed below 1 − this is damaged (graded): 0.05 to 0.95</source>
-        <translation>组织压缩至 1 − 此值以下即视为损伤（计入评分）：0.05 至 0.95</translation>
-    </message>
-    <message>
-        <source>Damage in compression</source>
-        <translation>压缩损伤</translation>
-    </message>
-    <message>
-        <source>Pick on the organ</source>
-        <translation>在器官上选取</translation>
-    </message>
-    <message>
-        <source>Retraction: click where the lobe is to be grasped</source>
-        <translation>牵拉：单击肝叶上要抓取的位置</translation>
-    </message>
-    <message>
-        <source>Grasp point</source>
-        <translation>抓取点</translation>
-    </message>
-    <message>
-        <source>Retraction: how far to lift: 5 to 100 mm</source>
-        <translation>牵拉：提起的高度，5 至 100 mm</translation>
-    </message>
-    <message>
-        <source>Lift</source>
-        <translation>提起高度</translation>
-    </message>
-    <message>
-        <source>Change the lift</source>
-        <translation>更改提起高度</translation>
-    </message>
-    <message>
-        <source>The criterion&apos;s weight in the score</source>
-        <translation>该标准在得分中的权重</translation>
-    </message>
-    <message>
-        <source>at most</source>
-        <translation>不超过</translation>
-    </message>
-    <message>
-        <source>at least</source>
-        <translation>不低于</translation>
-    </message>
-    <message>
-        <source>The threshold, in the metric&apos;s unit</source>
-        <translation>阈值，单位与指标相同</translation>
-    </message>
-    <message>
-        <source>Change a criterion&apos;s metric</source>
-        <translation>更改标准的指标</translation>
-    </message>
-    <message>
-        <source>Change a criterion&apos;s weight</source>
-        <translation>更改标准的权重</translation>
-    </message>
-    <message>
-        <source>Change a criterion&apos;s rule</source>
-        <translation>更改标准的规则</translation>
-    </message>
-    <message>
-        <source>Change a criterion&apos;s threshold</source>
-        <translation>更改标准的阈值</translation>
     </message>
     <message>
         <source>The organ cannot be built: %1</source>
@@ -2012,32 +2073,6 @@ The scene that was running goes on.</source>
         <translation>器官：%1</translation>
     </message>
     <message>
-        <source>through (%1, %2, %3) mm, normal (%4, %5, %6)</source>
-        <translation>经过 (%1, %2, %3) mm，法向 (%4, %5, %6)</translation>
-    </message>
-    <message>
-        <source>none: draw it across the organ (Draw plane)</source>
-        <translation>无：请在器官上绘制（“绘制平面”）</translation>
-    </message>
-    <message>
-        <source>resection tasks only</source>
-        <translation>仅用于切除任务</translation>
-    </message>
-    <message numerus="yes">
-        <source>%n ball(s)</source>
-        <translation>
-            <numerusform>%n 个球形区域</numerusform>
-        </translation>
-    </message>
-    <message>
-        <source>(%1, %2, %3) mm</source>
-        <translation>(%1, %2, %3) mm</translation>
-    </message>
-    <message>
-        <source>retraction tasks only</source>
-        <translation>仅用于牵拉任务</translation>
-    </message>
-    <message>
         <source>untitled</source>
         <translation>未命名</translation>
     </message>
@@ -2048,10 +2083,6 @@ The scene that was running goes on.</source>
     <message>
         <source>Click where the lobe is to be grasped.</source>
         <translation>请单击肝叶上要抓取的位置。</translation>
-    </message>
-    <message>
-        <source>the parenchyma&apos;s</source>
-        <translation>同实质</translation>
     </message>
     <message>
         <source>Place a lesion</source>

@@ -3,7 +3,10 @@
 // placed, moved and resized by mouse on it, the planned resection plane drawn across it, fixed
 // regions painted on its surface and the fibre direction shown; panels for every parameter with
 // units, ranges and tooltips; the effects with what they cost, measured; "Try it" runs the
-// scenario in the workstation. Every edit can be undone; saving validates.
+// scenario in the workstation. Every edit can be undone; saving validates. The panels are
+// EditorLesionPanel, EditorTaskPanel, EditorTissuePanel, EditorOrganPanel and EditorGradingPanel;
+// the editor places them in its docks and keeps the view, the lesion selected, the files and the
+// cost measurement.
 
 #include "scenario_document.h"
 
@@ -19,24 +22,16 @@
 
 class QAction;
 class QActionGroup;
-class QCheckBox;
-class QComboBox;
 class QDockWidget;
-class QFormLayout;
-class QHBoxLayout;
-class QDoubleSpinBox;
-class QLabel;
-class QLineEdit;
-class QListWidget;
 class QMenu;
-class QPlainTextEdit;
-class QPushButton;
-class QSpinBox;
-class QTableWidget;
 
 namespace liversim {
 
-class AccuracyPanel;
+class EditorGradingPanel;
+class EditorLesionPanel;
+class EditorOrganPanel;
+class EditorTaskPanel;
+class EditorTissuePanel;
 class LiverScene;
 class ScenarioOverlay;
 class VtkViewport;
@@ -98,12 +93,6 @@ class ScenarioEditor : public QMainWindow {
 
  private:
   void buildActions();
-  QWidget* buildLesionPanel();
-  QWidget* buildTaskPanel();
-  QWidget* buildTissuePanel();
-  QWidget* buildOrganPanel();
-  QWidget* buildGradingPanel();
-  void showRubric();  // rebuilt only when the rubric differs from what the table shows
   QDockWidget* addDock(const QString& title, const char* name, QWidget* panel);
   void fitCamera();     // the whole organ in the view
   void rebuildOrgan();  // the organ's mesh, after organChanged
@@ -121,26 +110,13 @@ class ScenarioEditor : public QMainWindow {
   void releaseAt(QPoint display);
   int lesionAt(QPoint display) const;  // -1: none
   Eigen::Vector3d viewDirection() const;
+  // From the view's left to its right (not normalised); none while no organ is shown.
+  std::optional<Eigen::Vector3d> screenHorizontal() const;
   void paintAt(QPoint display);
 
-  // A label of what is set, and a button that clears it (an edit named `editText`).
-  QHBoxLayout* clearableRow(QLabel*& label, const char* labelName, const QString& buttonText,
-                            const char* buttonName, const QString& editText,
-                            std::function<void(Scenario&)> clear);
-  // A spin box's entered value as an edit (`set` puts it in the scenario).
-  void bindSpinBox(QDoubleSpinBox* box, const QString& text, int mergeKey,
-                   std::function<void(Scenario&, double)> set);
-  // A lesion's value that defaults to the parenchyma's (`field`), in the range named `range`.
-  QDoubleSpinBox* optionalLesionValue(QFormLayout* form, std::string_view range,
-                                      const QString& suffix, const char* name, const QString& label,
-                                      const QString& editText, int mergeKey,
-                                      std::optional<double> LesionSpec::*field);
   // A new lesion, named "lesion N", centred at `point_m`, or with depth_mm > 0 that much deeper
   // than its radius along the view; it is selected.
   void addLesion(const QString& text, const Eigen::Vector3d& point_m, double depth_mm);
-  // Edits of the selected lesion (`change` its spec).
-  void editLesion(const QString& text, int mergeKey,
-                  const std::function<void(LesionSpec&)>& change);
 
   void measureCost();  // (again) after the current measurement
   void finishCostMeasurement(std::optional<double> stepsPerSecond, double realTimeFactor,
@@ -156,7 +132,6 @@ class ScenarioEditor : public QMainWindow {
   Mode mode_ = Mode::view;
   int selectedLesion_ = -1;
   bool shown_ = false;
-  bool refreshing_ = false;  // panels being filled from the document: their signals are not edits
 
   // The drag the mouse is doing.
   enum class Drag { none, moveLesion, resizeLesion, plane, paint };
@@ -174,64 +149,11 @@ class ScenarioEditor : public QMainWindow {
   QAction* paintFixedAction_ = nullptr;
   QMenu* recentMenu_ = nullptr;
 
-  // Lesion panel.
-  QListWidget* lesionList_ = nullptr;
-  QLineEdit* lesionName_ = nullptr;
-  QDoubleSpinBox* lesionCentre_[3] = {};
-  QDoubleSpinBox* lesionRadius_[3] = {};
-  QDoubleSpinBox* lesionStiffness_ = nullptr;   // kPa
-  QDoubleSpinBox* lesionYieldLimit_ = nullptr;  // Pa; its minimum: the parenchyma's
-  QDoubleSpinBox* lesionViscosity_ = nullptr;   // Pa·s; its minimum: the parenchyma's
-  QCheckBox* lesionHidden_ = nullptr;
-  QPushButton* removeLesion_ = nullptr;
-  QWidget* lesionFields_ = nullptr;
-
-  // Task panel.
-  QLineEdit* title_ = nullptr;
-  QPlainTextEdit* description_ = nullptr;
-  QComboBox* taskKind_ = nullptr;
-  QLineEdit* instructions_ = nullptr;
-  QDoubleSpinBox* timeLimit_ = nullptr;
-  QComboBox* taskLesion_ = nullptr;
-  QDoubleSpinBox* margin_ = nullptr;
-  QLabel* plane_ = nullptr;
-  QCheckBox* tools_[3] = {};
-  QDoubleSpinBox* safeForce_ = nullptr;
-
-  // Tissue and effects panel.
-  QDoubleSpinBox* youngsModulus_ = nullptr;
-  QDoubleSpinBox* poissonRatio_ = nullptr;
-  QCheckBox* effects_[4] = {};  // near-incompressibility, viscoelastic, viscoplastic, fibres
-  QDoubleSpinBox* viscoelasticE1_ = nullptr;
-  QDoubleSpinBox* viscoelasticEta1_ = nullptr;
-  QDoubleSpinBox* yieldLimit_ = nullptr;
-  QDoubleSpinBox* viscoplasticEta2_ = nullptr;
-  QDoubleSpinBox* creepIndex_ = nullptr;
-  QDoubleSpinBox* fibreK1_ = nullptr;
-  QDoubleSpinBox* fibreK2_ = nullptr;
-  QDoubleSpinBox* fibreDirection_[3] = {};
-  QPushButton* fibreAlongView_ = nullptr;
-  QDoubleSpinBox* brushRadius_ = nullptr;
-  QLabel* fixedRegions_ = nullptr;
-  QCheckBox* fixLigament_ = nullptr;
-  QLabel* cost_ = nullptr;
-
-  // Organ and accuracy panel.
-  QComboBox* organGeometry_ = nullptr;
-  QLineEdit* organFile_ = nullptr;
-  QComboBox* lengthUnit_ = nullptr;
-  QSpinBox* targetTetCount_ = nullptr;
-  QLineEdit* fixedNodeSet_ = nullptr;
-  QLabel* organStatus_ = nullptr;
-  AccuracyPanel* accuracy_ = nullptr;
-
-  // Grading panel.
-  QTableWidget* rubricTable_ = nullptr;
-  std::optional<std::vector<RubricCriterion>> shownRubric_;
-  QDoubleSpinBox* damageTension_ = nullptr;
-  QDoubleSpinBox* damageCompression_ = nullptr;
-  QLabel* graspPoint_ = nullptr;
-  QDoubleSpinBox* lift_ = nullptr;
+  EditorLesionPanel* lesionPanel_ = nullptr;
+  EditorTaskPanel* taskPanel_ = nullptr;
+  EditorTissuePanel* tissuePanel_ = nullptr;  // shows the cost
+  EditorOrganPanel* organPanel_ = nullptr;
+  EditorGradingPanel* gradingPanel_ = nullptr;
 
   // The cost measurement on its worker.
   BackgroundJob costWorker_;
