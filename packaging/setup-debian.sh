@@ -11,7 +11,7 @@ packages=(
   libvtk9-dev libeigen3-dev libassimp-dev libgmsh-dev libsqlite3-dev libx11-dev libsodium-dev
   libpq-dev postgresql openssl
   libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev nlohmann-json3-dev python3 python3-jsonschema
+  libcli11-dev nlohmann-json3-dev python3 python3-jsonschema graphviz
   xvfb xauth
   libqt6svg6 qt6-translations-l10n fonts-wqy-microhei desktop-file-utils appstream
 )
