@@ -1,6 +1,8 @@
 // The embedded session store on real SQLite files: sessions written and read back exactly, a
 // writer killed mid-session, and files that are damaged, foreign, newer, read-only or full.
+#include "liversim/engine/forces.h"
 #include "liversim/sessions/session_recorder.h"
+#include "liversim/sessions/session_replay.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "storage_test_support.h"
 
@@ -345,6 +347,51 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
 
 // The simulation's input log goes in chunks, one per commit, and reads back whole and in order,
 // with how the scene was built; a chunk damaged in the file is named with its session.
+// A session recorded by `liversim-cli record` before the station existed (commit 0c1087a: 2.5 s
+// of a scripted scalpel drawn through the 1500-element built-in liver, two cuts, at 1 kHz; the
+// file is tests/data/storage/session-v5-scalpel-cut.sqlite), replayed by today's engine: its final
+// positions and velocities are those the replay of that commit gave, to the last bit. The digest
+// is 64-bit FNV-1a over the position then the velocity arrays (x, y, z each), taken then by the
+// same function. Bit for bit holds for one build of the engine, the one the digest was taken
+// with: GCC's optimised build with the AVX2+FMA element kernels. Other builds skip. A deliberate
+// change of the engine's numerics fails it: old sessions then no longer replay as recorded, which
+// is for that change to say (and to record a new file and digest).
+TEST(SessionReplay, ASessionRecordedBeforeTheStationReplaysToTheSameStateBitForBit) {
+#if !defined(__GNUC__) || defined(__clang__) || !defined(__OPTIMIZE__) || \
+    defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "the digest is of GCC's optimised build without sanitizers";
+#endif
+  if (element_kernel_instruction_set() != "avx2+fma")
+    GTEST_SKIP() << "the digest is of the AVX2+FMA element kernels; these are "
+                 << element_kernel_instruction_set();
+  const fs::path file = fresh_database("recorded-before-the-station");
+  fs::copy_file(fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cut.sqlite",
+                file);
+  SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
+  const std::optional<ReplaySetup> setup = store.replay_setup(1);
+  ASSERT_TRUE(setup);
+  SessionReplay replay(replay_scene(*setup, store.scenario_text(1)), store.inputs(1));
+  ASSERT_TRUE(replay.advance_to(std::numeric_limits<double>::infinity()));
+  const SimState& state = replay.simulation().state();
+  std::uint64_t digest = 1469598103934665603ull;
+  const auto fold = [&](const std::vector<double>& values) {
+    const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
+    for (std::size_t i = 0; i < values.size() * sizeof(double); ++i) {
+      digest ^= bytes[i];
+      digest *= 1099511628211ull;
+    }
+  };
+  for (const NodeArray* array : {&state.position_m, &state.velocity_m_per_s}) {
+    fold(array->x);
+    fold(array->y);
+    fold(array->z);
+  }
+  EXPECT_EQ(state.position_m.size(), 437u) << "the cuts made other nodes";
+  EXPECT_EQ(state.step_count, 10038u);
+  EXPECT_EQ(state.time_s, 2.4936618463282314);
+  EXPECT_EQ(digest, 0x51bb48c117507a0aull);
+}
+
 TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {
   const fs::path file = fresh_database("inputs");
   std::int64_t session = 0;
