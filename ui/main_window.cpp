@@ -40,6 +40,8 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QRegularExpression>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QSettings>
 #include <QStatusBar>
 #include <QStyle>
@@ -64,6 +66,36 @@ void answerForm(Form& form, Attempt attempt) {
 QString qstring(const std::string& text) {
   return QString::fromStdString(text);
 }
+
+// A panel in its dock: scrolled up and down when the dock is shorter than the panel (a dock the
+// user made small, a long scenario, the Material panel's eight fields), never sideways: the dock
+// is at least as wide as the panel's narrowest layout, so no field is cut off at its side, and
+// its least height is a few lines, so that any arrangement of the docks fits the window.
+class PanelScrollArea : public QScrollArea {
+ public:
+  PanelScrollArea(QWidget* panel, QWidget* parent) : QScrollArea(parent) {
+    setFrameShape(QFrame::NoFrame);
+    setWidgetResizable(true);
+    setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+    setWidget(panel);
+  }
+
+  QSize minimumSizeHint() const override {
+    const QSize panel = widget()->minimumSizeHint();
+    constexpr int kLeastLines = 6;
+    return {panel.width() + verticalScrollBar()->sizeHint().width(),
+            std::min(panel.height(), kLeastLines * fontMetrics().lineSpacing())};
+  }
+  QSize sizeHint() const override { return QScrollArea::sizeHint().expandedTo(minimumSizeHint()); }
+
+ protected:
+  // The panel's least width changes with what it shows (a row shown, a longer item): so does
+  // the dock's.
+  bool eventFilter(QObject* watched, QEvent* event) override {
+    if (watched == widget() && event->type() == QEvent::LayoutRequest) updateGeometry();
+    return QScrollArea::eventFilter(watched, event);
+  }
+};
 
 }  // namespace
 
@@ -94,7 +126,7 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
 
   scenarioPanel_ = new ScenarioPanel(this);
   scenarioPanel_->setObjectName("scenarioPanel");
-  addPanelDock(tr("Scenario"), "scenarioDock", scenarioPanel_);
+  QDockWidget* scenarioDock = addPanelDock(tr("Scenario"), "scenarioDock", scenarioPanel_);
 
   accuracyPanel_ = new AccuracyPanel(this);
   accuracyPanel_->setObjectName("accuracyPanel");
@@ -102,7 +134,7 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
   connect(accuracyPanel_, &AccuracyPanel::applyRequested, this,
           [this](const IntegratorSettings& settings) { applyIntegratorSettings(settings); });
   connect(accuracyPanel_, &AccuracyPanel::studyRequested, this, [this] { openAccuracyStudy(); });
-  addPanelDock(tr("Accuracy"), "accuracyDock", accuracyPanel_);
+  QDockWidget* accuracyDock = addPanelDock(tr("Accuracy"), "accuracyDock", accuracyPanel_);
 
   materialPanel_ = new MaterialPanel(this);
   materialPanel_->setObjectName("materialPanel");
@@ -112,11 +144,11 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
           tr("a scene or an integrator change is being built; enter the "
              "value again after it."));
   });
-  addPanelDock(tr("Material"), "materialDock", materialPanel_);
+  QDockWidget* materialDock = addPanelDock(tr("Material"), "materialDock", materialPanel_);
 
   toolPanel_ = new ToolPanel(this);
   toolPanel_->setObjectName("toolPanel");
-  addPanelDock(tr("Tool"), "toolDock", toolPanel_);
+  QDockWidget* toolDock = addPanelDock(tr("Tool"), "toolDock", toolPanel_);
   connect(toolPanel_, &ToolPanel::toolChanged, this, [this] {
     if (station_->mouse()) {
       if (mouseControl_->tool()) mouseControl_->endTool();  // the next press puts the new one down
@@ -128,7 +160,20 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
 
   devicePanel_ = new DevicePanel(this);
   devicePanel_->setObjectName("devicePanel");
-  addPanelDock(tr("Device"), "deviceDock", devicePanel_);
+  QDockWidget* deviceDock = addPanelDock(tr("Device"), "deviceDock", devicePanel_);
+  // Five docks stacked on the right leave each a sliver on a 1280 × 800 screen, their fields
+  // clipped; two groups of tabs give each panel half the height: the scenario with the settings
+  // of its model (Accuracy, Material) above, the tool with the device that moves it below. The
+  // task and the force on the tool, what a trainee watches while working, are in front. The tabs
+  // are above their panels, where one looks for them (below, the lower group's would sit at the
+  // status bar). Each panel can still be dragged out, floated or closed.
+  setTabPosition(Qt::AllDockWidgetAreas, QTabWidget::North);
+  tabifyDockWidget(scenarioDock, accuracyDock);
+  tabifyDockWidget(accuracyDock, materialDock);
+  tabifyDockWidget(toolDock, deviceDock);
+  scenarioDock->raise();
+  toolDock->raise();
+
   DeviceControl::Context devices;
   devices.window = this;
   devices.panel = devicePanel_;
@@ -236,7 +281,7 @@ void MainWindow::showStorageProblem(const QString& text) {
 QDockWidget* MainWindow::addPanelDock(const QString& title, const char* name, QWidget* panel) {
   auto* dock = new QDockWidget(title, this);
   dock->setObjectName(name);
-  dock->setWidget(panel);
+  dock->setWidget(new PanelScrollArea(panel, dock));
   dock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable |
                     QDockWidget::DockWidgetClosable);
   addDockWidget(Qt::RightDockWidgetArea, dock);

@@ -169,7 +169,9 @@ class MainWindow : public QMainWindow {
   std::vector<SessionSummary> replayableSessions();
   QDockWidget* addPanelDock(const QString& title, const char* name, QWidget* panel);
   void restoreLayout();
-  static constexpr int kLayoutVersion = 1;
+  // 2: the panels in scroll areas, tabbed in two groups (a saved layout of five stacked docks
+  // would squeeze them again).
+  static constexpr int kLayoutVersion = 2;
   // The picture of the station's scene, new (at start and when a scenario opened).
   void showNewScene();
   void showScenarioDetails();

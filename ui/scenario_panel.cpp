@@ -4,7 +4,6 @@
 
 #include <QFileInfo>
 #include <QLabel>
-#include <QScrollArea>
 #include <QStringList>
 #include <QVBoxLayout>
 
@@ -58,18 +57,7 @@ QString describeTask(const TaskSpec& task) {
 }
 
 ScenarioPanel::ScenarioPanel(QWidget* parent) : QWidget(parent) {
-  // In a scroll area: a dock squeezed by the others would otherwise clip the wrapped lines.
-  auto* outer = new QVBoxLayout(this);
-  outer->setContentsMargins(0, 0, 0, 0);
-  auto* scroll = new QScrollArea(this);
-  scroll->setFrameShape(QFrame::NoFrame);
-  scroll->setWidgetResizable(true);
-  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
-  scroll->setMinimumHeight(160);
-  outer->addWidget(scroll);
-  auto* content = new QWidget(scroll);
-  scroll->setWidget(content);
-  auto* layout = new QVBoxLayout(content);
+  auto* layout = new QVBoxLayout(this);
   title_ = addLabel(layout, this, "scenarioTitle");
   QFont bold = title_->font();
   bold.setBold(true);
