@@ -1568,34 +1568,6 @@ The scene that was running goes on.</source>
         <translation>学员</translation>
     </message>
     <message>
-        <source>Last session: peak force %1 N (free practice: no rubric).</source>
-        <translation>上次训练：峰值力 %1 N（自由练习：无评分标准）。</translation>
-    </message>
-    <message>
-        <source>Last session stored (no rubric).</source>
-        <translation>上次训练已保存（无评分标准）。</translation>
-    </message>
-    <message>
-        <source>was %1</source>
-        <translation>实际为 %1</translation>
-    </message>
-    <message>
-        <source>not done</source>
-        <translation>未完成</translation>
-    </message>
-    <message>
-        <source>Last session: score %1 %</source>
-        <translation>上次训练：得分 %1%</translation>
-    </message>
-    <message>
-        <source>, every criterion passed.</source>
-        <translation>，所有标准均已通过。</translation>
-    </message>
-    <message>
-        <source>. Not passed: %1.</source>
-        <translation>。未通过：%1。</translation>
-    </message>
-    <message>
         <source>Marks are kept with a recorded session: put a tool on the liver first.</source>
         <translation>标记随训练记录保存：请先将器械放到肝脏上。</translation>
     </message>
@@ -2240,6 +2212,34 @@ Simulated: %2.
     <message>
         <source>File: %1</source>
         <translation>文件：%1</translation>
+    </message>
+    <message>
+        <source>Last session: peak force %1 N (free practice: no rubric).</source>
+        <translation>上次训练：峰值力 %1 N（自由练习：无评分标准）。</translation>
+    </message>
+    <message>
+        <source>Last session stored (no rubric).</source>
+        <translation>上次训练已保存（无评分标准）。</translation>
+    </message>
+    <message>
+        <source>was %1</source>
+        <translation>实际为 %1</translation>
+    </message>
+    <message>
+        <source>not done</source>
+        <translation>未完成</translation>
+    </message>
+    <message>
+        <source>Last session: score %1 %</source>
+        <translation>上次训练：得分 %1%</translation>
+    </message>
+    <message>
+        <source>, every criterion passed.</source>
+        <translation>，所有标准均已通过。</translation>
+    </message>
+    <message>
+        <source>. Not passed: %1.</source>
+        <translation>。未通过：%1。</translation>
     </message>
 </context>
 <context>

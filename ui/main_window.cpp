@@ -6,6 +6,7 @@
 #include "device_control.h"
 #include "device_panel.h"
 #include "material_panel.h"
+#include "panel_scroll_area.h"
 #include "recent_scenarios.h"
 #include "scenario_document.h"
 #include "scenario_editor.h"
@@ -40,8 +41,6 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QRegularExpression>
-#include <QScrollArea>
-#include <QScrollBar>
 #include <QSettings>
 #include <QStatusBar>
 #include <QStyle>
@@ -66,36 +65,6 @@ void answerForm(Form& form, Attempt attempt) {
 QString qstring(const std::string& text) {
   return QString::fromStdString(text);
 }
-
-// A panel in its dock: scrolled up and down when the dock is shorter than the panel (a dock the
-// user made small, a long scenario, the Material panel's eight fields), never sideways: the dock
-// is at least as wide as the panel's narrowest layout, so no field is cut off at its side, and
-// its least height is a few lines, so that any arrangement of the docks fits the window.
-class PanelScrollArea : public QScrollArea {
- public:
-  PanelScrollArea(QWidget* panel, QWidget* parent) : QScrollArea(parent) {
-    setFrameShape(QFrame::NoFrame);
-    setWidgetResizable(true);
-    setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
-    setWidget(panel);
-  }
-
-  QSize minimumSizeHint() const override {
-    const QSize panel = widget()->minimumSizeHint();
-    constexpr int kLeastLines = 6;
-    return {panel.width() + verticalScrollBar()->sizeHint().width(),
-            std::min(panel.height(), kLeastLines * fontMetrics().lineSpacing())};
-  }
-  QSize sizeHint() const override { return QScrollArea::sizeHint().expandedTo(minimumSizeHint()); }
-
- protected:
-  // The panel's least width changes with what it shows (a row shown, a longer item): so does
-  // the dock's.
-  bool eventFilter(QObject* watched, QEvent* event) override {
-    if (watched == widget() && event->type() == QEvent::LayoutRequest) updateGeometry();
-    return QScrollArea::eventFilter(watched, event);
-  }
-};
 
 }  // namespace
 
@@ -920,31 +889,8 @@ void MainWindow::sessionMetricsDone(const SessionMetricsOutcome& outcome) {
     showStorageProblem(
         tr("The session's metrics were not stored: %1").arg(qstring(outcome.problem)));
   else
-    scenarioPanel_->showResult(sessionResultText(outcome.rubric, outcome.metrics));
+    scenarioPanel_->showSessionResult(outcome.rubric, outcome.metrics);
   emit sessionMetricsStored(outcome.session, outcome.stored);
-}
-
-QString MainWindow::sessionResultText(const RubricResult& rubric,
-                                      const std::vector<MetricValue>& metrics) {
-  if (!rubric.score_percent) {
-    for (const MetricValue& m : metrics)
-      if (m.name == "peak_force_n")
-        return tr("Last session: peak force %1 N (free practice: no rubric).")
-            .arg(m.value, 0, 'f', 2);
-    return tr("Last session stored (no rubric).");
-  }
-  QStringList missed;
-  for (const CriterionResult& r : rubric.criteria)
-    if (!r.passed)
-      missed << QString("%1 %2 %3 (%4)")
-                    .arg(qstring(r.criterion.metric),
-                         r.criterion.rule == PassRule::at_most ? "≤" : "≥",
-                         QString::number(r.criterion.threshold),
-                         r.value ? tr("was %1").arg(r.value.value(), 0, 'g', 3) : tr("not done"));
-  QString text = tr("Last session: score %1 %").arg(*rubric.score_percent, 0, 'f', 0);
-  text += missed.isEmpty() ? tr(", every criterion passed.")
-                           : tr(". Not passed: %1.").arg(missed.join("; "));
-  return text;
 }
 
 SessionReviewWindow* MainWindow::openSessionReview() {

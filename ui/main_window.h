@@ -186,8 +186,6 @@ class MainWindow : public QMainWindow {
   void updateStatus();
   SessionReviewWindow* showSessionsWindow(QPointer<SessionReviewWindow>& window,
                                           const std::optional<QString>& trainee);
-  static QString sessionResultText(const RubricResult& rubric,
-                                   const std::vector<MetricValue>& metrics);
 
   std::unique_ptr<Workstation> station_;
   std::unique_ptr<LiverScene> scene_;

@@ -118,6 +118,31 @@ QString ScenarioPanel::taskText() const {
   return task_->text();
 }
 
+// The trainee's summary of a session just ended: its score against the rubric and what it did
+// not pass, or (free practice) its peak force.
+void ScenarioPanel::showSessionResult(const RubricResult& rubric,
+                                      const std::vector<MetricValue>& metrics) {
+  if (!rubric.score_percent) {
+    for (const MetricValue& m : metrics)
+      if (m.name == "peak_force_n")
+        return showResult(tr("Last session: peak force %1 N (free practice: no rubric).")
+                              .arg(m.value, 0, 'f', 2));
+    return showResult(tr("Last session stored (no rubric)."));
+  }
+  QStringList missed;
+  for (const CriterionResult& r : rubric.criteria)
+    if (!r.passed)
+      missed << QString("%1 %2 %3 (%4)")
+                    .arg(QString::fromStdString(r.criterion.metric),
+                         r.criterion.rule == PassRule::at_most ? "≤" : "≥",
+                         QString::number(r.criterion.threshold),
+                         r.value ? tr("was %1").arg(r.value.value(), 0, 'g', 3) : tr("not done"));
+  QString text = tr("Last session: score %1 %").arg(*rubric.score_percent, 0, 'f', 0);
+  text += missed.isEmpty() ? tr(", every criterion passed.")
+                           : tr(". Not passed: %1.").arg(missed.join("; "));
+  showResult(text);
+}
+
 void ScenarioPanel::showResult(const QString& text) {
   result_->setText(text);
   result_->setVisible(!text.isEmpty());

@@ -4,6 +4,7 @@
 // a scenario it says the window is in free practice and how to open one.
 
 #include "liversim/scenario/scenario.h"
+#include "liversim/sessions/grading.h"
 
 #include <QWidget>
 
@@ -26,6 +27,7 @@ class ScenarioPanel : public QWidget {
 
   // The trainee's result of the session just ended (its score and criteria); empty hides it.
   void showResult(const QString& text);
+  void showSessionResult(const RubricResult& rubric, const std::vector<MetricValue>& metrics);
 
   QString taskText() const;
   QString problemText() const;
