@@ -152,16 +152,16 @@ void EditorGradingPanel::showRubric() {
       QMetaObject::invokeMethod(
           this, [this] { showRubric(); }, Qt::QueuedConnection);
     });
-    connect(weight, &QDoubleSpinBox::valueChanged, this, [=, this](double v) {
+    connect(weight, &QDoubleSpinBox::valueChanged, this, [=](double v) {
       editRow(row, tr("Change a criterion's weight"), kRubricWeight + row,
               [&](RubricCriterion& r) { r.weight = v; });
     });
-    connect(rule, &QComboBox::currentIndexChanged, this, [=, this](int index) {
+    connect(rule, &QComboBox::currentIndexChanged, this, [=](int index) {
       const auto pass = PassRule(rule->itemData(index).toInt());
       editRow(row, tr("Change a criterion's rule"), kNoMerge,
               [&](RubricCriterion& r) { r.rule = pass; });
     });
-    connect(threshold, &QDoubleSpinBox::valueChanged, this, [=, this](double v) {
+    connect(threshold, &QDoubleSpinBox::valueChanged, this, [=](double v) {
       editRow(row, tr("Change a criterion's threshold"), kRubricThreshold + row,
               [&](RubricCriterion& r) { r.threshold = v; });
     });

@@ -26,7 +26,6 @@ namespace liversim {
 namespace {
 
 // Block [0, 0.06] × [0, 0.05] × [0, 0.04] m of 1 cm cubes, fixed at its base.
-constexpr double kSpacing = 0.01;
 SimModel block_model(double jitter = 0.0, ModelOptions options = {}) {
   const TetMesh mesh = testing::block_mesh(6, 5, 4, {0.06, 0.05, 0.04}, jitter);
   for (std::size_t n = 0; n < mesh.node_count(); ++n)

@@ -102,8 +102,10 @@ TEST(Tangent, ViscoelasticRateForm) {
   Eigen::Matrix3d fp_inverse = random_deformation(random, 1.0);  // isochoric
   const Voigt6 q{40.0, -25.0, 10.0, 5.0, -8.0, 12.0};
   const double theta = 0.4;
-  for (const auto& [keep, weight] :
+  // Not a structured binding: clang 14 cannot capture one in the lambda below.
+  for (const std::pair<double, double>& arm :
        {std::pair{1.0, 0.0}, std::pair{1.0 / (1.0 + theta), theta / (1.0 + theta)}}) {
+    const double keep = arm.first, weight = arm.second;
     for (double J : {1.0, 1.2, 0.7, 0.1}) {
       const Eigen::Matrix3d F = random_deformation(random, J);
       const Tangent analytic =
