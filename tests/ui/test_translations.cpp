@@ -1,7 +1,9 @@
 // The interface in Simplified Chinese: every string the main window shows (its menus, panels,
 // status bar and tooltips) is translated. The same walk over the English window finds English
 // everywhere, so the check can fail.
+#include "device_panel.h"
 #include "main_window.h"
+#include "wait_limits.h"
 #include "translations.h"
 
 #include "liversim/meshing/default_scene.h"
@@ -129,8 +131,18 @@ class MainWindowLanguage : public ::testing::Test {
     window_ = std::make_unique<MainWindow>(default_scene(kTetCount));
     window_->show();
     EXPECT_TRUE(QTest::qWaitForWindowExposed(window_.get()));
-    // The status line is written every 500 ms, the device panel's servo line as the servo runs.
-    QTest::qWait(1200);
+    // The status line is written every 500 ms, the device panel's servo line once the servo has
+    // run (its figures replace the line said before it starts).
+    auto* status = window_->findChild<QLabel*>("simulationStatus");
+    const QString notRunning = window_->devicePanel()->servoText();
+    EXPECT_TRUE(status != nullptr);
+    EXPECT_TRUE(QTest::qWaitFor(
+        [&] {
+          return status != nullptr && !status->text().isEmpty() &&
+                 window_->devicePanel()->servoText() != notRunning;
+        },
+        test::waitLimitMs(30'000)))
+        << "the status line or the servo's figures never came";
     return shownTexts(*window_);
   }
 
