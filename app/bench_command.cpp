@@ -603,10 +603,8 @@ int run_bench(const BenchOptions& o) {
 
   std::ostringstream md;
   md << "# Performance\n\n"
-     << "Written by `" << line.str() << "` on " << today_utc() << " (" << processor_name() << ", "
-     << std::thread::hardware_concurrency() << " hardware threads; element loops built for "
-     << element_kernel_instruction_set()
-     << "). Wall-clock time on this machine (the same build has run 2 to 3 times slower on "
+     << written_by(line.str()) << "\n\nElement loops built for " << element_kernel_instruction_set()
+     << ". Wall-clock time on this machine (the same build has run 2 to 3 times slower on "
         "other virtual machines of this kind: compare figures only within one run); each force "
         "figure is the best of "
      << kRepetitions << " runs of at least " << o.min_time_s

@@ -29,6 +29,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -82,6 +83,24 @@ int write_report(const std::filesystem::path& file, const std::string& text) {
   return 0;
 }
 
+std::string written_by(const std::string& command) {
+  return "Written by `" + command + "` on " + today_utc() + " (" + processor_name() + ", " +
+         std::to_string(std::thread::hardware_concurrency()) + " hardware threads).";
+}
+
+void append_table_row(const std::filesystem::path& file, const std::string& header,
+                      const std::string& row) {
+  std::error_code error;
+  const bool has_header =
+      std::filesystem::exists(file, error) && std::filesystem::file_size(file, error) > 0 && !error;
+  std::ofstream out(file, std::ios::app);
+  if (!has_header) out << header << "\n";
+  out << row << "\n";
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+  std::cout << "wrote a row of " << file.string() << "\n";
+}
+
 IntegratorKind integrator_kind(const std::string& name) {
   if (auto kind = integrator_from_name(name)) return *kind;
   std::string valid;
@@ -133,10 +152,16 @@ double metres_per_unit(const std::filesystem::path& surface,
                               "' is unknown: expected mm, cm or m");
 }
 
+// How a surface model was meshed: Gmsh's wall time and each attempt's element count.
+struct SurfaceMeshingRecord {
+  double meshing_s = 0.0;
+  std::vector<int> attempt_tets;
+};
+
 // Reads, checks and meshes a surface model, printing each finished meshing attempt and the
-// wall time of reading and checking the surface and of meshing it.
+// wall time of reading and checking the surface and of meshing it (also into `record`).
 SceneSetup mesh_surface(const std::filesystem::path& file, const std::optional<std::string>& unit,
-                        int target_tet_count) {
+                        int target_tet_count, SurfaceMeshingRecord* record) {
   const double metres = metres_per_unit(file, unit);
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
@@ -148,6 +173,7 @@ SceneSetup mesh_surface(const std::filesystem::path& file, const std::optional<s
       return true;
     }
     ++attempts;
+    if (record) record->attempt_tets.push_back(attempt.tet_count);
     std::ostringstream line;
     line << std::fixed << std::setprecision(2) << "meshing attempt " << attempt.attempt << "/"
          << attempt.max_attempts << ": element size " << attempt.element_size_mm << " mm, "
@@ -158,6 +184,7 @@ SceneSetup mesh_surface(const std::filesystem::path& file, const std::optional<s
   SceneSetup scene = scene_from_surface(file, metres, target_tet_count, progress);
   const Clock::time_point end = Clock::now();
   const Clock::time_point meshed_from = meshing_start.value_or(end);
+  if (record) record->meshing_s = std::chrono::duration<double>(end - meshed_from).count();
   std::ostringstream summary;
   summary << std::fixed << std::setprecision(3) << "surface read and checked in "
           << std::chrono::duration<double>(meshed_from - start).count() << " s; meshed in "
@@ -174,7 +201,7 @@ SceneSetup mesh_surface(const std::filesystem::path& file, const std::optional<s
   return scene;
 }
 
-SceneSetup load_scene(const MeshSource& source) {
+SceneSetup load_scene(const MeshSource& source, SurfaceMeshingRecord* meshing = nullptr) {
   if (source.length_unit && !source.surface)
     throw std::invalid_argument("--length-unit applies to --surface only");
   if (source.scenario) {
@@ -193,7 +220,8 @@ SceneSetup load_scene(const MeshSource& source) {
     throw std::invalid_argument("--mesh and --surface are two organs: give one of them");
   if (source.file) return scene_from_file(*source.file, source.fixed_set);
   if (source.fixed_set) throw std::invalid_argument("--fixed-set needs --mesh");
-  if (source.surface) return mesh_surface(*source.surface, source.length_unit, source.tet_count);
+  if (source.surface)
+    return mesh_surface(*source.surface, source.length_unit, source.tet_count, meshing);
   return default_scene(source.tet_count);
 }
 
@@ -213,6 +241,57 @@ std::string boundary_obj(const SceneSetup& scene) {
   for (const auto& t : boundary.triangles)
     obj << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
   return obj.str();
+}
+
+// What mesh-report measured, for a row of its table.
+struct MeshReportFigures {
+  const MeshQualityReport& quality;
+  double surface_gap_mean_m, surface_gap_max_m;  // rendered surface off the boundary nodes
+  const SimModel& model;
+  const std::optional<SimModel>& element_pressure;  // the model without averaged pressure
+  const SurfaceMeshingRecord& meshing;
+};
+
+// One row of docs/mesh-quality.md's tables, appended to `table`: a surface model's with its
+// meshing, any other organ's with the rendered surface's distance and the step without averaging.
+void append_mesh_report_row(const std::filesystem::path& table, const MeshSource& source,
+                            const MeshReportFigures& f) {
+  const bool surface = source.surface.has_value();
+  std::ostringstream header, row;
+  header << "| organ | requested | tets | nodes | volume (L) | min / max dihedral (°) | max "
+            "aspect R/3r | min / median height (mm) | inverted / degenerate | ";
+  header << (surface ? "ω_max (rad/s) | explicit step (ms) | meshing time (s) | attempts |"
+                     : "rendered surface off the boundary nodes, mean / max (mm) | ω_max (rad/s) | "
+                       "explicit step (ms) | without averaged pressure: ω_max / step |");
+  header << "\n|---|---:|---:|---:|---:|---|---:|---|---|"
+         << (surface ? "---:|---:|---:|---|" : "---|---:|---:|---|");
+  const std::string organ = source.surface    ? source.surface->filename().string()
+                            : source.file     ? source.file->filename().string()
+                            : source.scenario ? source.scenario->filename().string()
+                                              : std::string("built-in liver");
+  const bool requested = surface || (!source.file && !source.scenario);
+  const MeshQualityReport& q = f.quality;
+  row << std::fixed << "| " << organ << " | "
+      << (requested ? std::to_string(source.tet_count) : std::string("–")) << " | " << q.tet_count
+      << " | " << q.node_count << " | " << std::setprecision(4) << q.volume_m3 * 1e3 << " | "
+      << std::setprecision(2) << q.min_dihedral_deg << " / " << q.max_dihedral_deg << " | "
+      << q.max_aspect_ratio << " | " << q.min_height_m * 1e3 << " / " << q.median_height_m * 1e3
+      << " | " << q.inverted_count << " / " << q.degenerate_count << " | ";
+  if (!surface) row << 1e3 * f.surface_gap_mean_m << " / " << 1e3 * f.surface_gap_max_m << " | ";
+  row << std::setprecision(0) << f.model.max_frequency_rad_per_s << " | " << std::setprecision(3)
+      << f.model.stable_time_step_s * 1e3 << " | ";
+  if (surface) {
+    row << f.meshing.meshing_s << " | " << f.meshing.attempt_tets.size() << " (";
+    for (std::size_t i = 0; i < f.meshing.attempt_tets.size(); ++i)
+      row << (i ? ", " : "") << f.meshing.attempt_tets[i];
+    row << ") |";
+  } else if (f.element_pressure) {
+    row << std::setprecision(0) << f.element_pressure->max_frequency_rad_per_s << " / "
+        << std::setprecision(3) << f.element_pressure->stable_time_step_s * 1e3 << " |";
+  } else {
+    row << "the same (this organ is not averaged) |";
+  }
+  append_table_row(table, header.str(), row.str());
 }
 
 // What a material test records and the closed form it is compared with.
@@ -249,8 +328,10 @@ constexpr double kMaxMaterialSteps = 1e7;
 
 int mesh_report(const MeshReportOptions& options) {
   return guarded([&] {
-    const SceneSetup scene = load_scene(options.mesh);
-    std::cout << scene.description << "\n" << assess_quality(scene.mesh);
+    SurfaceMeshingRecord meshing;
+    const SceneSetup scene = load_scene(options.mesh, &meshing);
+    const MeshQualityReport quality = assess_quality(scene.mesh);
+    std::cout << scene.description << "\n" << quality;
     std::cout << "fixed nodes " << scene.model_options.fixed_nodes.size() << "\n";
     std::vector<double> visual_xyz;
     map_visual_positions(scene.visual, scene.mesh.rest_position_m, visual_xyz);
@@ -262,9 +343,9 @@ int mesh_report(const MeshReportOptions& options) {
       gap_sum += gap;
       gap_max = std::max(gap_max, gap);
     }
+    const double gap_mean = gap_sum / std::max<std::size_t>(scene.visual.vertex_count(), 1);
     std::cout << std::fixed << std::setprecision(2)
-              << "rendered surface off the physics boundary nodes: mean "
-              << 1e3 * gap_sum / std::max<std::size_t>(scene.visual.vertex_count(), 1)
+              << "rendered surface off the physics boundary nodes: mean " << 1e3 * gap_mean
               << " mm, max " << 1e3 * gap_max << " mm\n";
     const SimModel model = build_model(scene.mesh, scene.model_options);
     std::cout << std::fixed << std::setprecision(0) << "highest frequency at rest "
@@ -274,6 +355,20 @@ int mesh_report(const MeshReportOptions& options) {
               << " x 2/omega, E = " << std::setprecision(0)
               << model.regions[0].tissue.youngs_modulus_pa << " Pa, nu = " << std::setprecision(3)
               << model.regions[0].tissue.poisson_ratio << ")\n";
+    // What the averaging of the pressure over the nodes does to the step (docs/mesh-quality.md).
+    std::optional<SimModel> element_pressure;
+    if (scene.model_options.average_nodal_pressure) {
+      ModelOptions without = scene.model_options;
+      without.average_nodal_pressure = false;
+      element_pressure = build_model(scene.mesh, without);
+      std::cout << std::setprecision(0) << "without averaged pressure: highest frequency "
+                << element_pressure->max_frequency_rad_per_s << " rad/s; step "
+                << std::setprecision(3) << element_pressure->stable_time_step_s * 1e3 << " ms\n";
+    }
+    std::cout << std::defaultfloat;
+    if (options.table_output)
+      append_mesh_report_row(*options.table_output, options.mesh,
+                             {quality, gap_mean, gap_max, model, element_pressure, meshing});
     if (options.surface_output) return write_report(*options.surface_output, boundary_obj(scene));
     return 0;
   });
@@ -494,6 +589,18 @@ int material_test(const MaterialTestOptions& o) {
               << std::defaultfloat << std::setprecision(6)
               << " (at t = " << curve.time_of_largest_error_s << " s)\n";
 
+    if (o.table_output) {
+      std::ostringstream row;
+      row << "| " << test_names[static_cast<int>(o.test)] << " | " << quantity.equation << " | "
+          << (holds_strain ? "strain " + number(o.strain) : "stress " + number(o.stress_pa) + " Pa")
+          << " | " << number(o.dt_s) << " | " << number(t_s) << " | " << std::scientific
+          << std::setprecision(1) << curve.largest_relative_error << std::defaultfloat << " | "
+          << number(curve.time_of_largest_error_s) << " |";
+      append_table_row(*o.table_output,
+                       "| test | equation | held | step (s) | simulated (s) | largest relative "
+                       "error over the curve | at t (s) |\n|---|---|---|---:|---:|---:|---:|",
+                       row.str());
+    }
     // The CSV first: a plot that cannot be drawn (no display) must not lose the computed curve.
     if (o.csv_output) {
       std::ofstream csv(*o.csv_output);

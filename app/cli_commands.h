@@ -27,6 +27,9 @@ struct MeshSource {
 struct MeshReportOptions {
   MeshSource mesh;
   std::optional<std::filesystem::path> surface_output;  // the mesh's boundary as OBJ, in mm
+  // A row of the report appended to this markdown table (docs/mesh-quality.md's tables), its
+  // header written first when the file is new.
+  std::optional<std::filesystem::path> table_output;
 };
 
 struct SimulateOptions {
@@ -67,6 +70,9 @@ struct MaterialTestOptions {
   double dt_s = 0.01;
   std::optional<std::filesystem::path> csv_output;
   std::optional<std::filesystem::path> plot_output;
+  // A row (test, equation, load, step, largest error) appended to this markdown table
+  // (docs/material-verification.md), its header written first when the file is new.
+  std::optional<std::filesystem::path> table_output;
 };
 
 struct ScreenshotOptions {
@@ -109,6 +115,15 @@ double percentile(std::vector<double> values, double p);
 std::string processor_name();
 // Writes a report file and says so on stdout; 0, or fail()'s exit code naming the file.
 int write_report(const std::filesystem::path& file, const std::string& text);
+// The line under a written report's title: "Written by `COMMAND` on DATE (PROCESSOR, N hardware
+// threads)." on a line of its own, which packaging/regenerate-docs.sh replaces with its own line
+// (the commit, the machine and the command) when it reruns the command.
+std::string written_by(const std::string& command);
+// Appends `row` (one markdown table line, without its newline) to the table in `file`, writing
+// `header` (the table's two first lines, without their last newline) first when the file is new or
+// empty; says so on stdout. Throws std::runtime_error naming the file when it cannot be written.
+void append_table_row(const std::filesystem::path& file, const std::string& header,
+                      const std::string& row);
 
 // The integrator of --integrator NAME; throws std::invalid_argument naming it and listing the
 // valid names.

@@ -55,6 +55,9 @@ int main(int argc, char** argv) {
   report->add_option("--write-surface", report_options.surface_output,
                      "Also write the mesh's boundary as a Wavefront OBJ in millimetres (what "
                      "--surface reads with --length-unit mm)");
+  report->add_option("--table", report_options.table_output,
+                     "Also append the report as a row of this markdown table (its header first "
+                     "when the file is new; docs/mesh-quality.md)");
 
   std::vector<std::filesystem::path> scenario_files;
   auto* validate_cmd = app.add_subcommand(
@@ -160,6 +163,9 @@ int main(int argc, char** argv) {
                            "Write time_s, simulated, analytic, relative_error as CSV");
   material_cmd->add_option("--plot", material.plot_output,
                            "Write a PNG plot of both curves (needs X or xvfb-run)");
+  material_cmd->add_option("--table", material.table_output,
+                           "Also append the largest error as a row of this markdown table (its "
+                           "header first when the file is new; docs/material-verification.md)");
 
   const auto run_experiment = add_experiment_command(app);
   const auto run_study = add_study_command(app);

@@ -23,6 +23,9 @@
 namespace liversim::cli {
 namespace {
 
+// Issue 7's target: one cut update within a frame of the display (60 Hz).
+constexpr double kFrameMs = 16.0;
+
 struct CutBenchOptions {
   int tets = 10583;
   double step_mm = 2.0;
@@ -124,8 +127,9 @@ int run(const CutBenchOptions& o) {
           << o.repeats;
   std::ostringstream doc;
   doc << "# Cutting: cost of a stroke's updates\n\n"
-      << "Measured by `" << command.str() << "` (release build; the state's loops on " << o.threads
-      << " thread(s), as the workstation's run on both cores). A vertical blade is\n"
+      << written_by(command.str()) << "\n\n"
+      << "Release build; the state's loops on " << o.threads
+      << " thread(s), as the workstation's run on both cores. A vertical blade is\n"
       << "drawn " << o.stroke_mm << " mm along the built-in liver (" << start_tets
       << " tetrahedra) through its whole depth in steps of " << o.step_mm
       << " mm; after each step the cut is\n"
@@ -139,7 +143,7 @@ int run(const CutBenchOptions& o) {
          "fastest of\n"
       << "those, so that other work on this shared machine does not count. Target (issue 7): one "
          "update\n"
-      << "within a frame, 16 ms.\n\n"
+      << "within a frame, " << kFrameMs << " ms.\n\n"
       << std::fixed << std::setprecision(2)
       << "| part | updates | median (ms) | 95th percentile (ms) | max (ms) |\n"
       << "|---|---:|---:|---:|---:|\n";
@@ -153,6 +157,9 @@ int run(const CutBenchOptions& o) {
   row("`cut_tissue` alone, every update", cut_ms);
   row("surface (`boundary_surface`), updates that cut", surface_ms);
   row("hierarchy build, updates that cut", bvh_ms);
+  const double slowest_ms = all_ms.empty() ? 0.0 : *std::max_element(all_ms.begin(), all_ms.end());
+  doc << "\nThe slowest update took " << slowest_ms << " ms: the target is "
+      << (slowest_ms <= kFrameMs ? "met" : "**not met**") << ".\n";
   doc << "\nOver the stroke: " << separated << " faces separated, " << duplicated
       << " node copies, " << snapped << " nodes snapped onto the cut; " << model->tet_count
       << " tetrahedra after. The stable explicit step went from " << std::setprecision(3)

@@ -83,6 +83,17 @@ void write_plot(const std::filesystem::path& file, const std::string& title,
 #endif
 }
 
+// Writes a table the command printed to --table FILE (docs/seed-experiments.md takes it from
+// there).
+void write_table(const std::optional<std::filesystem::path>& file, const std::string& table) {
+  if (!file) return;
+  std::ofstream out(*file);
+  out << table;
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + file->string());
+  std::cout << "wrote " << file->string() << "\n";
+}
+
 void require_positive(double value, const std::string& option, const char* unit) {
   if (!std::isfinite(value) || value <= 0.0)
     throw std::invalid_argument(option + " " + number(value) + unit +
@@ -141,6 +152,33 @@ int creep_experiment(const CreepExperimentOptions& o) {
                 << " mm/N; displacement change / force change over the last ramp interval: "
                 << result.incremental_ratio_mm_per_n.back() << " mm/N\n";
 
+    if (o.table_output) {
+      // Every quarter of the ramp, to the end; the ratios over the ramp only.
+      std::ostringstream table;
+      table << "| t (s) | force (N) | \\|u\\| (mm) | u along the load (mm) | \\|u\\| / force "
+               "(mm/N) | change of \\|u\\| / change of force over the last "
+            << number(o.sample_interval_s * 1e3) << " ms (mm/N) |\n"
+            << "|---:|---:|---:|---:|---:|---:|\n";
+      const double every_s = o.ramp_time_s / 4.0;
+      for (std::size_t i = 0; i < result.time_s.size(); ++i) {
+        const double t = result.time_s[i];
+        const double quarters = t / every_s;
+        if (std::abs(quarters - std::round(quarters)) > 1e-6 * std::max(1.0, quarters)) continue;
+        const bool on_ramp = i >= 1 && i <= result.incremental_ratio_mm_per_n.size();
+        table << std::fixed << std::setprecision(2) << "| " << t << " | " << result.force_n[i]
+              << " | " << result.displacement_mm[i] << " | " << result.displacement_along_load_mm[i]
+              << " | ";
+        if (on_ramp)
+          table << std::setprecision(1) << result.secant_ratio_mm_per_n[i - 1] << " | "
+                << result.incremental_ratio_mm_per_n[i - 1] << " |\n";
+        else
+          table << "– | – |\n";
+      }
+      table << std::defaultfloat << "\n"
+            << step_summary(built.model, result.steps) << "; " << format(result.wall_time_s)
+            << " s wall time.\n";
+      write_table(o.table_output, table.str());
+    }
     if (o.csv_output) {
       std::ofstream csv = open_csv(*o.csv_output);
       csv << "time_s,force_n,displacement_mm,displacement_along_load_mm\n";
@@ -208,22 +246,24 @@ int pull_experiment(const PullExperimentOptions& o) {
               << " x applied force at every check (every " << settings.check_interval_s
               << " s) for " << settings.settle_window_s
               << " s; this bounds |feedback - applied| / applied by " << o.residual_tolerance
-              << "\n\n"
-              << "| applied (N) | held nodes | feedback along load (N) | relative error | bound | "
-                 "settled at (s) | displacement (mm) | wall (s) |\n"
-              << "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+              << "\n\n";
+    std::ostringstream table;
+    table << "| applied (N) | held nodes | feedback along load (N) | relative error | bound R/F | "
+             "settled at (s) | displacement (mm) | steps | wall (s) |\n"
+          << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     bool all_settled = true;
     for (const PullCase& c : result.cases) {
       all_settled = all_settled && c.settled;
-      std::cout << std::defaultfloat << std::setprecision(6) << "| " << c.applied_force_n << " | "
-                << c.held_nodes << " | " << std::fixed << std::setprecision(6)
-                << c.feedback_n.dot(settings.direction) << " | " << std::scientific
-                << std::setprecision(2) << c.relative_error << " | " << c.bound_relative_error
-                << " | " << std::fixed << std::setprecision(2) << c.settle_time_s
-                << (c.settled ? "" : " (not settled)") << " | " << c.displacement_mm << " | "
-                << c.wall_time_s << " |\n";
+      table << std::defaultfloat << std::setprecision(6) << "| " << c.applied_force_n << " | "
+            << c.held_nodes << " | " << std::fixed << std::setprecision(6)
+            << c.feedback_n.dot(settings.direction) << " | " << std::scientific
+            << std::setprecision(2) << c.relative_error << " | " << c.bound_relative_error << " | "
+            << std::fixed << std::setprecision(2) << c.settle_time_s
+            << (c.settled ? "" : " (not settled)") << " | " << c.displacement_mm << " | "
+            << c.steps.substeps << " | " << c.wall_time_s << " |\n";
     }
-    std::cout << std::defaultfloat << std::setprecision(5) << "\n";
+    std::cout << table.str() << std::defaultfloat << std::setprecision(5) << "\n";
+    write_table(o.table_output, table.str());
     for (const PullCase& c : result.cases)
       std::cout << c.applied_force_n << " N: " << step_summary(built.model, c.steps) << "\n";
 
@@ -313,36 +353,38 @@ int timing_experiment(const TimingExperimentOptions& o) {
               << rows.front().timing.frames << " frames of " << o.dt_s * 1e3 << " ms ("
               << o.simulated_s << " s simulated), integrator " << o.integrator
               << ". Deformation time = wall time of the frames' advance() calls (model build "
-                 "excluded); one thread.\n\n"
-              << "| tets (seed) | tets (ours) | nodes | deformation time (ms per " << o.simulated_s
-              << " s) | per frame (ms) | steps | per step (us) | steps/s | real-time factor | "
-                 "stability-limited steps | smallest stable step (ms) | u (mm) | seed deform | "
-                 "[3] deform | [14] deform |\n"
-              << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+                 "excluded); one thread.\n\n";
+    std::ostringstream table;
+    table << "| tets (seed) | tets (ours) | nodes | deformation time (ms per " << o.simulated_s
+          << " s) | per frame (ms) | steps | force evaluations | per step (µs) | steps/s | "
+             "real-time factor | stability-limited steps | smallest stable step (ms) | u (mm) | "
+             "seed deform | [3] deform | [14] deform |\n"
+          << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const Row& row : rows) {
       const TimingCase& t = row.timing;
-      std::cout << std::fixed << "| " << row.requested_tets << " | " << t.tet_count << " | "
-                << t.node_count << " | " << std::setprecision(1) << t.deformation_wall_s * 1e3
-                << " | " << std::setprecision(3) << t.wall_per_frame_s() * 1e3 << " | "
-                << t.steps.substeps << " | " << std::setprecision(1) << t.wall_per_substep_s() * 1e6
-                << " | " << std::setprecision(0) << t.substeps_per_wall_s() << " | "
-                << std::setprecision(2) << t.real_time_factor(settings) << " | "
-                << t.steps.stability_limited_steps << " | "
-                << (t.steps.stability_limited_steps > 0
-                        ? number(t.steps.smallest_stable_step_s * 1e3)
-                        : std::string("-"))
-                << " | " << std::setprecision(2) << t.displacement_mm << " | ";
+      table << std::fixed << "| " << row.requested_tets << " | " << t.tet_count << " | "
+            << t.node_count << " | " << std::setprecision(1) << t.deformation_wall_s * 1e3 << " | "
+            << std::setprecision(3) << t.wall_per_frame_s() * 1e3 << " | " << t.steps.substeps
+            << " | " << t.steps.force_evaluations << " | " << std::setprecision(1)
+            << t.wall_per_substep_s() * 1e6 << " | " << std::setprecision(0)
+            << t.substeps_per_wall_s() << " | " << std::setprecision(2)
+            << t.real_time_factor(settings) << " | " << t.steps.stability_limited_steps << " | "
+            << (t.steps.stability_limited_steps > 0 ? number(t.steps.smallest_stable_step_s * 1e3)
+                                                    : std::string("-"))
+            << " | " << std::setprecision(2) << t.displacement_mm << " | ";
       if (row.seed)
-        std::cout << std::setprecision(1) << row.seed->seed_deform_ms << " | "
-                  << row.seed->conical_spring_deform_ms << " | " << row.seed->implicit_fem_deform_ms
-                  << " |\n";
+        table << std::setprecision(1) << row.seed->seed_deform_ms << " | "
+              << row.seed->conical_spring_deform_ms << " | " << row.seed->implicit_fem_deform_ms
+              << " |\n";
       else
-        std::cout << "- | - | - |\n";
+        table << "- | - | - |\n";
     }
-    std::cout << std::defaultfloat
+    std::cout << table.str() << std::defaultfloat
               << "\nSeed columns: Table 1 of the seed (unit not stated, read as ms; its "
                  "\"deformation time\" is not defined; i7-10700). [3] conical-spring model, [14] "
-                 "FEM with optimised implicit Euler. Cutting times: no cutting yet.\n";
+                 "FEM with optimised implicit Euler. Cutting times: liversim-cli bench-cut "
+                 "(docs/cutting-performance.md).\n";
+    write_table(o.table_output, table.str());
 
     if (o.csv_output) {
       std::ofstream csv = open_csv(*o.csv_output);
@@ -456,6 +498,9 @@ std::function<std::optional<int>()> add_experiment_command(CLI::App& app) {
                         "PNG of displacement vs time (needs X or xvfb-run)");
   creep_cmd->add_option("--ratio-plot", creep.ratio_plot_output,
                         "PNG of displacement / force vs force (needs X or xvfb-run)");
+  creep_cmd->add_option("--table", creep.table_output,
+                        "Write the marked point's displacement every quarter of the ramp as a "
+                        "markdown table");
 
   PullExperimentOptions& pull = options->pull;
   auto* pull_cmd = experiment->add_subcommand(
@@ -485,12 +530,14 @@ std::function<std::optional<int>()> add_experiment_command(CLI::App& app) {
                        "Write the feedback force at every check");
   pull_cmd->add_option("--plot", pull.plot_output,
                        "PNG of feedback / applied force vs time (needs X or xvfb-run)");
+  pull_cmd->add_option("--table", pull.table_output, "Write the table printed as a markdown file");
 
   TimingExperimentOptions& timing = options->timing;
   auto* timing_cmd = experiment->add_subcommand(
       "timing",
       "The seed's Table 1: wall time to simulate the loaded liver at the seed's mesh sizes");
   timing_cmd->add_option("--tets", timing.tet_counts, "Element counts of the built-in liver")
+      ->delimiter(',')
       ->check(CLI::Range(100, 2'000'000))
       ->capture_default_str();
   timing_cmd
@@ -506,6 +553,8 @@ std::function<std::optional<int>()> add_experiment_command(CLI::App& app) {
   timing_cmd->add_option("--csv", timing.csv_output, "Write one row per size");
   timing_cmd->add_option("--plot", timing.plot_output,
                          "PNG of deformation time vs size beside the seed's (needs X)");
+  timing_cmd->add_option("--table", timing.table_output,
+                         "Write the table printed as a markdown file");
 
   return [=]() -> std::optional<int> {
     if (creep_cmd->parsed()) return creep_experiment(options->creep);

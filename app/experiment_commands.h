@@ -31,6 +31,8 @@ struct CreepExperimentOptions {
   bool viscoelastic = false;  // the assumed SLS of material-test instead of the elastic tissue
   std::optional<std::filesystem::path> csv_output, ratio_csv_output;
   std::optional<std::filesystem::path> plot_output, ratio_plot_output;
+  // The marked point's displacement every quarter of the ramp, as a markdown table.
+  std::optional<std::filesystem::path> table_output;
 };
 
 struct PullExperimentOptions {
@@ -41,6 +43,7 @@ struct PullExperimentOptions {
   double max_time_s = 30.0;
   std::string attachment = "patch";  // "patch": point loads; "forceps": the forceps' hold
   std::optional<std::filesystem::path> csv_output, history_csv_output, plot_output;
+  std::optional<std::filesystem::path> table_output;  // the table printed, as a markdown file
 };
 
 struct TimingExperimentOptions {
@@ -50,6 +53,7 @@ struct TimingExperimentOptions {
   double force_n = 0.75;
   double simulated_s = 1.0;
   std::optional<std::filesystem::path> csv_output, plot_output;
+  std::optional<std::filesystem::path> table_output;  // the table printed, as a markdown file
 };
 
 // Adds `experiment` with its subcommands creep, pull and timing to the app. After parsing, the

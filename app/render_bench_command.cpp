@@ -186,8 +186,7 @@ int run(const RenderBenchOptions& o) {
 
   std::ostringstream md;
   md << "# Rendering: frame rate\n\n"
-     << "Written by `" << command.str() << "` on " << today_utc() << " (" << processor_name()
-     << "; release build). Renderer: " << renderer
+     << written_by(command.str()) << "\n\nRelease build. Renderer: " << renderer
      << (software ? " — Mesa's software rasteriser, which is what Xvfb offers: no graphics "
                     "card draws here, the processor does, sharing its cores with whatever else "
                     "runs"

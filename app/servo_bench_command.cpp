@@ -113,10 +113,10 @@ int run(const ServoBenchOptions& o) {
                 << " missed deadlines" << std::endl;
     }
   std::ostringstream md;
-  md << "# Haptic servo timing\n\nWritten by `liversim-cli bench-servo --seconds "
-     << number(o.seconds) << " --runs " << o.runs << " --tets " << o.tets << "` on " << today_utc()
-     << " (" << std::thread::hardware_concurrency()
-     << " hardware threads). Wall-clock timing of the servo thread on this machine: it is shared "
+  md << "# Haptic servo timing\n\n"
+     << written_by("liversim-cli bench-servo --seconds " + number(o.seconds) + " --runs " +
+                   std::to_string(o.runs) + " --tets " + std::to_string(o.tets))
+     << "\n\nWall-clock timing of the servo thread on this machine: it is shared "
         "with other work, so the tails vary from run to run; the tests assert only loose sanity "
         "bounds (docs/haptics.md).\n\n"
      << "The device is a scripted trajectory: the probe's ball pressing 3 mm into the top of the "

@@ -15,7 +15,6 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
-#include <thread>
 
 namespace liversim::cli {
 namespace {
@@ -103,9 +102,8 @@ int run_suite(const StabilityStudyOptions& o) {
 
   std::ostringstream md;
   md << "# Stability suite report\n\n"
-     << "Written by `" << command_line(o) << "` on " << today_utc() << " ("
-     << std::thread::hardware_concurrency()
-     << " hardware threads, one used; wall times are of that run). The cases, their checks and "
+     << written_by(command_line(o))
+     << "\n\nOne hardware thread used; wall times are of that run. The cases, their checks and "
         "where each limit comes from are in [stability.md](stability.md) and "
         "`core/studies/src/stability_case*.cpp`. Energy created: the largest energy created over "
         "the run "
@@ -118,7 +116,8 @@ int run_suite(const StabilityStudyOptions& o) {
      << total - failed << " of " << total << " runs passed.\n\n"
      << table.str() << "\n## Checks\n"
      << checks.str()
-     << "\n## Parameter ranges (case 12 samples them; `core/parameter_ranges.h`)\n\n"
+     << "\n## Parameter ranges (case 12 samples them; "
+        "`core/engine/include/liversim/engine/parameter_ranges.h`)\n\n"
      << "| parameter | key | from | to | unit | sampled | why |\n|---|---|---:|---:|---|---|---|\n";
   for (const ParameterRange& range : tissue_parameter_ranges())
     md << "| " << range.label << " | `" << range.name << "` | " << format(range.min, 4) << " | "

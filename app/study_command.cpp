@@ -23,7 +23,6 @@
 #include <iostream>
 #include <map>
 #include <sstream>
-#include <thread>
 
 namespace liversim::cli {
 namespace {
@@ -154,9 +153,8 @@ int run_study(const StudyCommandOptions& command) {
 
   std::ostringstream md;
   md << "# Accuracy study: what accuracy costs in time\n\n"
-     << "Written by `" << command.command_line << "` on " << today_utc() << " ("
-     << std::thread::hardware_concurrency()
-     << " hardware threads; every run on one thread). Every figure below is from that run; "
+     << written_by(command.command_line)
+     << "\n\nEvery run on one thread. Every figure below is from that run; "
         "run the command again to regenerate this page, its CSV and its images.\n\n"
      << "## What is measured\n"
      << "- The experiment: the built-in liver (ligament fixed, E = 3500 Pa, ν = 0.49, average "

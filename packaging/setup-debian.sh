@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages LiverSim needs to build and test, only those missing.
-# Usage: packaging/setup-debian.sh   (packaging/liversim.sh calls it before building)
+# Usage: packaging/setup-debian.sh [--measuring]   (packaging/liversim.sh calls it before building)
+# --measuring: also what packaging/regenerate-docs.sh measures with (valgrind's instruction
+# counts, LLVM's coverage tools, the sqlite3 shell of the soak's report).
 set -euo pipefail
 
 packages=(
@@ -15,6 +17,14 @@ packages=(
   xvfb xauth
   libqt6svg6 qt6-translations-l10n fonts-wqy-microhei desktop-file-utils appstream
 )
+case ${1:-} in
+  --measuring) packages+=(valgrind llvm-14 sqlite3) ;;
+  "") ;;
+  *)
+    echo "usage: $0 [--measuring]" >&2
+    exit 2
+    ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do
