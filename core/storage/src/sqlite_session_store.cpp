@@ -996,6 +996,12 @@ SessionTransfer SqliteSessionStore::transfer_of(std::int64_t session) {
       while (rows.step("reading the chunks to upload")) {
         chunk.first = rows.integer(0);
         chunk.count = rows.integer(1);
+        // A damaged file's row is refused here, not handed on to be uploaded.
+        if (chunk.first < 0 || chunk.count < 0)
+          throw error("session " + std::to_string(session) + " has a chunk starting at " +
+                          std::to_string(chunk.first) + " with " + std::to_string(chunk.count) +
+                          " entries: the file is damaged",
+                      StorageProblem::damaged);
         chunk.layout = static_cast<int>(rows.integer(2));
         const std::span<const std::uint8_t> data = rows.blob(3);
         chunk.data.assign(data.begin(), data.end());
