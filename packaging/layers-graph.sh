@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Draws docs/images/layers.svg, the project's libraries and how they link, from the CMake targets
 # of a configured build (cmake --graphviz, then Graphviz's dot): the picture in
-# docs/architecture.md. Usage: packaging/layers-graph.sh [BUILD_DIR] (default build/release).
+# docs/architecture.md. Usage: packaging/layers-graph.sh [BUILD_DIR [DOCS_DIR]] (default
+# build/release and docs).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build=${1:-"$root/build/release"}
+docs=${2:-"$root/docs"}
 command -v dot >/dev/null || { echo "layers-graph: Graphviz's dot is missing (apt-get install graphviz)" >&2; exit 1; }
 [ -f "$build/CMakeCache.txt" ] || { echo "layers-graph: $build is not a configured build" >&2; exit 1; }
 work=$(mktemp -d)
@@ -23,6 +25,6 @@ text = text.replace("{", '{\nnode [ shape = box, style = rounded, fontname = "De
                     'edge [ color = "#555555" ];', 1)
 open(sys.argv[2], "w").write(text)
 PY
-mkdir -p "$root/docs/images"
-dot -Tsvg "$work/layers.dot" -o "$root/docs/images/layers.svg"
-echo "layers-graph: wrote $root/docs/images/layers.svg"
+mkdir -p "$docs/images"
+dot -Tsvg "$work/layers.dot" -o "$docs/images/layers.svg"
+echo "layers-graph: wrote $docs/images/layers.svg"

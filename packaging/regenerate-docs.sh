@@ -49,6 +49,7 @@ done
 # expected minutes on a quiet 2-core machine, the full run (estimated from the wall times the pages
 # recorded) and --quick (builds not counted) | what takes the time.
 step_table=(
+  "architecture|architecture.md|1|1|"
   "mesh-quality|mesh-quality.md|2|1|"
   "material-verification|material-verification.md|1|1|"
   "tissue-model|tissue-model.md|1|1|"
@@ -67,6 +68,7 @@ step_table=(
   "training-centre-load|training-centre-load.md|12|2|a 10-minute recorded session, then 20 uploads to a throwaway PostgreSQL"
   "fuzzing|fuzzing.md|90|10|six 10-minute long runs, a fresh fuzz build timed, a coverage build"
   "sanitizers|sanitizers.md|120|15|the asan preset's build of every target (about an hour) and its whole suite; the tsan-threads and asan-inputs steps"
+  "ci|ci.md|60|1|.ci/run on a clean clone twice: with the compiler cache as it is, and without it (a new machine's builds)"
 )
 steps=()
 declare -A pages=() minutes_of=() step_notes=()
@@ -741,6 +743,68 @@ step_sanitizers() {
   } >"$w/runs.md"
   splice sanitizers.md latest-runs "$w/runs.md"
   stamp sanitizers.md
+}
+
+step_architecture() {
+  run packaging/layers-graph.sh "$build" "$out"
+  doing || return 0
+  stamp architecture.md
+}
+
+# .ci/run on a clean clone of HEAD beside this checkout (the tests read ../shared from there), as
+# CI runs it: once with the compiler cache as this machine has it, once without (CCACHE_DISABLE:
+# what a new machine's builds cost). Its step lines ("liversim: step NAME took S s") and test
+# counts make the table. Each run is on a fresh clone (its builds from nothing). --quick clones and
+# runs the set-up step only.
+step_ci() {
+  local clone mode seconds
+  clone=$(dirname "$root")/liversim-ci-measure
+  for mode in cached uncached; do
+    ((listing)) || rm -rf "$clone"
+    run git clone --quiet "$root" "$clone"
+    if ((quick)); then
+      run --output "$w/$mode.log" env CCACHE_DISABLE=$([ "$mode" = uncached ] && echo 1 || echo 0) \
+        "$clone/packaging/setup-debian.sh"
+    else
+      run --output "$w/$mode.log" env CI=true \
+        CCACHE_DISABLE=$([ "$mode" = uncached ] && echo 1 || echo 0) \
+        bash -c 'start=$SECONDS; "$1/.ci/run"; status=$?; echo "liversim: step whole run took $((SECONDS - start)) s"; exit $status' \
+        ci-run "$clone"
+    fi
+  done
+  doing || return 0
+  rm -rf "$clone"
+  python3 - "$w/cached.log" "$w/uncached.log" >"$w/runs.md" <<'PYTHON'
+import re, sys
+logs = [open(path, encoding="utf-8").read() for path in sys.argv[1:3]]
+def steps(log):
+    return {m.group(1): int(m.group(2)) for m in re.finditer(r"liversim: step (.+?) took (\d+) s", log)}
+def tests(log):
+    return re.findall(r"(\d+)% tests passed, (\d+) tests failed out of (\d+)", log)
+cached, uncached = steps(logs[0]), steps(logs[1])
+print("| step | with this machine's compiler cache (s) | without a compiler cache (s) |")
+print("|---|---|---|")
+for name in cached:
+    fmt = lambda d: f"{d[name]} ({d[name] / 60:.1f} min)" if name in d else "-"
+    print(f"| {name} | {fmt(cached)} | {fmt(uncached)} |")
+print()
+counts = tests(logs[0])
+suites = ["release suite", "fuzz short runs", "asan-inputs", "tsan-threads"]
+print("Tests run (with the cache): " + "; ".join(
+    f"{suites[i] if i < len(suites) else 'suite ' + str(i)}: {int(total) - int(failed)}/{total}"
+    for i, (_, failed, total) in enumerate(counts)) + ".")
+budget = re.search(r"test budget: (\d+) tests, (\d+) s of test time; the slowest:\n((?:  .*\n)+)", logs[0])
+if budget:
+    print()
+    print(f"The release suite's {budget.group(1)} tests took {budget.group(2)} s of test time; the slowest "
+          "(packaging/test-budget.py):")
+    print()
+    print("```")
+    print(budget.group(3).rstrip())
+    print("```")
+PYTHON
+  splice ci.md ci-runs "$w/runs.md"
+  stamp ci.md
 }
 
 # ---- The run ------------------------------------------------------------------------------------
