@@ -803,7 +803,7 @@ if budget:
     print(budget.group(3).rstrip())
     print("```")
 PYTHON
-  splice ci.md ci-runs "$w/runs.md"
+  splice ci.md ci-runs "$w/runs.md" 0 "${#commands[@]}"
   stamp ci.md
 }
 
