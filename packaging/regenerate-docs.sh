@@ -757,17 +757,17 @@ step_architecture() {
 # counts make the table. Each run is on a fresh clone (its builds from nothing). --quick clones and
 # runs the set-up step only.
 step_ci() {
-  local clone mode seconds
+  local clone mode cache
   clone=$(dirname "$root")/liversim-ci-measure
   for mode in cached uncached; do
+    # ccache takes no "0": the cached run leaves the variable unset.
+    if [ "$mode" = uncached ]; then cache=(CCACHE_DISABLE=1); else cache=(-u CCACHE_DISABLE); fi
     ((listing)) || rm -rf "$clone"
     run git clone --quiet "$root" "$clone"
     if ((quick)); then
-      run --output "$w/$mode.log" env CCACHE_DISABLE=$([ "$mode" = uncached ] && echo 1 || echo 0) \
-        "$clone/packaging/setup-debian.sh"
+      run --output "$w/$mode.log" env "${cache[@]}" "$clone/packaging/setup-debian.sh"
     else
-      run --output "$w/$mode.log" env CI=true \
-        CCACHE_DISABLE=$([ "$mode" = uncached ] && echo 1 || echo 0) \
+      run --output "$w/$mode.log" env "${cache[@]}" CI=true \
         bash -c 'start=$SECONDS; "$1/.ci/run"; status=$?; echo "liversim: step whole run took $((SECONDS - start)) s"; exit $status' \
         ci-run "$clone"
     fi
