@@ -1,6 +1,7 @@
 #include "cut_bench_command.h"
 
 #include "cli_commands.h"
+#include "live_cut_bench.h"
 
 #include "liversim/engine/model_building.h"
 #include "liversim/engine/surface_bvh.h"
@@ -202,9 +203,25 @@ std::function<std::optional<int>()> add_cut_bench_command(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--output-dir", options->output_dir, "Where cutting-performance.md goes")
       ->capture_default_str();
-  return [command, options]() -> std::optional<int> {
+  auto live = std::make_shared<LiveCutBenchOptions>();
+  auto live_asked = std::make_shared<bool>(false);
+  command->add_flag(
+      "--live", *live_asked,
+      "Run --trajectory with a scalpel through the workstation's real-time loop instead, one "
+      "run, every second and every cut update as they came; writes cutting-live.md");
+  auto* trajectory = command->add_option(
+      "--trajectory", live->trajectory,
+      "--live: the scripted device's trajectory (device mm: time_s x_mm y_mm z_mm buttons; the "
+      "first button arms the blade)");
+  command->add_option("--scenario", live->scenario,
+                      "--live: the scenario to cut (default: free practice at --tets)");
+  return [command, options, live, live_asked, trajectory]() -> std::optional<int> {
     if (!command->parsed()) return std::nullopt;
-    return run(*options);
+    if (!*live_asked) return run(*options);
+    if (trajectory->count() == 0) return fail("bench-cut --live needs --trajectory");
+    live->tets = options->tets;
+    live->output_dir = options->output_dir;
+    return run_live_cut_bench(*live);
   };
 }
 

@@ -127,15 +127,7 @@ int record(const RecordOptions& options) {
   std::optional<ToolKind> tool;
   try {
     script = load_trajectory(options.trajectory);  // its errors name the file and the line
-    if (options.scenario) {
-      auto read = read_scenario_to_run(*options.scenario);
-      if (auto* errors = std::get_if<std::vector<ScenarioError>>(&read)) {
-        std::string message = "cannot open the scenario " + options.scenario->string() + ":";
-        for (const ScenarioError& error : *errors) message += "\n  " + error.text();
-        throw std::runtime_error(message);
-      }
-      scenario = std::get<OpenedScenario>(std::move(read));
-    }
+    scenario = open_scenario_to_run(options.scenario);
     tool = held_tool(options, scenario ? &scenario->scenario : nullptr);
   } catch (const std::exception& e) {
     return fail(e.what());
@@ -262,6 +254,17 @@ int record(const RecordOptions& options) {
 }
 
 }  // namespace
+
+std::optional<OpenedScenario> open_scenario_to_run(const std::optional<fs::path>& file) {
+  if (!file) return std::nullopt;
+  auto read = read_scenario_to_run(*file);
+  if (auto* errors = std::get_if<std::vector<ScenarioError>>(&read)) {
+    std::string message = "cannot open the scenario " + file->string() + ":";
+    for (const ScenarioError& error : *errors) message += "\n  " + error.text();
+    throw std::runtime_error(message);
+  }
+  return std::get<OpenedScenario>(std::move(read));
+}
 
 std::function<std::optional<int>()> add_record_command(CLI::App& app) {
   auto options = std::make_shared<RecordOptions>();

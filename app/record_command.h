@@ -5,6 +5,9 @@
 // and, at the end, the servo's figures and the metrics go to a sessions database. For unattended
 // soaks (memory, rate), demonstrations and the crash-safety tests.
 
+#include "liversim/station/workstation.h"
+
+#include <filesystem>
 #include <functional>
 #include <optional>
 
@@ -18,5 +21,10 @@ namespace liversim::cli {
 // code (nothing when `record` was not on the command line): 0 for a session recorded to its end
 // or ended by SIGINT or SIGTERM, 1 when storage failed (what was committed stays), 2 for bad input.
 std::function<std::optional<int>()> add_record_command(CLI::App& app);
+
+// The scenario a headless run plays (none: free practice), read as the workstation reads one.
+// Throws std::runtime_error naming the file and each of its errors.
+std::optional<OpenedScenario> open_scenario_to_run(
+    const std::optional<std::filesystem::path>& file);
 
 }  // namespace liversim::cli

@@ -1258,6 +1258,58 @@
             <numerusform>%n 个球形区域</numerusform>
         </translation>
     </message>
+    <message>
+        <source>Supine: toward the back (−z)</source>
+        <translation>仰卧位：朝向背侧（−z）</translation>
+    </message>
+    <message>
+        <source>Upright: toward the feet (−y)</source>
+        <translation>直立位：朝向足侧（−y）</translation>
+    </message>
+    <message>
+        <source>Prone: toward the front (+z)</source>
+        <translation>俯卧位：朝向腹侧（+z）</translation>
+    </message>
+    <message>
+        <source>Gravity (the organ&apos;s weight)</source>
+        <translation>重力（器官自重）</translation>
+    </message>
+    <message>
+        <source>Switch gravity on</source>
+        <translation>开启重力</translation>
+    </message>
+    <message>
+        <source>Switch gravity off</source>
+        <translation>关闭重力</translation>
+    </message>
+    <message>
+        <source>Which way is down: the patient&apos;s position on the table</source>
+        <translation>向下的方向：患者在手术台上的体位</translation>
+    </message>
+    <message>
+        <source>As the file sets it</source>
+        <translation>按文件设定</translation>
+    </message>
+    <message>
+        <source>Down</source>
+        <translation>向下</translation>
+    </message>
+    <message>
+        <source>Change gravity&apos;s direction</source>
+        <translation>更改重力方向</translation>
+    </message>
+    <message>
+        <source>Gravity&apos;s strength g: 9.81 m/s² on Earth</source>
+        <translation>重力加速度 g：地球上为 9.81 m/s²</translation>
+    </message>
+    <message>
+        <source>g</source>
+        <translation>g</translation>
+    </message>
+    <message>
+        <source>Change gravity&apos;s strength</source>
+        <translation>更改重力大小</translation>
+    </message>
 </context>
 <context>
     <name>liversim::ForceTrace</name>
@@ -1767,6 +1819,18 @@ The scene that was running goes on.</source>
         <source>Upload finished sessions to the training centre&apos;s server and pull its scenarios</source>
         <translation>将已结束的训练上传到培训中心服务器，并获取其发布的情景</translation>
     </message>
+    <message>
+        <source>a scene or another change of the model is being built; switch gravity again after it.</source>
+        <translation>正在构建场景或模型的其他更改；请在其完成后再切换重力。</translation>
+    </message>
+    <message>
+        <source>Gravity is the scenario&apos;s: an instructor can switch it (Settings ▸ Instructor Mode).</source>
+        <translation>重力由场景设定：教员可以切换它（设置 ▸ 教员模式）。</translation>
+    </message>
+    <message>
+        <source>The liver was cut while gravity was switched; switch it again.</source>
+        <translation>切换重力时肝脏被切割了；请再次切换。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::MaterialPanel</name>
@@ -1881,6 +1945,30 @@ The scene that was running goes on.</source>
     <message>
         <source>. E2 = E − E1 follows.</source>
         <translation>。E2 = E − E1 随之确定。</translation>
+    </message>
+    <message>
+        <source>The organ&apos;s weight pulls it onto its bed</source>
+        <translation>器官的重量将其压在其支撑床上</translation>
+    </message>
+    <message>
+        <source>Gravity</source>
+        <translation>重力</translation>
+    </message>
+    <message>
+        <source>g = %1 m/s² toward (%2, %3, %4), the scene&apos;s axes; it rests on a bed shaped as its underside, and on a tray around it</source>
+        <translation>g = %1 m/s²，方向 (%2, %3, %4)（场景坐标轴）；器官躺在与其底面形状相同的支撑床上，周围有托盘</translation>
+    </message>
+    <message>
+        <source>gravity</source>
+        <translation>重力</translation>
+    </message>
+    <message>
+        <source>Switching gravity on…</source>
+        <translation>正在开启重力…</translation>
+    </message>
+    <message>
+        <source>Switching gravity off…</source>
+        <translation>正在关闭重力…</translation>
     </message>
 </context>
 <context>
@@ -2241,6 +2329,10 @@ Simulated: %2.
         <source>. Not passed: %1.</source>
         <translation>。未通过：%1。</translation>
     </message>
+    <message>
+        <source>gravity</source>
+        <translation>重力</translation>
+    </message>
 </context>
 <context>
     <name>liversim::SessionReplayWindow</name>
@@ -2323,6 +2415,10 @@ Simulated: %2.
     <message>
         <source>Session %1 is not replayed: reading it was cancelled. Open the replay again to read it.</source>
         <translation>会话 %1 未回放：读取已取消。再次打开回放即可读取。</translation>
+    </message>
+    <message>
+        <source>The replay ends at %1 s, where gravity was switched (to %2): what followed was not logged for replay.</source>
+        <translation>回放在 %1 秒处结束，此时重力被切换（为 %2）：之后的操作未记录用于回放。</translation>
     </message>
 </context>
 <context>

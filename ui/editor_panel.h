@@ -54,6 +54,7 @@ class EditorPanel : public QWidget {
     kDamageTension = kRubricThreshold + 1000,
     kDamageCompression,
     kLift,
+    kGravityStrength,
   };
 
  protected:

@@ -5,15 +5,35 @@
 #include "liversim/engine/parameter_ranges.h"
 
 #include <QCheckBox>
+#include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
 #include <QLabel>
 #include <QPushButton>
+#include <QStandardItemModel>
 #include <QVBoxLayout>
 
+#include <array>
+#include <iterator>
+
 namespace liversim {
+namespace {
+
+// Where "down" is for the usual positions of the patient, in the scene's axes (liver_geometry.h:
+// x to the patient's left, y superior, z anterior).
+struct PatientPosition {
+  const char* name;
+  std::array<double, 3> down;
+};
+const PatientPosition kPatientPositions[] = {
+    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Supine: toward the back (−z)"), {0.0, 0.0, -1.0}},
+    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Upright: toward the feet (−y)"), {0.0, -1.0, 0.0}},
+    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Prone: toward the front (+z)"), {0.0, 0.0, 1.0}},
+};
+
+}  // namespace
 
 EditorTissuePanel::EditorTissuePanel(
     ScenarioDocument& scenarioDocument,
@@ -86,6 +106,42 @@ EditorTissuePanel::EditorTissuePanel(
       });
     });
   }
+  gravity_ = new QCheckBox(tr("Gravity (the organ's weight)"));
+  gravity_->setObjectName("effectGravity");
+  effectsLayout->addWidget(gravity_);
+  connect(gravity_, &QCheckBox::toggled, this, [this](bool on) {
+    if (refreshing()) return;
+    document().edit(on ? tr("Switch gravity on") : tr("Switch gravity off"),
+                    [&](Scenario& s) { s.effects.gravity = on; });
+  });
+  auto* gravityForm = new QFormLayout;
+  gravityDirection_ = new QComboBox;
+  gravityDirection_->setObjectName("gravityDirection");
+  gravityDirection_->setToolTip(tr("Which way is down: the patient's position on the table"));
+  for (const PatientPosition& position : kPatientPositions)
+    gravityDirection_->addItem(tr(position.name));
+  gravityDirection_->addItem(tr("As the file sets it"));  // shown only for another direction
+  if (auto* items = qobject_cast<QStandardItemModel*>(gravityDirection_->model()))
+    items->item(gravityDirection_->count() - 1)->setEnabled(false);  // not a choice
+  gravityForm->addRow(tr("Down"), gravityDirection_);
+  connect(gravityDirection_, &QComboBox::activated, this, [this](int index) {
+    if (refreshing() || index >= int(std::size(kPatientPositions))) return;
+    document().edit(tr("Change gravity's direction"), [&](Scenario& s) {
+      s.effects.gravity_direction = kPatientPositions[index].down;
+    });
+  });
+  gravityStrength_ = new QDoubleSpinBox;
+  gravityStrength_->setObjectName("gravityStrength");
+  gravityStrength_->setRange(kMinGravityMPerS2, kMaxGravityMPerS2);
+  gravityStrength_->setDecimals(2);
+  gravityStrength_->setSingleStep(0.5);
+  gravityStrength_->setSuffix(" m/s²");
+  gravityStrength_->setKeyboardTracking(false);
+  gravityStrength_->setToolTip(tr("Gravity's strength g: 9.81 m/s² on Earth"));
+  gravityForm->addRow(tr("g"), gravityStrength_);
+  bindSpinBox(gravityStrength_, tr("Change gravity's strength"), kGravityStrength,
+              [](Scenario& s, double v) { s.effects.gravity_m_per_s2 = v; });
+  effectsLayout->addLayout(gravityForm);
   cost_ = new QLabel;
   cost_->setObjectName("effectsCost");
   cost_->setWordWrap(true);
@@ -203,6 +259,14 @@ void EditorTissuePanel::refresh() {
     const bool on[4] = {s.effects.near_incompressibility, s.effects.viscoelastic,
                         s.effects.viscoplastic, s.effects.fibres};
     for (int i = 0; i < 4; ++i) effects_[i]->setChecked(on[i]);
+    gravity_->setChecked(s.effects.gravity);
+    int position = int(std::size(kPatientPositions));  // another direction: "as the file sets it"
+    for (int p = 0; p < int(std::size(kPatientPositions)); ++p)
+      if (kPatientPositions[p].down == s.effects.gravity_direction) position = p;
+    gravityDirection_->setCurrentIndex(position);
+    gravityDirection_->setEnabled(s.effects.gravity);
+    gravityStrength_->setValue(s.effects.gravity_m_per_s2);
+    gravityStrength_->setEnabled(s.effects.gravity);
     for (int k = 0; k < 3; ++k) {
       fibreDirection_[k]->setEnabled(s.parenchyma.fibres.has_value());
       if (s.parenchyma.fibres) fibreDirection_[k]->setValue(s.parenchyma.fibres->direction[k]);

@@ -1,7 +1,7 @@
 #pragma once
 // The scenario editor's Tissue and effects panel: the parenchyma's stiffness and Poisson's ratio,
-// the effects simulated with what they cost (measured by the editor), the laws of the effects that
-// are on, the fibres' direction, and the fixed regions: the brush that paints them on the organ,
+// the effects simulated with what they cost (measured by the editor), gravity's direction and
+// strength, the laws of the effects that are on, the fibres' direction, and the fixed regions: the brush that paints them on the organ,
 // what is painted, and the built-in liver's ligament.
 
 #include "editor_panel.h"
@@ -12,6 +12,7 @@
 #include <optional>
 
 class QCheckBox;
+class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
 class QPushButton;
@@ -53,6 +54,9 @@ class EditorTissuePanel : public EditorPanel {
   QLabel* fixedRegions_ = nullptr;
   QCheckBox* fixLigament_ = nullptr;
   QLabel* cost_ = nullptr;
+  QCheckBox* gravity_ = nullptr;
+  QComboBox* gravityDirection_ = nullptr;  // the patient's positions, and "as the file sets it"
+  QDoubleSpinBox* gravityStrength_ = nullptr;
 };
 
 }  // namespace liversim

@@ -113,6 +113,12 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
           tr("a scene or an integrator change is being built; enter the "
              "value again after it."));
   });
+  connect(materialPanel_, &MaterialPanel::gravityRequested, this, [this](bool on) {
+    if (!applyGravity(on))
+      materialPanel_->showError(
+          tr("a scene or another change of the model is being built; "
+             "switch gravity again after it."));
+  });
   QDockWidget* materialDock = addPanelDock(tr("Material"), "materialDock", materialPanel_);
 
   toolPanel_ = new ToolPanel(this);
@@ -285,6 +291,7 @@ void MainWindow::setInstructorMode(bool on) {
 void MainWindow::applyMode(bool instructor) {
   instructorMode_ = instructor;
   materialPanel_->setEditable(instructor);
+  materialPanel_->setGravityEditable(instructor || !station_->scenario());
   if (instructorModeAction_ != nullptr) instructorModeAction_->setChecked(instructor);
   if (scenarioEditorAction_ != nullptr) scenarioEditorAction_->setVisible(instructor);
   if (reviewSessionsAction_ != nullptr) reviewSessionsAction_->setVisible(instructor);
@@ -504,6 +511,7 @@ void MainWindow::showScenarioDetails() {
   toolPanel_->setAvailableTools(opened ? opened->scenario.tools : Scenario{}.tools);
   const Scenario described = station_->described_scenario();
   materialPanel_->showTissue(described.parenchyma, described.effects);
+  materialPanel_->setGravityEditable(instructorMode_ || !opened);
 }
 
 void MainWindow::buildMenus() {
@@ -732,7 +740,30 @@ bool MainWindow::applyTissue(const TissueSpec& tissue) {
   return true;
 }
 
+bool MainWindow::applyGravity(bool on) {
+  if (station_->scenario() && !instructorMode_) {  // the scenario's: for instructors to change
+    materialPanel_->showError(
+        tr("Gravity is the scenario's: an instructor can switch it (Settings ▸ Instructor Mode)."));
+    return true;  // said why
+  }
+  if (!station_->change_gravity(on)) return false;
+  materialPanel_->setSwitchingGravity();
+  return true;
+}
+
 void MainWindow::modelChanged(const ModelChangeOutcome& outcome) {
+  if (outcome.kind == ModelChangeOutcome::Kind::gravity) {
+    if (!outcome.applied)
+      materialPanel_->showError(outcome.cut_meanwhile
+                                    ? tr("The liver was cut while gravity was switched; switch it "
+                                         "again.")
+                                    : qstring(outcome.error));
+    else
+      materialPanel_->showTissue(station_->described_scenario().parenchyma,
+                                 station_->described_scenario().effects);
+    emit gravityChangeFinished(outcome.applied);
+    return;
+  }
   const bool integrator = outcome.kind == ModelChangeOutcome::Kind::integrator;
   if (!outcome.applied) {
     const QString why = !outcome.cut_meanwhile ? qstring(outcome.error)

@@ -84,6 +84,9 @@ class MainWindow : public QMainWindow {
   // being built.
   bool applyTissue(const TissueSpec& tissue);
   bool changingTissue() const { return station_->changing_tissue(); }
+  // The Material panel's gravity switch, applied as a tissue change is (gravityChangeFinished):
+  // anyone in free practice, instructors in a scenario. False while a model is being built.
+  bool applyGravity(bool on);
 
   // Instructor mode: the Material panel edits the tissue, and the scenario editor and the review
   // and grading of every trainee's sessions are offered. Every start is in trainee mode; turning
@@ -151,6 +154,7 @@ class MainWindow : public QMainWindow {
   void recordingStopped(const QString& message);
   void integratorChangeFinished(bool applied);
   void tissueChangeFinished(bool applied);
+  void gravityChangeFinished(bool applied);
   void scenarioOpenFinished(bool opened);
 
  protected:

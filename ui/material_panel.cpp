@@ -4,6 +4,7 @@
 
 #include "liversim/engine/parameter_ranges.h"
 
+#include <QCheckBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QLabel>
@@ -43,6 +44,12 @@ MaterialPanel::MaterialPanel(QWidget* parent) : QWidget(parent) {
       tr("Creep index n"));
   add(fibreK1_, parameter::fibre_k1, 1.0, tr(" Pa"), 0, "materialFibreK1", tr("Fibre k1"));
   add(fibreK2_, parameter::fibre_k2, 1.0, QString(), 2, "materialFibreK2", tr("Fibre k2"));
+  gravity_ = new QCheckBox(tr("The organ's weight pulls it onto its bed"), this);
+  gravity_->setObjectName("materialGravity");
+  form_->addRow(tr("Gravity"), gravity_);
+  connect(gravity_, &QCheckBox::toggled, this, [this](bool on) {
+    if (!refreshing_) emit gravityRequested(on);
+  });
 
   derived_ = new QLabel(this);
   derived_->setObjectName("materialDerived");
@@ -105,6 +112,14 @@ void MaterialPanel::showTissue(const TissueSpec& tissue, const EffectsSpec& effe
   for (QDoubleSpinBox* box : {yieldLimit_, eta2_, creepIndex_})
     form_->setRowVisible(box, viscoplastic);
   for (QDoubleSpinBox* box : {fibreK1_, fibreK2_}) form_->setRowVisible(box, fibres);
+  gravity_->setChecked(effects.gravity);
+  const auto& down = effects.gravity_direction;
+  gravity_->setToolTip(tr("g = %1 m/s² toward (%2, %3, %4), the scene's axes; it rests on a bed "
+                          "shaped as its underside, and on a tray around it")
+                           .arg(effects.gravity_m_per_s2, 0, 'g', 3)
+                           .arg(down[0], 0, 'g', 3)
+                           .arg(down[1], 0, 'g', 3)
+                           .arg(down[2], 0, 'g', 3));
   refreshing_ = false;
   error_->hide();
   error_->clear();
@@ -113,6 +128,7 @@ void MaterialPanel::showTissue(const TissueSpec& tissue, const EffectsSpec& effe
     if (!effects.viscoelastic) off << tr("viscoelasticity");
     if (!effects.viscoplastic) off << tr("viscoplasticity");
     if (!effects.fibres) off << tr("fibres");
+    if (!effects.gravity) off << tr("gravity");
     return off.isEmpty() ? tr("none") : off.join(tr(", "));
   }()));
   updateNotes();
@@ -170,6 +186,19 @@ void MaterialPanel::setEditable(bool editable) {
   editable_ = editable;
   for (QDoubleSpinBox* box : findChildren<QDoubleSpinBox*>()) box->setReadOnly(!editable);
   readOnlyNote_->setVisible(!editable);
+}
+
+void MaterialPanel::setGravityEditable(bool editable) {
+  gravity_->setEnabled(editable);
+}
+
+bool MaterialPanel::gravityOn() const {
+  return gravity_->isChecked();
+}
+
+void MaterialPanel::setSwitchingGravity() {
+  status_->setText(gravity_->isChecked() ? tr("Switching gravity on…")
+                                         : tr("Switching gravity off…"));
 }
 
 void MaterialPanel::setBusy(bool busy) {

@@ -1,14 +1,15 @@
 #pragma once
 // The tissue of the scene running, live-editable: the parenchyma's parameters, each with its unit
-// and documented range (parameter_ranges.h). A value entered is applied to the running liver at
-// once, which goes on from where it is; whoever applies it reports back. The laws of effects the
-// scene leaves off are not shown: they are not simulated. In trainee mode the values are shown but
-// cannot be changed.
+// and documented range (parameter_ranges.h), and gravity. A value entered is applied to the running
+// liver at once, which goes on from where it is; whoever applies it reports back. The laws of
+// effects the scene leaves off are not shown: they are not simulated. In trainee mode the values
+// are shown but cannot be changed; gravity can, in free practice.
 
 #include "liversim/scenario/scenario.h"
 
 #include <QWidget>
 
+class QCheckBox;
 class QDoubleSpinBox;
 class QFormLayout;
 class QLabel;
@@ -29,14 +30,19 @@ class MaterialPanel : public QWidget {
 
   void setEditable(bool editable);
   bool editable() const { return editable_; }
+  // Whether gravity may be switched (free practice, or an instructor).
+  void setGravityEditable(bool editable);
+  bool gravityOn() const;
   // While a change is being applied: says so (entries made meanwhile are applied after it).
   void setBusy(bool busy);
+  void setSwitchingGravity();
   // Why the requested tissue could not be applied (the tissue in use stays).
   void showError(const QString& message);
   QString errorText() const;
 
  signals:
   void tissueRequested(const liversim::TissueSpec& tissue);
+  void gravityRequested(bool on);
 
  private:
   void request();
@@ -58,6 +64,7 @@ class MaterialPanel : public QWidget {
   QDoubleSpinBox* creepIndex_ = nullptr;
   QDoubleSpinBox* fibreK1_ = nullptr;
   QDoubleSpinBox* fibreK2_ = nullptr;
+  QCheckBox* gravity_ = nullptr;
   QLabel* derived_ = nullptr;  // E2 and the relaxation time that follow
   QLabel* status_ = nullptr;
   QLabel* error_ = nullptr;

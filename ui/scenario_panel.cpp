@@ -97,6 +97,7 @@ void ScenarioPanel::showScenario(const Scenario* scenario, const QString& file) 
   if (scenario->effects.viscoelastic) effects << tr("viscoelasticity");
   if (scenario->effects.viscoplastic) effects << tr("viscoplasticity");
   if (scenario->effects.fibres) effects << tr("fibres");
+  if (scenario->effects.gravity) effects << tr("gravity");
   if (effects.isEmpty()) effects << tr("elasticity only");
   int hidden = 0;
   for (const LesionSpec& lesion : scenario->lesions) hidden += lesion.hidden ? 1 : 0;

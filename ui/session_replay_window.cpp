@@ -125,14 +125,17 @@ SessionReplayWindow::SessionReplayWindow(SessionStore* openStore, const QString&
     // A change of the model ends the session's input log: the replay stops there.
     for (const SessionEvent& event : store.events(session)) {
       const bool integrator = event.kind == SessionEventKind::integrator_changed;
+      const bool gravity = event.kind == SessionEventKind::gravity_changed;
       if (!limitNote_.isEmpty() ||
-          !(integrator || event.kind == SessionEventKind::material_changed))
+          !(integrator || gravity || event.kind == SessionEventKind::material_changed))
         continue;
       const double at_s = event.time_s - (frames.empty() ? 0.0 : frames.front().time_s);
       limitNote_ = (integrator ? tr("The replay ends at %1 s, where the integrator was changed "
                                     "(to %2): what followed was not logged for replay.")
+                    : gravity  ? tr("The replay ends at %1 s, where gravity was switched (to "
+                                     "%2): what followed was not logged for replay.")
                                : tr("The replay ends at %1 s, where the tissue was changed (to "
-                                    "%2): what followed was not logged for replay."))
+                                     "%2): what followed was not logged for replay."))
                        .arg(at_s, 0, 'f', 2)
                        .arg(QString::fromStdString(event.detail));
     }

@@ -43,6 +43,9 @@ Scenario every_field_set() {
   lesion.hidden = true;
   s.lesions = {lesion};
   s.effects = {false, true, true, true};
+  s.effects.gravity = true;
+  s.effects.gravity_direction = {0.0, -1.0, 0.0};
+  s.effects.gravity_m_per_s2 = 4.9;
   s.integrator.kind = IntegratorKind::backward_euler;
   s.integrator.step_s = 0.002;
   s.integrator.tolerance_m = 2e-6;
@@ -111,6 +114,12 @@ TEST(ScenarioFile, EveryFieldSurvivesASaveAndALoad) {
        [](Scenario& s) { s.effects.near_incompressibility = true; }},
       {"effects.fibres", [](Scenario& s) { s.effects.fibres = false; }},
       {"effects.viscoplastic", [](Scenario& s) { s.effects.viscoplastic = false; }},
+      {"effects.gravity", [](Scenario& s) { s.effects.gravity = false; }},
+      {"effects.gravity_direction",
+       [](Scenario& s) {
+         s.effects.gravity_direction = {0.0, 0.0, -1.0};
+       }},
+      {"effects.gravity_m_per_s2", [](Scenario& s) { s.effects.gravity_m_per_s2 = 9.81; }},
       {"integrator.kind", [](Scenario& s) { s.integrator.kind = IntegratorKind::bdf2; }},
       {"integrator.step_s", [](Scenario& s) { s.integrator.step_s = 0.001; }},
       {"integrator.tolerance_m", [](Scenario& s) { s.integrator.tolerance_m = 1e-7; }},
@@ -241,6 +250,9 @@ TEST(ScenarioFile, EachMalformedFileGetsItsOwnErrorAndNothingIsHalfLoaded) {
         "2000 Pa is invalid: expected 1 to 100 times the parenchyma's 3500 Pa"}},
       {"semantic-duplicate-lesion-names.json", {"lesions[1].name", "another lesion has this name"}},
       {"semantic-zero-fibre-direction.json", {"parenchyma.fibres.direction", "not all 0"}},
+      {"semantic-zero-gravity-direction.json", {"effects.gravity_direction", "not all 0"}},
+      {"schema-gravity-too-strong.json",
+       {"effects.gravity_m_per_s2", "100 is invalid: expected gravity's strength, 0.981 to 29.43"}},
       {"semantic-surface-file-not-a-model.json",
        {"organ.file", "expected a surface model (.obj, .stl, .ply, .gltf, .glb, .fbx, .3ds)"}},
       {"semantic-rubric-weights-zero.json", {"rubric", "the weights sum to 0"}},
@@ -296,6 +308,63 @@ TEST(ScenarioFile, ANumberBeyondADoublesRangeIsAnErrorOfTheTextNotACrash) {
                                             " is out of range: expected at most about 1.8e308 "
                                             "in size");
   }
+}
+
+// Version 2 added gravity; a version-1 file (every shipped scenario before it) reads as before,
+// with gravity off and its direction and strength at their defaults, and says it was migrated.
+TEST(ScenarioFile, AVersionOneFileReadsWithGravityOff) {
+  const std::string text = R"({
+  "format": "liversim-scenario", "version": 1, "title": "Written by version 1",
+  "organ": {"geometry": "built-in-liver", "target_tet_count": 3841, "fix_ligament": true},
+  "parenchyma": {"youngs_modulus_pa": 3500, "poisson_ratio": 0.49, "density_kg_per_m3": 1060},
+  "effects": {"near_incompressibility": true, "viscoelastic": false, "viscoplastic": false,
+              "fibres": false},
+  "tools": ["probe"],
+  "task": {"kind": "palpate-lesion", "lesion": "t", "time_limit_s": 180},
+  "lesions": [{"name": "t", "centre_mm": [-50, 10, 40], "radii_mm": [12, 12, 12],
+               "youngs_modulus_pa": 17500}]
+})";
+  const ScenarioReading reading = read_scenario(text);
+  ASSERT_TRUE(reading.scenario) << (reading.errors.empty() ? "" : reading.errors[0].text());
+  EXPECT_EQ(reading.file_version, 1);
+  EXPECT_FALSE(reading.scenario->effects.gravity);
+  EXPECT_EQ(reading.scenario->effects, EffectsSpec{});
+  // Saved again, it is the current version with gravity written out (and still off).
+  const std::string saved = write_scenario(*reading.scenario);
+  EXPECT_NE(saved.find("\"version\": " + std::to_string(kScenarioFormatVersion)),
+            std::string::npos);
+  EXPECT_NE(saved.find("\"gravity\": false"), std::string::npos) << saved;
+  EXPECT_EQ(round_trip(*reading.scenario), *reading.scenario);
+}
+
+// Gravity in the scene: its acceleration is g times the normalised direction when on, and the
+// model has no gravity at all when off (the direction and strength are kept for switching it on).
+TEST(ScenarioScene, GravityIsTheModelsAccelerationWhenOnAndAbsentWhenOff) {
+  Scenario s = every_field_set();
+  s.organ.fixed_balls.clear();
+  s.organ.fix_ligament = true;
+  s.effects.gravity = true;
+  s.effects.gravity_direction = {0.0, 0.6, -0.8};
+  s.effects.gravity_m_per_s2 = 9.81;
+  const SceneSetup on_scene = build_scene(s, ".");
+  const SimModel on = build_model(on_scene.mesh, on_scene.model_options);
+  EXPECT_TRUE(on.effects.gravity);
+  EXPECT_NEAR(on.gravity_m_per_s2.y(), 0.6 * 9.81, 1e-12);
+  EXPECT_NEAR(on.gravity_m_per_s2.z(), -0.8 * 9.81, 1e-12);
+  EXPECT_EQ(on.gravity_m_per_s2.x(), 0.0);
+
+  s.effects.gravity = false;
+  const SceneSetup off_scene = build_scene(s, ".");
+  const SimModel off = build_model(off_scene.mesh, off_scene.model_options);
+  EXPECT_FALSE(off.effects.gravity);
+  EXPECT_TRUE(off.gravity_m_per_s2.isZero(0.0));
+  EXPECT_EQ(round_trip(s).effects.gravity_direction, s.effects.gravity_direction);
+
+  // A strength out of range is refused by validate() too (the editor builds scenarios in code).
+  s.effects.gravity_m_per_s2 = 0.0;
+  const auto errors = validate(s);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].path, "effects.gravity_m_per_s2");
 }
 
 // Found by fuzzing (docs/fuzzing.md): a direction written not of unit length is normalised on

@@ -315,7 +315,8 @@ TEST_F(StationTest, ARecordedSessionReplaysItsDeviceInputAndIsNotRecordedAgain) 
 
 // A live integrator change carries the liver on where it is (carry_state), mid-press, and is a
 // session event; the same mesh keeps the session's outcome tracking. A tissue change does the same
-// and is stored with free practice's text, which then cannot be replayed.
+// and is stored with free practice's text, which then cannot be replayed; so does gravity switched
+// on.
 TEST_F(StationTest, LiveModelChangesCarryTheLiverOnAndAreSessionEvents) {
   open(ToolKind::probe);
   const fs::path database = folder_ / "sessions.sqlite";
@@ -362,7 +363,17 @@ TEST_F(StationTest, LiveModelChangesCarryTheLiverOnAndAreSessionEvents) {
   ASSERT_TRUE(changes_[2].applied) << changes_[2].error;
   EXPECT_EQ(station_->described_scenario().parenchyma.elastic.youngs_modulus_pa,
             stiffer.elastic.youngs_modulus_pa);
-  EXPECT_TRUE(station_->tissue_changed_in_free_practice());
+  EXPECT_TRUE(station_->free_practice_changed());
+
+  // Gravity switched on: the scene's support comes with it, and the session says so.
+  ASSERT_TRUE(station_->change_gravity(true));
+  EXPECT_FALSE(station_->change_tissue(stiffer)) << "one change of the model at a time";
+  ASSERT_TRUE(frameUntil([&] { return changes_.size() == 4; }));
+  ASSERT_TRUE(changes_[3].applied) << changes_[3].error;
+  EXPECT_EQ(changes_[3].kind, ModelChangeOutcome::Kind::gravity);
+  ASSERT_TRUE(frameUntil([&] { return snapshot().model && snapshot().model->effects.gravity; }));
+  EXPECT_NE(snapshot().model->support, nullptr);
+  EXPECT_TRUE(station_->described_scenario().effects.gravity);
 
   ASSERT_FALSE(station_->use_device(DeviceChoice::mouse, WorkspaceMapping{}));
   station_->finish_metrics();
@@ -370,10 +381,11 @@ TEST_F(StationTest, LiveModelChangesCarryTheLiverOnAndAreSessionEvents) {
   std::vector<SessionEventKind> changes;
   for (const SessionEvent& e : store.events(session))
     if (e.kind == SessionEventKind::integrator_changed ||
-        e.kind == SessionEventKind::material_changed)
+        e.kind == SessionEventKind::material_changed || e.kind == SessionEventKind::gravity_changed)
       changes.push_back(e.kind);
   const std::vector<SessionEventKind> expected{SessionEventKind::integrator_changed,
-                                               SessionEventKind::material_changed};
+                                               SessionEventKind::material_changed,
+                                               SessionEventKind::gravity_changed};
   EXPECT_EQ(changes, expected);
   // The next session stores the changed tissue with free practice's text, and no replay set-up.
   play({{0.0, pressed + Eigen::Vector3d(0, 0, 20), 0},
@@ -383,8 +395,9 @@ TEST_F(StationTest, LiveModelChangesCarryTheLiverOnAndAreSessionEvents) {
   station_->finish_metrics();
   SqliteSessionStore after(database, SqliteSessionStore::Access::read_only);
   const std::string next_text = after.scenario_text(next);
-  EXPECT_NE(next_text.find("tissue changed: E "), std::string::npos) << next_text;
-  EXPECT_FALSE(after.replay_setup(next)) << "a changed free-practice tissue cannot be built again";
+  EXPECT_NE(next_text.find("changed: tissue E "), std::string::npos) << next_text;
+  EXPECT_NE(next_text.find("gravity 9.81 m/s2 toward (0, 0, -1)"), std::string::npos) << next_text;
+  EXPECT_FALSE(after.replay_setup(next)) << "a changed free practice cannot be built again";
 }
 
 // A scenario opened while a device session is recorded: the session of the old scene ends whole,

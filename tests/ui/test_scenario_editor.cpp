@@ -446,6 +446,42 @@ TEST_F(ScenarioEditorTest, SwitchingAnEffectOnIsMeasuredAgainAndShowsTheCostBesi
   EXPECT_EQ(scenario().title, "Costless");
 }
 
+// Gravity is switched on, pointed and sized in the Tissue and effects panel; each is one undo step,
+// the file keeps them, and while gravity is off its direction and strength are kept but greyed.
+TEST_F(ScenarioEditorTest, GravityIsSwitchedOnPointedSizedSavedAndUndone) {
+  auto* gravity = field<QCheckBox>("effectGravity");
+  auto* direction = field<QComboBox>("gravityDirection");
+  auto* strength = field<QDoubleSpinBox>("gravityStrength");
+  ASSERT_FALSE(scenario().effects.gravity);
+  EXPECT_FALSE(direction->isEnabled());
+  EXPECT_FALSE(strength->isEnabled());
+  EXPECT_EQ(direction->currentIndex(), 0);  // supine: the default direction
+  gravity->setChecked(true);
+  EXPECT_TRUE(scenario().effects.gravity);
+  EXPECT_TRUE(direction->isEnabled());
+  EXPECT_TRUE(strength->isEnabled());
+  direction->setCurrentIndex(1);
+  emit direction->activated(1);
+  EXPECT_EQ(scenario().effects.gravity_direction, (std::array<double, 3>{0.0, -1.0, 0.0}));
+  strength->setValue(4.9);
+  EXPECT_DOUBLE_EQ(scenario().effects.gravity_m_per_s2, 4.9);
+
+  const QString file = folder_.filePath("gravity.json");
+  ASSERT_TRUE(editor_->saveAs(file));
+  const ScenarioReading reading = read_scenario_file(file.toStdString());
+  ASSERT_TRUE(reading.scenario);
+  EXPECT_EQ(reading.scenario->effects, scenario().effects);
+
+  editor_->document().undoStack()->undo();  // the strength
+  EXPECT_DOUBLE_EQ(scenario().effects.gravity_m_per_s2, kEarthGravityMPerS2);
+  editor_->document().undoStack()->undo();  // the direction
+  EXPECT_EQ(direction->currentIndex(), 0);
+  editor_->document().undoStack()->undo();  // switched on
+  EXPECT_FALSE(scenario().effects.gravity);
+  EXPECT_FALSE(gravity->isChecked());
+  EXPECT_FALSE(strength->isEnabled());
+}
+
 TEST(ScenarioEditorInTheWorkstation, TryItRunsTheEditedScenarioAndTheEditorStartsFromTheShownOne) {
   QSettings().clear();
   MainWindow window(default_scene(1000));

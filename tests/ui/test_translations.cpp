@@ -3,8 +3,8 @@
 // everywhere, so the check can fail.
 #include "device_panel.h"
 #include "main_window.h"
-#include "wait_limits.h"
 #include "translations.h"
+#include "wait_limits.h"
 
 #include "liversim/meshing/default_scene.h"
 
@@ -101,15 +101,16 @@ std::vector<ShownText> shownTexts(const MainWindow& window) {
 }
 
 // What may stay in Latin letters in a Chinese interface: names (of the product, devices,
-// methods, file formats), units, the symbols of the tissue's parameters (E, n, k1...), key names
+// methods, file formats), units, the symbols of the tissue's parameters (E, n, k1...) and of
+// gravity's acceleration (g), key names
 // and shortcuts "（Ctrl+O）", mnemonics "(&F)", file names in docs/, numbers.
 QString withoutNamesAndUnits(QString text) {
   static const QRegularExpression allowed(QStringLiteral(
       R"(\(&[A-Z]\)|LiverSim|Phantom Omni|Geomagic Touch|OpenHaptics|libHD\.so|SQLite|JSON|)"
       R"(CSV|PDF|RK4|BDF2|Dormand|Prince|Gmsh|English|Shift|Ctrl|p99|)"
-      R"(（((Ctrl|Shift|Alt)\+)*[A-Z]）|docs/[\w.-]+\.md|kg/m³|)"
+      R"(（((Ctrl|Shift|Alt)\+)*[A-Z]）|docs/[\w.-]+\.md|kg/m³|m/s²|)"
       R"([-+]?\d+(\.\d+)?(e[-+]?\d+)?|)"
-      R"(\b(N|mm|m|s|ms|µm|nm|pm|mL|Pa|kPa|Hz|x|y|z|E|E1|E2|n|k1|k2)\b)"));
+      R"(\b(N|mm|m|s|ms|µm|nm|pm|mL|Pa|kPa|Hz|x|y|z|E|E1|E2|n|k1|k2|g)\b)"));
   return text.remove(allowed);
 }
 

@@ -1,8 +1,10 @@
 // The main window as a desktop product: the toolbar, trainee and instructor modes, the layout
-// remembered between starts, and the Material panel changing the running liver's tissue.
+// remembered between starts, and the Material panel changing the running liver's tissue and
+// switching gravity.
 #include <gtest/gtest.h>
 
 #include <QAction>
+#include <QCheckBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
 #include <QSettings>
@@ -211,6 +213,66 @@ TEST(Workstation, TheMaterialPanelChangesTheRunningLiversTissue) {
   ASSERT_TRUE(QTest::qWaitFor([&] { return finished.size() == 2; }, kTimeoutMs));
   EXPECT_EQ(window->simulation().model().regions[0].tissue.density_kg_per_m3, 1000.0);
   EXPECT_FALSE(window->changingTissue());
+}
+
+// Gravity is free practice's to choose, for a trainee too: switched on, the liver carries its
+// weight onto its bed (the support costs the step 1 − 1/√1.04, its contact frequency a fifth of the
+// mesh's); switched off, the model is as it was.
+TEST(Workstation, ATraineeSwitchesGravityInFreePracticeAndTheLiverSettlesOnItsBed) {
+  QSettings().clear();
+  auto window = openWindow();
+  ASSERT_FALSE(window->instructorMode());
+  ASSERT_TRUE(QTest::qWaitFor([&] { return simulatedTime(*window) > 0.0; }, kTimeoutMs));
+  auto* gravity = window->findChild<QCheckBox*>("materialGravity");
+  ASSERT_NE(gravity, nullptr);
+  EXPECT_TRUE(gravity->isEnabled());
+  EXPECT_FALSE(gravity->isChecked());
+  const double stepBefore_s = window->simulation().model().stable_time_step_s;
+  EXPECT_FALSE(window->simulation().model().effects.gravity);
+
+  QSignalSpy finished(window.get(), &MainWindow::gravityChangeFinished);
+  QTest::mouseClick(gravity, Qt::LeftButton, {}, QPoint(8, gravity->height() / 2));
+  ASSERT_TRUE(finished.wait(kTimeoutMs));
+  ASSERT_TRUE(finished.first().first().toBool())
+      << window->materialPanel()->errorText().toStdString();
+  {
+    const SimModel& model = window->simulation().model();
+    EXPECT_TRUE(model.effects.gravity);
+    EXPECT_EQ(model.gravity_m_per_s2, Eigen::Vector3d(0.0, 0.0, -9.81));
+    ASSERT_NE(model.support, nullptr);
+    EXPECT_NEAR(model.stable_time_step_s / stepBefore_s, 1.0 / std::sqrt(1.04), 1e-4);
+  }
+  EXPECT_TRUE(gravity->isChecked());
+  EXPECT_TRUE(window->station().described_scenario().effects.gravity);
+
+  // A fifth of a second later the free nodes have come down: each is 0.1 mm above its bed at rest,
+  // so all but those the ligament holds fall at least that far.
+  const double switched_s = simulatedTime(*window);
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return simulatedTime(*window) > switched_s + 0.2; }, kTimeoutMs));
+  {
+    const SimModel& model = window->simulation().model();
+    const SimulationSnapshot& snapshot = window->simulation().snapshot();
+    double drop_m = 0.0;
+    int free = 0;
+    for (std::size_t n = 0; n < model.node_count; ++n) {
+      if (model.is_fixed[n]) continue;
+      drop_m += model.rest_position_m.z[n] - snapshot.position_m.z[n];
+      ++free;
+    }
+    drop_m /= free;
+    EXPECT_GT(drop_m, 0.5e-4) << "the liver did not come down";
+  }
+
+  finished.clear();
+  QTest::mouseClick(gravity, Qt::LeftButton, {}, QPoint(8, gravity->height() / 2));
+  ASSERT_TRUE(finished.wait(kTimeoutMs));
+  ASSERT_TRUE(finished.first().first().toBool());
+  const SimModel& model = window->simulation().model();
+  EXPECT_FALSE(model.effects.gravity);
+  EXPECT_EQ(model.support, nullptr);
+  EXPECT_DOUBLE_EQ(model.stable_time_step_s, stepBefore_s);
+  EXPECT_FALSE(gravity->isChecked());
 }
 
 }  // namespace

@@ -109,12 +109,39 @@ double spring_energy_j(std::span<const NodeSpring> springs, const NodeArray& pos
   return energy;
 }
 
+double gravity_potential_energy_j(const SimModel& model, const NodeArray& position) {
+  if (!model.effects.gravity) return 0.0;
+  const Eigen::Vector3d& g = model.gravity_m_per_s2;
+  const NodeArray& rest = model.rest_position_m;
+  double energy = 0.0;
+  for (std::size_t n = 0; n < model.node_count; ++n)
+    energy -= model.lumped_mass_kg[n] * (g.x() * (position.x[n] - rest.x[n]) +
+                                         g.y() * (position.y[n] - rest.y[n]) +
+                                         g.z() * (position.z[n] - rest.z[n]));
+  return energy;
+}
+
+double support_energy_j(const SimModel& model, const NodeArray& position) {
+  if (!model.support) return 0.0;
+  double energy = 0.0;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    if (model.is_fixed[n]) continue;
+    const Eigen::Vector3d x = position.at(n);
+    const double past = x.dot(model.support->down) - model.support->depth_under(x).depth_m;
+    if (past > 0.0)
+      energy += 0.5 * model.lumped_mass_kg[n] * model.support_stiffness_per_kg * past * past;
+  }
+  return energy;
+}
+
 EnergyBalance energy_balance(const SimModel& model, const SimState& state,
                              const StepInputs& inputs) {
   EnergyBalance balance;
   balance.kinetic_j = kinetic_energy_j(model, state.velocity_m_per_s);
   balance.tissue_j = tissue_energy_j(model, state);
   balance.spring_j = spring_energy_j(inputs.springs, state.position_m);
+  balance.gravity_j = gravity_potential_energy_j(model, state.position_m);
+  balance.support_j = support_energy_j(model, state.position_m);
   balance.initial_j = state.energy.initial_j;
   balance.tool_work_j = state.energy.tool_work_j;
   balance.viscous_dissipated_j = state.energy.viscous_dissipated_j;

@@ -584,6 +584,37 @@ void add_external_forces(const StepInputs& inputs, const NodeArray& position, No
   }
 }
 
+void add_gravity_forces(const SimModel& model, NodeArray& force) {
+  if (!model.effects.gravity) return;
+  const Eigen::Vector3d g = model.gravity_m_per_s2;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    const double mass = model.lumped_mass_kg[n];
+    force.x[n] += mass * g.x();
+    force.y[n] += mass * g.y();
+    force.z[n] += mass * g.z();
+  }
+}
+
+void add_support_forces(const SimModel& model, const NodeArray& position, NodeArray& force) {
+  if (!model.support) return;
+  const SupportSurface& support = *model.support;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    if (model.is_fixed[n]) continue;
+    const Eigen::Vector3d x = position.at(n);
+    const SupportSurface::Depth under = support.depth_under(x);
+    const double past = x.dot(support.down) - under.depth_m;
+    if (!(past > 0.0)) continue;
+    // −∇(½·k·p²), p = x·down − depth(u, v).
+    const double k = model.lumped_mass_kg[n] * model.support_stiffness_per_kg;
+    const Eigen::Vector3d push =
+        -k * past *
+        (support.down - under.slope_u * support.axis_u - under.slope_v * support.axis_v);
+    force.x[n] += push.x();
+    force.y[n] += push.y();
+    force.z[n] += push.z();
+  }
+}
+
 double strain_energy_j(const SimModel& model, const NodeArray& position) {
   double energy = 0.0;
   for (std::size_t e = 0; e < model.tet_count; ++e)

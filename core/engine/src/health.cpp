@@ -1,5 +1,7 @@
 #include "liversim/engine/health.h"
 
+#include "liversim/engine/energy.h"
+
 #include "integrator_internal.h"
 
 #include <algorithm>
@@ -30,8 +32,11 @@ std::string_view health_problem_text(HealthProblem problem) {
 HealthProblem check_health(const SimModel& model, const SimState& state,
                            const GuardOptions& options) {
   const double limit_sq = options.speed_limit_m_per_s * options.speed_limit_m_per_s;
-  // Twice the kinetic energy a node may hold (1e-12 J above zero: round-off at rest).
-  const double supplied = state.energy.initial_j + state.energy.tool_work_j;
+  // Twice the kinetic energy a node may hold (1e-12 J above zero: round-off at rest). Gravity
+  // supplies what its potential has fallen by since rest (energy.h's gravity_j, negated).
+  double supplied = state.energy.initial_j + state.energy.tool_work_j;
+  if (model.effects.gravity)
+    supplied += std::max(0.0, -gravity_potential_energy_j(model, state.position_m));
   const double twice_allowed_j =
       2.0 * ((1.0 + options.kinetic_energy_slack) * std::max(supplied, 0.0) + 1e-12);
   const auto& x = state.position_m;

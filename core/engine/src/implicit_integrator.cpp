@@ -355,7 +355,7 @@ void advance_implicit(const SimModel& model, SimState& state, const StepInputs& 
       const ElasticEvaluation seen =
           compute_internal_forces_rate_form(model, state, position, arm, solver.force);
       ++report.force_evaluations;
-      add_input_forces(inputs, position, velocity, solver.force);
+      add_input_forces(model, inputs, position, velocity, solver.force);
       for (std::size_t n = 0; n < n_nodes; ++n) {
         const double mass = model.lumped_mass_kg[n];
         const bool fixed = model.is_fixed[n] != 0;

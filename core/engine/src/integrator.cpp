@@ -23,11 +23,15 @@ ElasticEvaluation evaluate_forces(const SimModel& model, SimState& state,
   std::fill(external.y.begin(), external.y.end(), 0.0);
   std::fill(external.z.begin(), external.z.end(), 0.0);
   add_external_forces(inputs, state.position_m, external);
+  add_gravity_forces(model, external);
   for (std::size_t n = 0; n < model.node_count; ++n) {
     state.force_n.x[n] += external.x[n];
     state.force_n.y[n] += external.y[n];
     state.force_n.z[n] += external.z[n];
   }
+  // The support's push depends on where the nodes are, as the tissue's does: not an input whose
+  // change the kick splits.
+  add_support_forces(model, state.position_m, state.force_n);
   for (const auto& spring : inputs.springs)
     state.spring_damping_per_s[spring.node] +=
         spring.damping_n_s_per_m * model.inverse_mass_per_kg[spring.node];
@@ -160,6 +164,11 @@ void accumulate(StepReport& total, const StepReport& part) {
             ? std::min(total.smallest_stable_step_s, part.smallest_stable_step_s)
             : part.smallest_stable_step_s;
   total.stability_limited_steps += part.stability_limited_steps;
+  total.smallest_mesh_limit_s = std::min(total.smallest_mesh_limit_s, part.smallest_mesh_limit_s);
+  total.smallest_travel_limit_s =
+      std::min(total.smallest_travel_limit_s, part.smallest_travel_limit_s);
+  total.smallest_spring_limit_s =
+      std::min(total.smallest_spring_limit_s, part.smallest_spring_limit_s);
   total.rejected_steps += part.rejected_steps;
   total.force_evaluations += part.force_evaluations;
   total.newton_iterations += part.newton_iterations;
@@ -177,9 +186,11 @@ double max_frequency_rad_per_s(const SimModel& model, const StepInputs& inputs, 
     max_spring_omega_sq = std::max(
         max_spring_omega_sq, spring.stiffness_n_per_m * model.inverse_mass_per_kg[spring.node]);
   }
+  // The support's penalty adds its ω² to any node it pushes (Weyl: the largest eigenvalue of a
+  // sum is at most the sum of the largest).
   return std::sqrt(model.max_frequency_rad_per_s * model.max_frequency_rad_per_s *
                        std::max(1.0, stiffening) +
-                   max_spring_omega_sq);
+                   max_spring_omega_sq + model.support_stiffness_per_kg);
 }
 
 double stable_time_step_s(const SimModel& model, const StepInputs& inputs, double stiffening) {
@@ -346,9 +357,11 @@ void prepare_integrator_scratch(const SimModel& model, IntegratorScratch& scratc
   }
 }
 
-void add_input_forces(const StepInputs& inputs, const NodeArray& position,
+void add_input_forces(const SimModel& model, const StepInputs& inputs, const NodeArray& position,
                       const NodeArray& velocity, NodeArray& force) {
   add_external_forces(inputs, position, force);
+  add_gravity_forces(model, force);
+  add_support_forces(model, position, force);
   for (const auto& spring : inputs.springs) {
     const auto n = spring.node;
     force.x[n] -= spring.damping_n_s_per_m * velocity.x[n];
@@ -426,8 +439,15 @@ void advance_central_difference(const SimModel& model, SimState& state, const St
     ++report.force_evaluations;
     report.max_stiffening = std::max(report.max_stiffening, stiffening);
     double limit = stable_time_step_s(model, inputs, stiffening);
-    if (state.max_speed_m_per_s > 0.0)
-      limit = std::min(limit, 0.1 * model.min_element_height_m / state.max_speed_m_per_s);
+    report.smallest_spring_limit_s = std::min(report.smallest_spring_limit_s, limit);
+    report.smallest_mesh_limit_s =
+        std::min(report.smallest_mesh_limit_s,
+                 inputs.springs.empty() ? limit : stable_time_step_s(model, {}, stiffening));
+    if (state.max_speed_m_per_s > 0.0) {
+      const double travel_limit = 0.1 * model.min_element_height_m / state.max_speed_m_per_s;
+      report.smallest_travel_limit_s = std::min(report.smallest_travel_limit_s, travel_limit);
+      limit = std::min(limit, travel_limit);
+    }
     double step = limit;
     if (requested_s > 0.0) {
       step = std::min(requested_s, limit);

@@ -15,9 +15,9 @@ std::uint64_t fingerprint(const StepInputs& inputs);
 // Sizes the scratch of the model's integrator (allocation happens here, never while stepping).
 void prepare_integrator_scratch(const SimModel& model, IntegratorScratch& scratch);
 
-// Adds the external forces of `inputs` at `position` to `force` and the springs' damping force
-// at `velocity`.
-void add_input_forces(const StepInputs& inputs, const NodeArray& position,
+// Adds the external forces of `inputs` at `position` to `force`, the model's gravity, and the
+// springs' damping force at `velocity`.
+void add_input_forces(const SimModel& model, const StepInputs& inputs, const NodeArray& position,
                       const NodeArray& velocity, NodeArray& force);
 
 // Acceleration of each node from the total force and the velocity (mass-proportional damping

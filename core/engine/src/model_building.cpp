@@ -80,6 +80,10 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
     throw std::invalid_argument("mass damping must be a finite value >= 0 (1/s)");
   if (!(options.stable_step_safety > 0.0 && options.stable_step_safety <= 1.0))
     throw std::invalid_argument("stable step safety factor must be in (0, 1]");
+  if (!options.gravity_m_per_s2.allFinite())
+    throw std::invalid_argument("gravity must be a finite acceleration (m/s²)");
+  if (!(options.support_frequency_fraction > 0.0 && options.support_frequency_fraction <= 1.0))
+    throw std::invalid_argument("the support's frequency fraction must be in (0, 1]");
   validate_integrator(options.integrator);
 
   SimModel model;
@@ -90,6 +94,10 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   model.mass_damping_per_s = options.mass_damping_per_s;
   model.stable_step_safety = options.stable_step_safety;
   model.integrator = options.integrator;
+  // Gravity and the support are set with the stable step, at the end (set_gravity).
+  model.gravity_m_per_s2 = options.gravity_m_per_s2;
+  model.support = options.support;
+  model.support_frequency_fraction = options.support_frequency_fraction;
 
   const std::size_t tets = model.tet_count;
   for (auto& entry : model.dm_inverse) entry.resize(tets);
@@ -224,6 +232,19 @@ void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& re
     model.inverse_mass_per_kg[n] = free ? 1.0 / model.lumped_mass_kg[n] : 0.0;
   }
   model.max_frequency_rad_per_s = estimate_max_frequency_rad_per_s(model, model.rest_position_m);
+  set_gravity(model, model.gravity_m_per_s2, model.support);
+}
+
+void set_gravity(SimModel& model, const Eigen::Vector3d& gravity_m_per_s2,
+                 std::shared_ptr<const SupportSurface> support) {
+  if (!gravity_m_per_s2.allFinite())
+    throw std::invalid_argument("gravity must be a finite acceleration (m/s²)");
+  model.gravity_m_per_s2 = gravity_m_per_s2;
+  model.effects.gravity = !gravity_m_per_s2.isZero(0.0);
+  model.support = std::move(support);
+  // The support's contact frequency follows the mesh's: a stiffer tissue, a stiffer support.
+  const double support_omega = model.support_frequency_fraction * model.max_frequency_rad_per_s;
+  model.support_stiffness_per_kg = model.support ? support_omega * support_omega : 0.0;
   model.stable_time_step_s = stable_time_step_s(model, StepInputs{});
 }
 

@@ -50,7 +50,7 @@ double evaluate_rate(const SimModel& model, SimState& state, const StepInputs& i
   const ViscousArmInputs arm{q, s.keep_by_region, s.elastic_weight_by_region, s.elastic_stress};
   const ElasticEvaluation seen =
       compute_internal_forces_rate_form(model, state, x, arm, acceleration);
-  add_input_forces(inputs, x, v, acceleration);
+  add_input_forces(model, inputs, x, v, acceleration);
   acceleration_from_force(model, acceleration, v, acceleration);  // in place: per node
   s.position_rate[slot].x = v.x;
   s.position_rate[slot].y = v.y;

@@ -3,6 +3,7 @@
 #include "liversim/engine/integrator.h"
 #include "liversim/engine/mesh_io.h"
 #include "liversim/engine/parameter_ranges.h"
+#include "liversim/engine/support.h"
 #include "liversim/engine/surface.h"
 #include "liversim/meshing/liver_geometry.h"
 #include "liversim/meshing/surface_import.h"
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -436,13 +438,20 @@ std::vector<LesionSpec> read_lesions(const Json& value, std::vector<ScenarioErro
 EffectsSpec read_effects(const Json& value, std::vector<ScenarioError>& errors) {
   EffectsSpec effects;
   Fields f(value, "effects", errors,
-           {"near_incompressibility", "viscoelastic", "viscoplastic", "fibres"});
+           {"near_incompressibility", "viscoelastic", "viscoplastic", "fibres", "gravity",
+            "gravity_direction", "gravity_m_per_s2"});
   if (!f.is_object()) return effects;
   effects.near_incompressibility =
       f.boolean("near_incompressibility", false).value_or(effects.near_incompressibility);
   effects.viscoelastic = f.boolean("viscoelastic", false).value_or(false);
   effects.viscoplastic = f.boolean("viscoplastic", false).value_or(false);
   effects.fibres = f.boolean("fibres", false).value_or(false);
+  effects.gravity = f.boolean("gravity", false).value_or(false);
+  effects.gravity_direction =
+      f.direction("gravity_direction", false).value_or(effects.gravity_direction);
+  effects.gravity_m_per_s2 = f.number("gravity_m_per_s2", kMinGravityMPerS2, kMaxGravityMPerS2,
+                                      "m/s²", false, "gravity's strength")
+                                 .value_or(effects.gravity_m_per_s2);
   return effects;
 }
 
@@ -558,8 +567,10 @@ std::vector<RubricCriterion> read_rubric(const Json& value, std::vector<Scenario
       });
 }
 
-// Older format versions, step by step up to the current one. Version 1 is the first: nothing to
-// migrate yet; a version-2 format adds its step here (and a test with a version-1 file).
+// Older format versions, step by step up to the current one. Version 2 added effects.gravity and
+// its direction and strength; a version-1 file has none, which reads as gravity off, so there is
+// nothing to rewrite. A later version adds its step here (and a test with a file of the one
+// before).
 void migrate(Json& /*document*/, int /*from_version*/) {}
 
 // Thresholds of relative agreement.
@@ -587,6 +598,12 @@ const MetricInfo* find_metric(std::string_view name) {
   for (const MetricInfo& m : kMetrics)
     if (m.name == name) return &m;
   return nullptr;
+}
+
+Eigen::Vector3d gravity_acceleration_m_per_s2(const EffectsSpec& effects) {
+  if (!effects.gravity) return Eigen::Vector3d::Zero();
+  const auto& d = effects.gravity_direction;
+  return effects.gravity_m_per_s2 * Eigen::Vector3d(d[0], d[1], d[2]).normalized();
 }
 
 std::string_view task_name(TaskKind kind) {
@@ -644,6 +661,20 @@ std::vector<ScenarioError> validate(const Scenario& s) {
   if (s.effects.fibres && !t.fibres)
     fail("parenchyma.fibres",
          "missing: expected {k1_pa, k2, direction} since effects.fibres is true");
+  // Checked whether gravity is on or not: the editor keeps them for when it is switched on.
+  if (!(s.effects.gravity_m_per_s2 >= kMinGravityMPerS2 &&
+        s.effects.gravity_m_per_s2 <= kMaxGravityMPerS2))
+    fail("effects.gravity_m_per_s2", format_number(s.effects.gravity_m_per_s2) +
+                                         " is invalid: expected gravity's strength, " +
+                                         format_number(kMinGravityMPerS2) + " to " +
+                                         format_number(kMaxGravityMPerS2) + " m/s²");
+  {
+    const auto& d = s.effects.gravity_direction;
+    const double length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!(length > 1e-12) || !std::isfinite(length))
+      fail("effects.gravity_direction",
+           "is invalid: expected a direction (three finite numbers, not all 0)");
+  }
   if (s.effects.viscoelastic && t.viscoelastic) {
     const double sum = t.viscoelastic->instantaneous_modulus_pa();
     if (!nearly_equal(sum, t.elastic.youngs_modulus_pa))
@@ -910,7 +941,10 @@ std::string write_scenario(const Scenario& s) {
   doc["effects"] = {{"near_incompressibility", s.effects.near_incompressibility},
                     {"viscoelastic", s.effects.viscoelastic},
                     {"viscoplastic", s.effects.viscoplastic},
-                    {"fibres", s.effects.fibres}};
+                    {"fibres", s.effects.fibres},
+                    {"gravity", s.effects.gravity},
+                    {"gravity_direction", triple(s.effects.gravity_direction)},
+                    {"gravity_m_per_s2", s.effects.gravity_m_per_s2}};
   doc["integrator"] = {{"kind", integrator_name(s.integrator.kind)},
                        {"step_s", s.integrator.step_s},
                        {"tolerance_m", s.integrator.tolerance_m}};
@@ -1058,6 +1092,11 @@ SceneSetup build_scene(const Scenario& s, const std::filesystem::path& scenario_
     options.fibre_field.first_family = {Eigen::Vector3d(d[0], d[1], d[2])};
   }
   options.average_nodal_pressure = s.effects.near_incompressibility;
+  options.gravity_m_per_s2 = gravity_acceleration_m_per_s2(s.effects);
+  // Gravity pulls the organ onto its bed, and a freed piece onto the tray beside it (support.h).
+  if (s.effects.gravity)
+    options.support =
+        std::make_shared<const SupportSurface>(support_under(mesh, options.gravity_m_per_s2));
   options.integrator = s.integrator;
 
   // Lesions: regions 1, 2, ... over the elements whose centroid lies in the ellipsoid.

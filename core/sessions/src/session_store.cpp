@@ -9,7 +9,7 @@ namespace liversim {
 
 namespace {
 
-constexpr std::array<std::string_view, 11> kEventNames = {"grasp",
+constexpr std::array<std::string_view, 12> kEventNames = {"grasp",
                                                           "release",
                                                           "cut",
                                                           "excessive_force",
@@ -19,7 +19,8 @@ constexpr std::array<std::string_view, 11> kEventNames = {"grasp",
                                                           "tool_selected",
                                                           "lesion_marked",
                                                           "integrator_changed",
-                                                          "material_changed"};
+                                                          "material_changed",
+                                                          "gravity_changed"};
 
 // Layout 1: "LSF1", the frame count (u32), then one column per quantity, frame by frame: time,
 // position x, y, z, velocity x, y, z, force x, y, z (IEEE doubles), buttons (u32). Columns keep

@@ -148,6 +148,7 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   }
   stroke_.add(edge);
   if (stroke_.edges_m.size() < 2) return;
+  const auto update_start = std::chrono::steady_clock::now();
   // Once in, the edge cuts whatever it is drawn through: the stress at a sharp edge in the tissue
   // (a crack front) is unbounded, which no element's average resolves, so the threshold decides
   // only where the blade breaks in. Otherwise the tissue, relaxed around a still blade, would let
@@ -155,7 +156,22 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   CuttingSettings propagating = *cutting_;
   propagating.cutting_stress_pa = 0.0;
   CutResult cut = cut_tissue(*model_, state_, stroke_, propagating);
-  if (!cut.cut()) return;
+  const auto trace_cut = [&](bool parted) {
+    if (!trace_) return;
+    LoopRecord record;
+    record.kind = LoopRecord::Kind::cut;
+    record.wall_s = trace_wall_s();
+    record.simulated_s = state_.time_s;
+    record.blade_in_tissue = blade_in_tissue_;
+    record.cut_update_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - update_start).count();
+    record.parted = parted;
+    record.tets = model_->tet_count;
+    record.model_stable_step_s = model_->stable_time_step_s;
+    record.min_element_height_m = model_->min_element_height_m;
+    trace_->push(record);
+  };
+  if (!cut.cut()) return trace_cut(false);
   {
     std::lock_guard lock(outcome_mutex_);
     if (outcome_) {
@@ -177,6 +193,16 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   active_springs_.clear();
   ++topology_version_;
   resected_volume_m3_ += cut.report.resected_volume_m3;
+  trace_cut(true);
+}
+
+void RealtimeSimulation::trace_loop(SpscRing<LoopRecord>* trace) {
+  if (running()) throw std::logic_error("trace_loop: stop the simulation first");
+  trace_ = trace;
+}
+
+double RealtimeSimulation::trace_wall_s() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start_).count();
 }
 
 void RealtimeSimulation::track_outcome(std::optional<Eigen::Vector3d> lift_point_m,
@@ -478,6 +504,7 @@ void RealtimeSimulation::run() {
   using Seconds = std::chrono::duration<double>;
   StepAccumulator clock(step_s_, max_steps_per_cycle_);
   auto last_cycle = Clock::now();
+  loop_start_ = last_cycle;
 
   // The statistics window: what the integrator reported, the wall time it took and whether the
   // cap bit, since the window began.
@@ -544,6 +571,27 @@ void RealtimeSimulation::run() {
       }
       behind_ = window_capped;
       dropped_s_ = dropped_s;
+      if (trace_) {
+        LoopRecord record;
+        record.kind = LoopRecord::Kind::window;
+        record.wall_s = Seconds(now - loop_start_).count();
+        record.simulated_s = state_.time_s;
+        record.blade_in_tissue = blade_in_tissue_;
+        record.window_wall_s = window_s;
+        record.window_simulated_s = simulated_s;
+        record.integrating_s = window_integrating_s;
+        record.behind = window_capped;
+        record.steps = window_report.substeps;
+        record.force_evaluations = window_report.force_evaluations;
+        record.stability_limited_steps = window_report.stability_limited_steps;
+        record.smallest_step_s =
+            window_report.substeps > 0 ? window_report.smallest_substep_s : 0.0;
+        record.smallest_stable_step_s = window_report.smallest_stable_step_s;
+        record.smallest_mesh_limit_s = window_report.smallest_mesh_limit_s;
+        record.smallest_travel_limit_s = window_report.smallest_travel_limit_s;
+        record.smallest_spring_limit_s = window_report.smallest_spring_limit_s;
+        trace_->push(record);
+      }
       window_start = now;
       window_sim_start_s = state_.time_s;
       window_start_steps = state_.step_count;

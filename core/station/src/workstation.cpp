@@ -70,6 +70,15 @@ std::string describe_tissue(const TissueSpec& tissue, const EffectsSpec& effects
   return text.str();
 }
 
+std::string describe_gravity(const EffectsSpec& effects) {
+  if (!effects.gravity) return "off";
+  const auto& d = effects.gravity_direction;
+  std::ostringstream text;
+  text << effects.gravity_m_per_s2 << " m/s2 toward (" << d[0] << ", " << d[1] << ", " << d[2]
+       << ")";
+  return text.str();
+}
+
 Workstation::Workstation(SceneSetup setup, std::optional<OpenedScenario> scenario,
                          StationListener listener)
     : listener_(std::move(listener)), scenario_(std::move(scenario)) {
@@ -103,7 +112,7 @@ void Workstation::install_scene(SceneSetup setup, std::shared_ptr<const SimModel
   setup_ = std::move(setup);
   scene_model_ = std::move(model);
   shown_topology_ = 0;
-  tissue_changed_in_free_practice_ = false;
+  free_practice_changed_ = false;
 }
 
 void Workstation::restart_from_rest() {
@@ -137,11 +146,18 @@ Scenario Workstation::described_scenario() const {
   }
   s.effects = {options.average_nodal_pressure, parenchyma.viscoelastic.has_value(),
                parenchyma.viscoplastic.has_value(), s.parenchyma.fibres.has_value()};
+  if (const Eigen::Vector3d& g = options.gravity_m_per_s2; !g.isZero(0.0)) {
+    s.effects.gravity = true;
+    s.effects.gravity_m_per_s2 = g.norm();
+    s.effects.gravity_direction = {g.x() / g.norm(), g.y() / g.norm(), g.z() / g.norm()};
+  }
+  s.organ.target_tet_count = setup_.built_in_liver_tets.value_or(s.organ.target_tet_count);
+  s.integrator = options.integrator;
   return s;
 }
 
 bool Workstation::busy_building() const {
-  return changing_integrator_ || changing_tissue_ || opening_scenario_;
+  return changing_integrator_ || changing_tissue_ || changing_gravity_ || opening_scenario_;
 }
 
 bool Workstation::open_scenario(OpenedScenario opened, const std::filesystem::path& folder) {
@@ -219,21 +235,22 @@ bool Workstation::change_integrator(const IntegratorSettings& settings) {
   std::shared_ptr<const SimModel> cut =
       shown_topology_ > 0 ? simulation_->snapshot().model : nullptr;
   // Reads setup_.mesh on the worker: it changes only when no model is being built.
-  start_model_change({settings, std::nullopt}, [this, options = std::move(options), settings, cut] {
-    ModelChangeBuilt built;
-    if (cut) {
-      validate_integrator(settings);
-      auto changed = std::make_shared<SimModel>(*cut);
-      changed->integrator = settings;
-      changed->stable_time_step_s = stable_time_step_s(*changed, StepInputs{});
-      built.model = std::move(changed);
-    } else {
-      // build_model checks the settings first, so a bad entry is refused at once.
-      built.model = std::make_shared<const SimModel>(build_model(setup_.mesh, options));
-      built.rest_model = built.model;
-    }
-    return built;
-  });
+  start_model_change(
+      {settings, std::nullopt, std::nullopt}, [this, options = std::move(options), settings, cut] {
+        ModelChangeBuilt built;
+        if (cut) {
+          validate_integrator(settings);
+          auto changed = std::make_shared<SimModel>(*cut);
+          changed->integrator = settings;
+          changed->stable_time_step_s = stable_time_step_s(*changed, StepInputs{});
+          built.model = std::move(changed);
+        } else {
+          // build_model checks the settings first, so a bad entry is refused at once.
+          built.model = std::make_shared<const SimModel>(build_model(setup_.mesh, options));
+          built.rest_model = built.model;
+        }
+        return built;
+      });
   return true;
 }
 
@@ -250,16 +267,45 @@ bool Workstation::change_tissue(const TissueSpec& tissue) {
   // The model running (cut or not) and the scene's uncut one, which a restart from rest runs.
   std::shared_ptr<const SimModel> running = simulation_->snapshot().model;
   std::shared_ptr<const SimModel> rest = scene_model_;
-  start_model_change({std::nullopt, tissue}, [regions = std::move(regions), running, rest] {
-    const auto changed = [&](const SimModel& model) {
-      auto copy = std::make_shared<SimModel>(model);
-      set_region_materials(*copy, regions);
-      return copy;
-    };
-    ModelChangeBuilt built;
-    built.model = changed(*running);
-    built.rest_model = running == rest ? built.model : changed(*rest);
-    return built;
+  start_model_change(
+      {std::nullopt, tissue, std::nullopt}, [regions = std::move(regions), running, rest] {
+        return changed_models(running, rest,
+                              [&](SimModel& model) { set_region_materials(model, regions); });
+      });
+  return true;
+}
+
+Workstation::ModelChangeBuilt Workstation::changed_models(
+    const std::shared_ptr<const SimModel>& running, const std::shared_ptr<const SimModel>& rest,
+    const std::function<void(SimModel&)>& change) {
+  const auto changed = [&](const SimModel& model) {
+    auto copy = std::make_shared<SimModel>(model);
+    change(*copy);
+    return copy;
+  };
+  ModelChangeBuilt built;
+  built.model = changed(*running);
+  built.rest_model = running == rest ? built.model : changed(*rest);
+  return built;
+}
+
+bool Workstation::change_gravity(bool on) {
+  if (busy_building()) return false;
+  EffectsSpec effects = described_scenario().effects;
+  effects.gravity = on;
+  const Eigen::Vector3d gravity_m_per_s2 = gravity_acceleration_m_per_s2(effects);
+  changing_gravity_ = true;
+  std::shared_ptr<const SimModel> running = simulation_->snapshot().model;
+  std::shared_ptr<const SimModel> rest = scene_model_;
+  // Reads setup_.mesh on the worker: it changes only when no model is being built.
+  start_model_change({std::nullopt, std::nullopt, on}, [this, gravity_m_per_s2, running, rest] {
+    // The support is the scene's organ at rest: the same under a cut liver.
+    std::shared_ptr<const SupportSurface> support;
+    if (!gravity_m_per_s2.isZero(0.0))
+      support =
+          std::make_shared<const SupportSurface>(support_under(setup_.mesh, gravity_m_per_s2));
+    return changed_models(running, rest,
+                          [&](SimModel& model) { set_gravity(model, gravity_m_per_s2, support); });
   });
   return true;
 }
@@ -281,15 +327,18 @@ void Workstation::start_model_change(ModelChange change, std::function<ModelChan
 void Workstation::finish_model_change(const ModelChange& change, const ModelChangeBuilt& built,
                                       const std::string& error) {
   ModelChangeOutcome outcome;
-  outcome.kind =
-      change.integrator ? ModelChangeOutcome::Kind::integrator : ModelChangeOutcome::Kind::tissue;
+  outcome.kind = change.integrator ? ModelChangeOutcome::Kind::integrator
+                 : change.gravity  ? ModelChangeOutcome::Kind::gravity
+                                   : ModelChangeOutcome::Kind::tissue;
   const auto report = [&] {
     if (change.integrator)
       changing_integrator_ = false;
+    else if (change.gravity)
+      changing_gravity_ = false;
     else
       changing_tissue_ = false;
     if (listener_.model_changed) listener_.model_changed(outcome);
-    if (!change.integrator) apply_pending_tissue();
+    if (change.tissue) apply_pending_tissue();
   };
   if (!built.model) {
     outcome.error = error;
@@ -339,6 +388,19 @@ void Workstation::finish_model_change(const ModelChange& change, const ModelChan
       recorder_->record_event({now_s, SessionEventKind::integrator_changed,
                                std::string(integrator_name(settings.kind))});
     setup_.model_options.integrator = settings;
+  } else if (change.gravity) {
+    setup_.model_options.gravity_m_per_s2 = model->gravity_m_per_s2;
+    setup_.model_options.support = model->support;
+    if (scenario_) {
+      // Sessions recorded from now on store the scenario as it runs, so that they replay with it.
+      scenario_->scenario.effects.gravity = *change.gravity;
+      scenario_->text = write_scenario(scenario_->scenario);
+    } else {
+      free_practice_changed_ = true;
+    }
+    if (recorder_)
+      recorder_->record_event({now_s, SessionEventKind::gravity_changed,
+                               describe_gravity(described_scenario().effects)});
   } else {
     const TissueSpec& tissue = *change.tissue;
     const EffectsSpec effects = described_scenario().effects;  // a tissue change keeps them
@@ -351,7 +413,7 @@ void Workstation::finish_model_change(const ModelChange& change, const ModelChan
       scenario_->scenario.parenchyma = tissue;
       scenario_->text = write_scenario(scenario_->scenario);
     } else {
-      tissue_changed_in_free_practice_ = true;
+      free_practice_changed_ = true;
     }
   }
   outcome.applied = true;
@@ -506,9 +568,18 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
 }
 
 void Workstation::attach_device() {
+  simulation_->trace_loop(loop_trace_);  // every simulation the station makes is traced alike
   if (!servo_) return;
   simulation_->set_haptic_servo(servo_.get());
   simulation_->set_device_tool(device_tool());
+}
+
+void Workstation::trace_loop(SpscRing<LoopRecord>* trace) {
+  loop_trace_ = trace;
+  const bool running = simulation_->running();
+  simulation_->stop();
+  simulation_->trace_loop(trace);
+  if (running) simulation_->start();
 }
 
 void Workstation::detach_device() {
@@ -598,16 +669,17 @@ bool Workstation::begin_recording() {
     // Free practice has no file: the text names the scene it ran.
     start.scenario_title = "Free practice";
     start.scenario_text = free_practice_text(setup_.mesh.tet_count());
-    if (tissue_changed_in_free_practice_) {
+    if (free_practice_changed_) {
       const Scenario described = described_scenario();
-      start.scenario_text +=
-          ", tissue changed: " + describe_tissue(described.parenchyma, described.effects);
+      start.scenario_text += ", changed: tissue " +
+                             describe_tissue(described.parenchyma, described.effects) +
+                             ", gravity " + describe_gravity(described.effects);
     }
     replay.built_in_liver_tets = setup_.built_in_liver_tets;
   }
-  // Free practice stores only its element count: a tissue changed in it cannot be built again.
-  if (scenario_ || (setup_.built_in_liver_tets && !tissue_changed_in_free_practice_))
-    start.replay = replay;
+  // Free practice stores only its element count: a tissue or gravity changed in it cannot be
+  // built again.
+  if (scenario_ || (setup_.built_in_liver_tets && !free_practice_changed_)) start.replay = replay;
   start.device = device_name();
   start.started_unix_ms = unix_ms_now();
   start.mapping = servo_->mapping();

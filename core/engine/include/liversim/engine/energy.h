@@ -21,11 +21,14 @@ struct EnergyBalance {
   double kinetic_j = 0.0;
   double tissue_j = 0.0;  // stored in the tissue (tissue_energy_j)
   double spring_j = 0.0;  // stored in the tool springs
+  // Gravitational potential relative to rest, −Σ m·g·(x − X) (0 without the gravity effect).
+  double gravity_j = 0.0;
+  double support_j = 0.0;  // stored in the support's penalty springs (support.h)
   double initial_j = 0.0;
   double tool_work_j = 0.0;
   double viscous_dissipated_j = 0.0;  // part of dissipated_j(): by the Maxwell arms' dashpots
 
-  double held_j() const { return kinetic_j + tissue_j + spring_j; }
+  double held_j() const { return kinetic_j + tissue_j + spring_j + gravity_j + support_j; }
   double supplied_j() const { return initial_j + tool_work_j; }
   // By viscosity, plastic flow, damping and the scheme; negative: energy created.
   double dissipated_j() const { return supplied_j() - held_j(); }
@@ -43,6 +46,10 @@ struct EnergyBalance {
 // nothing; one pass over the elements.
 double tissue_energy_j(const SimModel& model, const SimState& state);
 double spring_energy_j(std::span<const NodeSpring> springs, const NodeArray& position);
+// −Σ m·g·(x − X) over the nodes: the work gravity would do bringing the organ back to rest.
+double gravity_potential_energy_j(const SimModel& model, const NodeArray& position);
+// Σ ½·k·p² over the free nodes deeper than the model's support by p (0 without one).
+double support_energy_j(const SimModel& model, const NodeArray& position);
 
 EnergyBalance energy_balance(const SimModel& model, const SimState& state,
                              const StepInputs& inputs);

@@ -96,6 +96,13 @@ Eigen::Matrix<double, 9, 9> element_stress_tangent(const SimModel& model, std::s
 // integrator).
 void add_external_forces(const StepInputs& inputs, const NodeArray& position, NodeArray& force);
 
+// Adds each node's weight m·g to `force` when the model's gravity effect is on; nothing otherwise.
+void add_gravity_forces(const SimModel& model, NodeArray& force);
+
+// Adds the push of the model's support (support.h) on the free nodes deeper than it at `position`;
+// nothing without a support.
+void add_support_forces(const SimModel& model, const NodeArray& position, NodeArray& force);
+
 double strain_energy_j(const SimModel& model, const NodeArray& position);
 double kinetic_energy_j(const SimModel& model, const NodeArray& velocity);
 

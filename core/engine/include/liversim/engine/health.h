@@ -27,8 +27,9 @@ std::string_view health_problem_text(HealthProblem problem);
 
 struct GuardOptions {
   // A blow-up is told apart from fast motion by energy, not speed: no node can hold more kinetic
-  // energy than the books say was supplied (energy.h), however light it is and however hard it is
-  // pulled (a device's full force on one node moves it at tens of m/s). The slack covers
+  // energy than the books say was supplied (energy.h), with what gravity has released as the organ
+  // came down, however light it is and however hard it is pulled (a device's full force on one
+  // node moves it at tens of m/s). The slack covers
   // leapfrog's half-step velocities and the books' O(Δt²). The speed limit is only a backstop.
   double kinetic_energy_slack = 0.1;
   double speed_limit_m_per_s = 1000.0;

@@ -7,6 +7,7 @@
 #include "liversim/engine/forces.h"
 
 #include <array>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -40,9 +41,19 @@ struct StepReport {
   // node-travel limit) required it, and the smallest such limit met.
   int stability_limited_steps = 0;
   double smallest_stable_step_s = 0.0;  // 0 when no step was limited
-  int rejected_steps = 0;               // dopri5: steps redone because the error was too large
-  int force_evaluations = 0;            // internal-force evaluations of the whole mesh
-  int newton_iterations = 0;            // implicit schemes
+  // Central difference: what made the limits met, each the smallest of the interval (infinite
+  // when it never applied): the mesh alone with the stiffening its elements reached (without the
+  // springs of tools and hands), and the node-travel limit (no node moves more than a tenth of the
+  // smallest element height in a step). The limit met is the smaller of the travel limit and the
+  // mesh's limit lowered by the springs (stable_time_step_s), so these say which set it.
+  double smallest_mesh_limit_s = std::numeric_limits<double>::infinity();
+  double smallest_travel_limit_s = std::numeric_limits<double>::infinity();
+  // The mesh's limit lowered by the springs (stable_time_step_s with the inputs), the smallest of
+  // the interval, whether or not it limited a step.
+  double smallest_spring_limit_s = std::numeric_limits<double>::infinity();
+  int rejected_steps = 0;     // dopri5: steps redone because the error was too large
+  int force_evaluations = 0;  // internal-force evaluations of the whole mesh
+  int newton_iterations = 0;  // implicit schemes
   int linear_solves = 0;
   int factorizations = 0;
   int unconverged_steps = 0;  // implicit steps whose Newton iteration hit its limit

@@ -5,6 +5,7 @@
 
 #include "liversim/engine/fibres.h"
 #include "liversim/engine/material.h"
+#include "liversim/engine/support.h"
 #include "liversim/engine/tet_mesh.h"
 #include "liversim/engine/viscous_tissue.h"
 
@@ -12,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -44,6 +46,8 @@ struct EffectSet {
   // average nodal volume ratio (Joldes, Wittek & Miller 2009; NiftySim's T4ANP), not the element's.
   bool average_nodal_pressure = false;
   bool mooney_rivlin = false;  // some region has a Mooney–Rivlin I2 term
+  // A uniform body force m·g on every node (SimModel::gravity_m_per_s2); off, nothing is added.
+  bool gravity = false;
 };
 
 // Time integrators (facts about each in integrator.h).
@@ -77,6 +81,12 @@ struct ModelOptions {
   std::vector<NodeIndex> fixed_nodes;   // held at their rest position (e.g. ligament attachment)
   double mass_damping_per_s = 8.0;      // Rayleigh mass-proportional damping coefficient α
   double stable_step_safety = 0.8;      // fraction of the central-difference limit actually used
+  // Gravitational acceleration in the mesh's axes (m/s²); zero: no gravity (the effect is off).
+  Eigen::Vector3d gravity_m_per_s2 = Eigen::Vector3d::Zero();
+  // What the organ rests on (support.h); none: nothing. Its contact frequency is this fraction of
+  // the mesh's highest at rest, so that it lowers the stable step by about f²/2 (2 % at 0.2).
+  std::shared_ptr<const SupportSurface> support;
+  double support_frequency_fraction = 0.2;
   IntegratorSettings integrator;
 };
 
@@ -112,6 +122,13 @@ struct SimModel {
   std::vector<std::int32_t> node_slots;
   std::vector<std::int32_t> node_slot_element;  // the element of each entry of node_slots
   double mass_damping_per_s = 0.0;
+  // Gravitational acceleration (m/s², the mesh's axes); acts only when effects.gravity.
+  Eigen::Vector3d gravity_m_per_s2 = Eigen::Vector3d::Zero();
+  // The support the organ rests on (none: nothing) and its penalty's stiffness per unit of a node's
+  // mass, ω² (1/s²): kept through cuts (a freed piece lands on the same tray).
+  std::shared_ptr<const SupportSurface> support;
+  double support_frequency_fraction = 0.2;  // ModelOptions'
+  double support_stiffness_per_kg = 0.0;
   // Largest eigenfrequency of M⁻¹K at rest (free nodes), from power iteration, and the explicit
   // step used: safety · 2/ω_max (reduced for damping).
   double max_frequency_rad_per_s = 0.0;

@@ -4,9 +4,11 @@
 // (model.h, the model itself, below them).
 
 #include "liversim/engine/model.h"
-#include "liversim/engine/model_building.h"
 #include "liversim/engine/tet_mesh.h"
 
+#include <Eigen/Core>
+
+#include <memory>
 #include <vector>
 
 namespace liversim {
@@ -24,5 +26,12 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
 // std::invalid_argument as build_model does for the materials; the model is then unchanged only
 // if the throw came from validation (callers change a copy).
 void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& regions);
+
+// Switches gravity on with this acceleration (m/s², the mesh's axes; zero: off) and the support
+// the organ rests on (null: none), as build_model would make them, also on a cut model: the
+// support's stiffness follows the model's largest frequency, and the stable step follows both.
+// Throws std::invalid_argument for an acceleration that is not finite.
+void set_gravity(SimModel& model, const Eigen::Vector3d& gravity_m_per_s2,
+                 std::shared_ptr<const SupportSurface> support);
 
 }  // namespace liversim

@@ -20,7 +20,7 @@
 namespace liversim {
 
 // The version this build writes and the newest it reads; older files are migrated on reading.
-inline constexpr int kScenarioFormatVersion = 1;
+inline constexpr int kScenarioFormatVersion = 2;
 inline constexpr std::string_view kScenarioFormatName = "liversim-scenario";
 
 using Millimetres3 =
@@ -86,14 +86,28 @@ struct LesionSpec {
   bool operator==(const LesionSpec&) const = default;
 };
 
+// Gravity's strength a scenario may set (m/s²): from a tenth of Earth's, to see the effect
+// slowly, to three times it, beyond which no trainer has a use for it.
+inline constexpr double kMinGravityMPerS2 = 0.981;
+inline constexpr double kMaxGravityMPerS2 = 29.43;
+inline constexpr double kEarthGravityMPerS2 = 9.81;
+
 // The effects simulated: an effect that is off is not computed (and costs nothing).
 struct EffectsSpec {
   bool near_incompressibility = true;  // average nodal pressure
   bool viscoelastic = false;
   bool viscoplastic = false;  // needs viscoelastic
   bool fibres = false;
+  // The organ's weight. Its direction and strength are kept when it is off, as the tissue's laws
+  // are. The default direction is posterior (−z): the patient lies supine on the table.
+  bool gravity = false;
+  std::array<double, 3> gravity_direction{0.0, 0.0, -1.0};  // scene axes, normalised on reading
+  double gravity_m_per_s2 = kEarthGravityMPerS2;
   bool operator==(const EffectsSpec&) const = default;
 };
+
+// The gravitational acceleration the effects ask for (m/s², scene axes): zero when gravity is off.
+Eigen::Vector3d gravity_acceleration_m_per_s2(const EffectsSpec& effects);
 
 enum class TaskKind { palpate_lesion, retract_lobe, resect_lesion };
 

@@ -62,6 +62,8 @@ enum class SessionEventKind {
   // The Material panel changed the tissue (detail: the parenchyma's new parameters); a replay of
   // the session's input stops there too.
   material_changed,
+  // Gravity was switched on or off (detail: describe_gravity); a replay stops there too.
+  gravity_changed,
 };
 std::string_view session_event_name(SessionEventKind kind);
 std::optional<SessionEventKind> session_event_kind(std::string_view name);

@@ -13,6 +13,7 @@
 #include "liversim/engine/model.h"
 #include "liversim/engine/state.h"
 #include "liversim/haptics/servo_loop.h"
+#include "liversim/haptics/spsc_ring.h"
 #include "liversim/haptics/triple_buffer.h"
 #include "liversim/interaction/cutting.h"
 #include "liversim/interaction/simulation_input.h"
@@ -20,6 +21,7 @@
 #include "liversim/simulation/tissue_outcome.h"
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -86,6 +88,40 @@ struct RealtimeStats {
   // energy supplied that viscosity, plasticity and damping have taken out.
   bool energy_created = false;
   double dissipated_fraction = 0.0;
+};
+
+// One record of the real-time loop's trace (RealtimeSimulation::trace_loop): a statistics window
+// (about a quarter of a second of wall time) or a cut of the scalpel. What a user meets, record by
+// record: the live cutting bench writes its per-second figures from these.
+struct LoopRecord {
+  enum class Kind : std::uint8_t { window, cut };
+  Kind kind = Kind::window;
+  double wall_s = 0.0;       // since the loop started, when the record was made
+  double simulated_s = 0.0;  // the state's time then
+  bool blade_in_tissue = false;
+  // A window: its wall time, the simulated time it advanced (their ratio is the real-time
+  // factor), the wall time spent stepping, whether the step cap dropped backlog, and the steps'
+  // report (StepReport: the smallest step and the limits that set it).
+  double window_wall_s = 0.0;
+  double window_simulated_s = 0.0;
+  double integrating_s = 0.0;
+  bool behind = false;
+  int steps = 0;
+  int force_evaluations = 0;
+  int stability_limited_steps = 0;
+  double smallest_step_s = 0.0;
+  double smallest_stable_step_s = 0.0;
+  double smallest_mesh_limit_s = std::numeric_limits<double>::infinity();
+  double smallest_travel_limit_s = std::numeric_limits<double>::infinity();
+  double smallest_spring_limit_s = std::numeric_limits<double>::infinity();
+  // A cut: the wall time of the whole update (the cut, the new model's surface and the tools on
+  // it), whether it parted anything, and the model after it: its elements, its stable explicit
+  // step and its smallest element height.
+  double cut_update_s = 0.0;
+  bool parted = false;
+  std::size_t tets = 0;
+  double model_stable_step_s = 0.0;
+  double min_element_height_m = 0.0;
 };
 
 // The fixed-step clock of the real-time loop, without the loop: wall time is added, whole steps
@@ -190,6 +226,11 @@ class RealtimeSimulation {
   // track_outcome begins it).
   std::optional<OutcomeTracking> outcome() const;
 
+  // While stopped: from the next start on the loop pushes a LoopRecord into `trace` at the end of
+  // each statistics window and after each cut (null: no trace). The ring is the caller's and must
+  // outlive the run; a full ring drops records (SpscRing counts them), the loop never waits.
+  void trace_loop(SpscRing<LoopRecord>* trace);
+
   // From any thread: keep (or stop keeping) every input the simulation takes from its next loop
   // on, and take those kept so far.
   void log_inputs(bool on);
@@ -270,6 +311,10 @@ class RealtimeSimulation {
   std::optional<std::pair<std::optional<Eigen::Vector3d>, DamageStrains>> outcome_request_;
   std::optional<OutcomeTracking> outcome_;
   void observe_outcome();  // simulation thread, once per published cycle
+
+  SpscRing<LoopRecord>* trace_ = nullptr;
+  std::chrono::steady_clock::time_point loop_start_{};  // of the running loop, for the trace
+  double trace_wall_s() const;
 
   std::atomic<bool> stop_requested_{false};
   // Statistics, written by the simulation thread once per window; each field on its own (a reader

@@ -62,6 +62,8 @@ std::string default_trainee_name();
 // A tissue as a session event's detail (English, as the database keeps it): the parenchyma's
 // parameters of the effects simulated.
 std::string describe_tissue(const TissueSpec& tissue, const EffectsSpec& effects);
+// Gravity as a session event's detail (English): "off", or its strength and direction.
+std::string describe_gravity(const EffectsSpec& effects);
 
 // A scene build that ended: opened, cancelled (asked for; not an error), or refused with why.
 struct SceneOpening {
@@ -73,7 +75,7 @@ struct SceneOpening {
 // A live change of the running model that ended: applied, or refused with why. `cut_meanwhile`:
 // refused because the liver was cut while it was built (the change is to be entered again).
 struct ModelChangeOutcome {
-  enum class Kind { integrator, tissue };
+  enum class Kind { integrator, tissue, gravity };
   Kind kind = Kind::integrator;
   bool applied = false;
   bool cut_meanwhile = false;
@@ -182,12 +184,24 @@ class Workstation {
   // after it (only the newest). Sessions recorded afterwards store the scenario with this tissue.
   // False while a scene or an integrator change is being built.
   bool change_tissue(const TissueSpec& tissue);
+  // Switches gravity on (the scenario's direction and strength; free practice's: toward the
+  // patient's back, 9.81 m/s²) with the support the organ rests on, or off, applied as a tissue
+  // change is, cut or not. Sessions recorded afterwards store the scenario with it. False while a
+  // scene or another change of the model is being built.
+  bool change_gravity(bool on);
   bool changing_integrator() const { return changing_integrator_; }
   bool changing_tissue() const { return changing_tissue_; }
+  bool changing_gravity() const { return changing_gravity_; }
   bool opening_scenario() const { return opening_scenario_; }
   bool busy_building() const;
-  // Free practice's tissue was changed: its sessions cannot be replayed (nothing can rebuild it).
-  bool tissue_changed_in_free_practice() const { return tissue_changed_in_free_practice_; }
+  // Free practice's tissue or gravity was changed: its sessions cannot be replayed (nothing can
+  // rebuild it).
+  bool free_practice_changed() const { return free_practice_changed_; }
+
+  // Every simulation the station runs from now on (a session's start makes a new one) pushes its
+  // loop's records into `trace` (RealtimeSimulation::trace_loop), which must outlive them; null:
+  // none. For the live benchmarks: what the user meets, measured in the product's own loop.
+  void trace_loop(SpscRing<LoopRecord>* trace);
 
   // The hand's springs (a mouse grab); kept across a restart of the simulation.
   void set_hand_springs(std::vector<NodeSpring> springs);
@@ -273,6 +287,7 @@ class Workstation {
   struct ModelChange {
     std::optional<IntegratorSettings> integrator;
     std::optional<TissueSpec> tissue;
+    std::optional<bool> gravity;
   };
   void install_scene(SceneSetup setup, std::shared_ptr<const SimModel> model);
   void restart_from_rest();
@@ -280,6 +295,10 @@ class Workstation {
   void detach_device();
   std::optional<DeviceToolSettings> device_tool() const;
   void start_model_change(ModelChange change, std::function<ModelChangeBuilt()> build);
+  // The running model and the scene's rest one (the same when uncut), each copied and changed.
+  static ModelChangeBuilt changed_models(const std::shared_ptr<const SimModel>& running,
+                                         const std::shared_ptr<const SimModel>& rest,
+                                         const std::function<void(SimModel&)>& change);
   void finish_model_change(const ModelChange& change, const ModelChangeBuilt& built,
                            const std::string& error);
   void finish_scene_build();
@@ -299,18 +318,20 @@ class Workstation {
   std::optional<OpenedScenario> scenario_;
   std::uint64_t shown_topology_ = 0;  // the cut of the last frame's snapshot
   std::vector<NodeSpring> hand_springs_;
+  SpscRing<LoopRecord>* loop_trace_ = nullptr;
 
   // Builds a scene or a model change; what it built waits here for frame().
   BackgroundJob builder_;
   std::function<void()> built_;  // written by the builder before it finishes
   std::shared_ptr<std::atomic<bool>> build_cancelled_;
-  std::mutex progress_mutex_;  // owner ↔ builder
+  std::mutex progress_mutex_;              // owner ↔ builder
   std::vector<MeshingProgress> progress_;  // reported, not yet told (each is told)
   bool changing_integrator_ = false;
   bool changing_tissue_ = false;
+  bool changing_gravity_ = false;
   bool opening_scenario_ = false;
   std::optional<TissueSpec> pending_tissue_;
-  bool tissue_changed_in_free_practice_ = false;
+  bool free_practice_changed_ = false;
 
   DeviceChoice device_ = DeviceChoice::mouse;
   std::unique_ptr<HapticDevice> omni_;

@@ -1,0 +1,229 @@
+#include "live_cut_bench.h"
+
+#include "cli_commands.h"
+#include "liversim/haptics/emulated_devices.h"
+#include "liversim/haptics/haptics.h"
+#include "liversim/haptics/spsc_ring.h"
+#include "liversim/meshing/default_scene.h"
+#include "liversim/scenario/scenario.h"
+#include "liversim/simulation/realtime_simulation.h"
+#include "liversim/station/workstation.h"
+#include "liversim/storage/sqlite_session_store.h"
+#include "record_command.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+namespace liversim::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Issue 42's targets for the resection in the real-time loop.
+constexpr double kLeastRealTimeFactor = 1.0;
+constexpr double kLeastStepMs = 0.15;
+constexpr double kFrameMs = 16.0;  // one cut update within a display frame
+constexpr double kFramePeriodS = 0.016;
+
+struct Second {
+  double wall_s = 0.0, simulated_s = 0.0, integrating_s = 0.0;
+  double smallest_step_s = std::numeric_limits<double>::infinity();
+  double smallest_mesh_limit_s = std::numeric_limits<double>::infinity();
+  double smallest_travel_limit_s = std::numeric_limits<double>::infinity();
+  double smallest_spring_limit_s = std::numeric_limits<double>::infinity();
+  int force_evaluations = 0, cuts = 0, parts = 0;
+  bool blade_in_tissue = false, behind = false;
+};
+
+std::string ms_text(double seconds) {
+  if (!std::isfinite(seconds)) return "–";
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(3) << seconds * 1e3;
+  return out.str();
+}
+
+}  // namespace
+
+int run_live_cut_bench(const LiveCutBenchOptions& o) {
+  std::vector<TrajectoryPoint> script;
+  std::optional<OpenedScenario> scenario;
+  try {
+    script = load_trajectory(o.trajectory);
+    scenario = open_scenario_to_run(o.scenario);
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+  const double duration_s = script.empty() ? 0.0 : script.back().time_s;
+  if (!(duration_s > 0.0))
+    return fail("the trajectory " + o.trajectory.string() + " lasts 0 s: nothing to cut");
+
+  // The session is recorded as the workstation records one (the writer's work is part of what
+  // the loop meets), into a database that is thrown away.
+  fs::create_directories(o.output_dir);
+  const fs::path database = o.output_dir / "bench-cut-live.sqlite";
+  fs::remove(database);
+  std::unique_ptr<SqliteSessionStore> store;
+  try {
+    store = std::make_unique<SqliteSessionStore>(database);
+  } catch (const StorageError& e) {
+    return fail(e.what());
+  }
+
+  const Eigen::Quaterniond view_axes = opening_view_device_axes();
+  StationListener listener;
+  listener.device_tool = [&]() -> std::optional<DeviceToolSettings> {
+    DeviceToolSettings held;
+    held.kind = ToolKind::scalpel;
+    held.orientation = tool_orientation_from_view(view_axes);
+    return held;
+  };
+  std::string fault;
+  listener.device_stopped = [&](DeviceChoice, const std::string&, const std::string& why) {
+    fault = why;
+  };
+  std::unique_ptr<Workstation> station;
+  try {
+    const fs::path folder = scenario ? scenario->file.parent_path() : fs::path();
+    SceneSetup setup = scenario ? build_scene(scenario->scenario, folder) : default_scene(o.tets);
+    station = std::make_unique<Workstation>(std::move(setup), std::move(scenario), listener);
+  } catch (const std::exception& e) {
+    return fail(std::string("cannot build the scene: ") + e.what());
+  }
+  const std::size_t start_tets = station->setup().mesh.tet_count();
+  const std::string scene_name =
+      station->scenario() ? station->scenario()->scenario.title : "Free practice";
+  // Room for a record per window (4 a second) and a cut per simulation cycle (at most ~120 a
+  // second): the ring is drained at every display frame, so it never fills.
+  SpscRing<LoopRecord> trace(1 << 14);
+  station->trace_loop(&trace);
+  station->use_sessions(std::move(store), database);
+  const WorkspaceMapping mapping =
+      first_use_mapping(station->setup().mesh.rest_position_m, view_axes);
+  if (const std::optional<DeviceRefusal> refusal =
+          station->use_device(DeviceChoice::scripted, mapping, std::move(script), o.trajectory))
+    return fail("cannot play the trajectory " + o.trajectory.string() + ": " + refusal->detail);
+
+  std::vector<LoopRecord> records;
+  ServoLoop& servo = *station->servo();
+  const double begin_s = servo.now_s();
+  while (servo.now_s() - begin_s < duration_s && fault.empty()) {
+    std::this_thread::sleep_for(std::chrono::duration<double>(kFramePeriodS));
+    station->frame();
+    for (LoopRecord record; trace.pop(record);) records.push_back(record);
+  }
+  station->stop();
+  for (LoopRecord record; trace.pop(record);) records.push_back(record);
+  station->finish_metrics();
+  const std::size_t end_tets = station->simulation().snapshot().model
+                                   ? station->simulation().snapshot().model->tet_count
+                                   : start_tets;
+  station.reset();
+  fs::remove(database);
+  if (!fault.empty()) return fail("the scripted device stopped: " + fault);
+
+  // Per second of wall time: the windows that ended in it, and the cuts made in it.
+  std::map<int, Second> seconds;
+  std::vector<double> update_ms, parting_ms;
+  double smallest_step_s = std::numeric_limits<double>::infinity();
+  for (const LoopRecord& r : records) {
+    Second& s = seconds[static_cast<int>(std::floor(r.wall_s))];
+    s.blade_in_tissue |= r.blade_in_tissue;
+    if (r.kind == LoopRecord::Kind::cut) {
+      ++s.cuts;
+      update_ms.push_back(r.cut_update_s * 1e3);
+      if (r.parted) {
+        ++s.parts;
+        parting_ms.push_back(r.cut_update_s * 1e3);
+      }
+      continue;
+    }
+    s.wall_s += r.window_wall_s;
+    s.simulated_s += r.window_simulated_s;
+    s.integrating_s += r.integrating_s;
+    s.force_evaluations += r.force_evaluations;
+    s.behind |= r.behind;
+    if (r.steps > 0) {
+      s.smallest_step_s = std::min(s.smallest_step_s, r.smallest_step_s);
+      smallest_step_s = std::min(smallest_step_s, r.smallest_step_s);
+    }
+    s.smallest_mesh_limit_s = std::min(s.smallest_mesh_limit_s, r.smallest_mesh_limit_s);
+    s.smallest_travel_limit_s = std::min(s.smallest_travel_limit_s, r.smallest_travel_limit_s);
+    s.smallest_spring_limit_s = std::min(s.smallest_spring_limit_s, r.smallest_spring_limit_s);
+  }
+
+  std::ostringstream command;
+  command << "liversim-cli bench-cut --live --trajectory " << o.trajectory.string();
+  if (o.scenario)
+    command << " --scenario " << o.scenario->string();
+  else
+    command << " --tets " << o.tets;
+  std::ostringstream doc;
+  doc << "# Cutting in the real-time loop\n\n"
+      << written_by(command.str()) << "\n\n"
+      << "One run of the workstation's own loop (`core/station`, headless): " << scene_name << " ("
+      << start_tets << " tetrahedra), a scalpel moved by the scripted device along `"
+      << o.trajectory.filename().string() << "` through the 1 kHz servo, the session recorded "
+      << "to a database thrown away after. Each second of wall time: the simulated time it "
+      << "advanced (the real-time factor), the smallest step taken and what limited it (the mesh "
+      << "with its stiffening, the springs of the tool, or the node-travel limit), and the cut "
+      << "updates made in it. Targets (issue 42): a real-time factor of at least "
+      << kLeastRealTimeFactor << " in every second, no step below " << kLeastStepMs
+      << " ms, every cut update within a frame (" << kFrameMs << " ms).\n\n"
+      << "| second | blade in | real-time factor | smallest step (ms) | mesh limit (ms) | "
+         "with springs (ms) | travel limit (ms) | force evaluations / simulated ms | cut updates "
+         "| parted |\n"
+      << "|---:|:---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  double least_factor = std::numeric_limits<double>::infinity();
+  for (const auto& [second, s] : seconds) {
+    if (s.wall_s <= 0.0) continue;
+    const double factor = s.simulated_s / s.wall_s;
+    least_factor = std::min(least_factor, factor);
+    doc << "| " << second << " | " << (s.blade_in_tissue ? "yes" : "") << " | " << std::fixed
+        << std::setprecision(2) << factor << " | " << ms_text(s.smallest_step_s) << " | "
+        << ms_text(s.smallest_mesh_limit_s) << " | " << ms_text(s.smallest_spring_limit_s) << " | "
+        << ms_text(s.smallest_travel_limit_s) << " | " << std::setprecision(1)
+        << (s.simulated_s > 0.0 ? s.force_evaluations / (s.simulated_s * 1e3) : 0.0) << " | "
+        << s.cuts << " | " << s.parts << " |\n";
+  }
+  doc << "\n| cut updates | count | median (ms) | 95th percentile (ms) | max (ms) |\n"
+      << "|---|---:|---:|---:|---:|\n";
+  auto row = [&](const char* name, const std::vector<double>& v) {
+    doc << "| " << name << " | " << v.size() << " | " << std::fixed << std::setprecision(2)
+        << percentile(v, 0.5) << " | " << percentile(v, 0.95) << " | "
+        << (v.empty() ? 0.0 : *std::max_element(v.begin(), v.end())) << " |\n";
+  };
+  row("every update", update_ms);
+  row("updates that parted tissue", parting_ms);
+  const double slowest_ms =
+      update_ms.empty() ? 0.0 : *std::max_element(update_ms.begin(), update_ms.end());
+  doc << "\n"
+      << start_tets << " tetrahedra before, " << end_tets << " after. Least real-time "
+      << "factor " << std::setprecision(2) << least_factor << " (target " << kLeastRealTimeFactor
+      << ": " << (least_factor >= kLeastRealTimeFactor ? "met" : "**not met**")
+      << "); smallest step " << ms_text(smallest_step_s) << " ms (target " << kLeastStepMs
+      << " ms: " << (smallest_step_s * 1e3 >= kLeastStepMs ? "met" : "**not met**")
+      << "); slowest cut update " << std::setprecision(2) << slowest_ms << " ms (target "
+      << kFrameMs << " ms: " << (slowest_ms <= kFrameMs ? "met" : "**not met**") << ").\n";
+  if (trace.dropped() > 0)
+    doc << "\n" << trace.dropped() << " records of the loop were dropped (the ring was full).\n";
+
+  const fs::path path = o.output_dir / "cutting-live.md";
+  std::ofstream out(path);
+  if (!out) return fail("cannot write " + path.string());
+  out << doc.str();
+  std::cout << doc.str();
+  return out ? 0 : 1;
+}
+
+}  // namespace liversim::cli

@@ -1,0 +1,53 @@
+#pragma once
+// What the organ rests on when gravity pulls it: a rigid support beneath it along gravity's
+// direction. Over the organ's footprint it is the organ's own underside at rest (its bed: the
+// organs and the wall it lies on, as a mould of it); around it, a flat tray at the organ's lowest
+// point, where a piece that comes free lands. A height field on a grid across gravity, bilinear
+// between grid points: a point deeper (farther along gravity) than the support is pushed back by a
+// penalty spring, the gradient of ½·k·p² with p the depth past the support and k = m·ω², so that
+// every node meets the same contact frequency ω and a light node pushes no harder than a heavy
+// one. On a slope the push has a sideways part: the bed holds the organ as a bowl would.
+// Frictionless.
+
+#include "liversim/engine/surface.h"
+#include "liversim/engine/tet_mesh.h"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace liversim {
+
+struct SupportSurface {
+  Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();   // unit, gravity's direction
+  Eigen::Vector3d axis_u = Eigen::Vector3d::UnitX();  // unit, across `down`
+  Eigen::Vector3d axis_v = Eigen::Vector3d::UnitY();  // unit, across `down` and axis_u
+  double origin_u_m = 0.0, origin_v_m = 0.0;          // the grid's first point
+  double cell_m = 0.002;
+  int cells_u = 0, cells_v = 0;  // (cells_u + 1) × (cells_v + 1) points, u fastest
+  // How far along `down` a point may go at each grid point (the support's surface).
+  std::vector<double> depth_m;
+  double floor_depth_m = 0.0;  // the tray, and everywhere beyond the grid
+
+  struct Depth {
+    double depth_m = 0.0;
+    double slope_u = 0.0, slope_v = 0.0;  // ∂depth/∂u, ∂depth/∂v
+  };
+  // The support's depth and slope under the point `point_m` (its u, v), bilinear in the grid.
+  Depth depth_under(const Eigen::Vector3d& point_m) const;
+};
+
+// The support under an organ at rest: the organ's underside over its footprint (each grid point
+// the deepest point of the boundary over the cells around it, so that no node lies below the
+// bilinear surface between grid points: under a slope the bed is up to a cell's rise deeper),
+// the tray (its deepest node) elsewhere, both `clearance_m` deeper so that the organ at rest
+// touches nothing; the grid reaches `margin_m`
+// beyond the footprint on every side. `down` need not be of unit length (not zero).
+SupportSurface support_under(const NodeArray& rest_position_m, const BoundarySurface& surface,
+                             const Eigen::Vector3d& down, double cell_m = 0.002,
+                             double margin_m = 0.05, double clearance_m = 1e-4);
+// The same under a mesh at rest (its boundary extracted), with the defaults: what a scene with
+// gravity gets.
+SupportSurface support_under(const TetMesh& mesh, const Eigen::Vector3d& down);
+
+}  // namespace liversim

@@ -1,0 +1,194 @@
+// The support the organ rests on under gravity (support.h): the organ's underside and the tray
+// around it as a height field, a body that falls onto it comes to rest carried by it, and the
+// energy books hold its springs.
+#include "block_mesh.h"
+
+#include "liversim/engine/energy.h"
+#include "liversim/engine/forces.h"
+#include "liversim/engine/health.h"
+#include "liversim/engine/integrator.h"
+#include "liversim/engine/model_building.h"
+#include "liversim/engine/state.h"
+#include "liversim/engine/support.h"
+#include "liversim/engine/surface.h"
+#include "liversim/meshing/default_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+namespace liversim {
+namespace {
+
+constexpr double kEarth = 9.81;
+constexpr double kClearance = 1e-4;
+
+// A box 4 × 3 × 2 cm on z = 0 … 2 cm.
+TetMesh box() {
+  return testing::block_mesh(4, 3, 2, {0.04, 0.03, 0.02});
+}
+
+TEST(Support, IsTheUndersideOverTheFootprintAndTheTrayAroundIt) {
+  const TetMesh mesh = box();
+  const BoundarySurface surface = extract_surface(mesh);
+  // Gravity along −z: the underside is the bottom face, z = 0, depth −z = 0; the tray is there too.
+  const SupportSurface down = support_under(mesh.rest_position_m, surface, {0.0, 0.0, -kEarth});
+  EXPECT_NEAR(down.depth_under({0.02, 0.015, 0.01}).depth_m, kClearance, 1e-12);
+  EXPECT_NEAR(down.floor_depth_m, kClearance, 1e-12);
+  EXPECT_NEAR(down.depth_under({0.5, 0.5, 0.0}).depth_m, kClearance, 1e-12);  // beyond the grid
+  // Gravity along +z: the underside is the top face (depth z = 2 cm) and so is the tray.
+  const SupportSurface up = support_under(mesh.rest_position_m, surface, {0.0, 0.0, 1.0});
+  EXPECT_NEAR(up.depth_under({0.02, 0.015, 0.0}).depth_m, 0.02 + kClearance, 1e-12);
+  // Gravity along −x: the underside is the face x = 0 (depth −x = 0), flat over the footprint.
+  const SupportSurface side = support_under(mesh.rest_position_m, surface, {-1.0, 0.0, 0.0});
+  const SupportSurface::Depth under = side.depth_under({0.03, 0.01, 0.01});
+  EXPECT_NEAR(under.depth_m, kClearance, 1e-12);
+  EXPECT_NEAR(under.slope_u, 0.0, 1e-9);
+  EXPECT_NEAR(under.slope_v, 0.0, 1e-9);
+  EXPECT_THROW(support_under(mesh.rest_position_m, surface, Eigen::Vector3d::Zero()),
+               std::invalid_argument);
+}
+
+// A wedge-shaped underside: the bed under a sloping face is the slope lowered by its rise over one
+// cell (each grid point holds the deepest of the cells around it), and its gradient is the
+// face's. Built from a box whose nodes are sheared so that the bottom face rises with x.
+TEST(Support, UnderASlopeTheBedHasTheSlopesGradient) {
+  TetMesh mesh = box();
+  const double rise = 0.25;  // dz/dx of the bottom face
+  for (std::size_t n = 0; n < mesh.node_count(); ++n)
+    mesh.rest_position_m.z[n] += rise * mesh.rest_position_m.x[n];
+  const SupportSurface bed =
+      support_under(mesh.rest_position_m, extract_surface(mesh), {0.0, 0.0, -1.0});
+  const Eigen::Vector3d point(0.02, 0.015, 0.0);
+  const SupportSurface::Depth under = bed.depth_under(point);
+  EXPECT_NEAR(under.depth_m, -rise * (point.x() - bed.cell_m) + kClearance, 1e-9);
+  // The gradient of the depth −z along the axes across gravity, whichever they are.
+  const Eigen::Vector3d gradient = under.slope_u * bed.axis_u + under.slope_v * bed.axis_v;
+  EXPECT_NEAR(gradient.x(), -rise, 1e-9);
+  EXPECT_NEAR(gradient.y(), 0.0, 1e-9);
+}
+
+SimModel resting_model(const TetMesh& mesh, double damping_per_s) {
+  ModelOptions options;
+  options.regions[0].tissue = TissueMaterial{20000.0, 0.3, 1060.0};
+  options.mass_damping_per_s = damping_per_s;
+  options.gravity_m_per_s2 = {0.0, 0.0, -kEarth};
+  // The box 5 mm above the support it would rest on.
+  TetMesh lifted = mesh;
+  for (std::size_t n = 0; n < lifted.node_count(); ++n) lifted.rest_position_m.z[n] += 0.005;
+  options.support = std::make_shared<const SupportSurface>(
+      support_under(mesh.rest_position_m, extract_surface(mesh), options.gravity_m_per_s2));
+  return build_model(lifted, options);
+}
+
+TEST(Support, ItsContactFrequencyIsAFractionOfTheMeshsAndLowersTheStepByLittle) {
+  const TetMesh mesh = box();
+  const SimModel model = resting_model(mesh, 0.0);
+  const double omega = model.max_frequency_rad_per_s;
+  EXPECT_NEAR(model.support_stiffness_per_kg, 0.04 * omega * omega, 1e-9 * omega * omega);
+  // 2/ω against 2/(ω·√1.04): the step is 1.9 % shorter.
+  EXPECT_NEAR(model.stable_time_step_s * omega / (2.0 * model.stable_step_safety),
+              1.0 / std::sqrt(1.04), 1e-12);
+}
+
+// Dropped 5 mm, the box comes to rest on the support, which then carries its whole weight: the
+// pushes sum to M·g (equilibrium, to the settling left), and no node sinks deeper than the weight
+// of the whole box on its lightest node would push it, M·g/(m_min·ω²).
+TEST(Support, ABodyDroppedOntoItComesToRestCarriedByIt) {
+  const TetMesh mesh = box();
+  const SimModel model = resting_model(mesh, 200.0);
+  SimState state = make_rest_state(model);
+  advance(model, state, {}, 1.0);
+  double mass = 0.0, lightest = INFINITY;
+  for (double m : model.lumped_mass_kg) {
+    mass += m;
+    lightest = std::min(lightest, m);
+  }
+  NodeArray push;
+  push.resize(model.node_count);
+  add_support_forces(model, state.position_m, push);
+  double carried = 0.0, fastest = 0.0, deepest = 0.0;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    carried += push.z[n];
+    fastest = std::max(fastest, state.velocity_m_per_s.at(n).norm());
+    deepest = std::max(deepest, -state.position_m.z[n]);
+  }
+  EXPECT_NEAR(carried, mass * kEarth, 1e-6 * mass * kEarth);
+  EXPECT_LT(fastest, 1e-6);
+  EXPECT_GT(deepest, kClearance);  // it rests on the support, not above it
+  EXPECT_LT(deepest - kClearance, mass * kEarth / (lightest * model.support_stiffness_per_kg));
+}
+
+// The built-in liver at rest touches nothing of its own support, whichever way is down: every
+// node is at least the clearance above it (the support is the deepest point of the underside over
+// each grid point, so between grid points it can only lie deeper).
+TEST(Support, NoNodeOfTheLiverAtRestTouchesItsSupport) {
+  const SceneSetup scene = default_scene(3841);
+  for (const Eigen::Vector3d& down :
+       {Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1)}) {
+    const SupportSurface support = support_under(scene.mesh, down);
+    int touching = 0;
+    double worst_m = -INFINITY;
+    for (std::size_t n = 0; n < scene.mesh.node_count(); ++n) {
+      const Eigen::Vector3d x = scene.mesh.rest_position_m.at(n);
+      const double past = x.dot(support.down) - support.depth_under(x).depth_m;
+      worst_m = std::max(worst_m, past);
+      touching += past > -0.5 * kClearance;
+    }
+    EXPECT_EQ(touching, 0) << "down " << down.transpose() << ": deepest node " << worst_m * 1e3
+                           << " mm past the support";
+  }
+}
+
+// The real-time loop steps through the guard, which bounds each node's kinetic energy by the
+// energy supplied: what gravity releases as the organ comes down counts, so a box let go above its
+// support falls onto it and settles without a single step undone, its books closing.
+TEST(Support, TheGuardLetsGravityBringTheBodyDownOntoIt) {
+  const TetMesh mesh = box();
+  const SimModel model = resting_model(mesh, 200.0);
+  SimState state = make_rest_state(model);
+  StateCheckpoint checkpoint = make_checkpoint(model);
+  GuardOptions guard;
+  guard.check_energy = true;
+  int rollbacks = 0;
+  for (int cycle = 0; cycle < 500; ++cycle) {
+    const GuardedReport report = guarded_advance(model, state, {}, 1e-3, checkpoint, guard);
+    ASSERT_FALSE(report.gave_up) << "cycle " << cycle << ": "
+                                 << health_problem_text(report.problem);
+    rollbacks += report.rollbacks;
+    ASSERT_TRUE(report.energy);
+    EXPECT_FALSE(report.energy_created) << "cycle " << cycle;
+  }
+  EXPECT_EQ(rollbacks, 0);
+  double deepest = 0.0;
+  for (std::size_t n = 0; n < model.node_count; ++n)
+    deepest = std::max(deepest, -state.position_m.z[n]);
+  EXPECT_GT(deepest, kClearance) << "it did not come down onto the support";
+}
+
+// Undamped, the box falls, hits the support and bounces: the books, holding the support's springs
+// and gravity's potential, stay at the nothing they opened with. RK4, whose velocity is at the
+// positions' time (leapfrog's lags half a step, which in free fall alone puts ½·M·g²·Δt·t
+// between the books' kinetic and potential energy), at a quarter of its stable step: its energy
+// error per period of the fastest mode is O((ωΔt)⁶), and the support's kink at contact costs it
+// an O(Δt²) error there. The tolerance is 4 % of the potential given up.
+TEST(Support, TheEnergyBooksHoldItsSprings) {
+  const TetMesh mesh = box();
+  SimModel model = resting_model(mesh, 0.0);
+  model.integrator.kind = IntegratorKind::rk4;
+  model.integrator.step_s = 0.25 * model.stable_time_step_s;
+  SimState state = make_rest_state(model);
+  bool touched = false;
+  for (int i = 0; i < 60; ++i) {
+    advance(model, state, {}, 0.001);
+    const EnergyBalance books = energy_balance(model, state, {});
+    touched |= books.support_j > 0.0;
+    EXPECT_NEAR(books.held_j(), 0.0, 0.04 * -books.gravity_j) << "at " << state.time_s << " s";
+  }
+  EXPECT_TRUE(touched) << "the box never reached the support";
+}
+
+}  // namespace
+}  // namespace liversim
