@@ -660,9 +660,10 @@ int run_bench(const BenchOptions& o) {
      << (counting_command.empty() ? std::string("not run: valgrind missing") : counting_command)
      << "`.\n\n"
      << effect_off.str()
-     << "\nGravity, lesions, cutting and haptics are not effects of the force loops: the engine "
-        "has no gravity yet; a lesion is only other per-element moduli (the same arrays, no "
-        "branch); a cut changes the mesh and rebuilds the model (its cost: "
+     << "\nGravity, lesions, cutting and haptics are not effects of the force loops: gravity's "
+        "weight and its support's push are added once per force evaluation, outside the element "
+        "loops, and return at once when gravity is off (not yet a row of this table); a lesion is "
+        "only other per-element moduli (the same arrays, no branch); a cut changes the mesh and rebuilds the model (its cost: "
         "cutting-performance.md), "
         "and the haptic force path runs on the servo thread, outside the force loops.\n"
      << "\n## Memory (bytes per tetrahedron, " << o.tet_counts.back()
