@@ -59,6 +59,7 @@ step_table=(
   "seed-experiments|seed-experiments.md|4|1|"
   "performance|performance.md|10|2|valgrind counts instructions; the workstation runs offscreen for its memory"
   "cutting|cutting-performance.md cutting.md|5|1|eight strokes at 10583 tets"
+  "cutting-live|cutting-live.md|1|1|"
   "haptics-servo|haptics-servo.md|1|1|"
   "rendering-performance|rendering-performance.md|3|1|"
   "accuracy-study|accuracy-study.md accuracy-study-effects/accuracy-study.md|20|1|both studies and their plots; references at 1/64 of the smallest step"
@@ -434,6 +435,17 @@ step_performance() {
 
 # cutting-performance.md; and in cutting.md, more runs of the same stroke: the same command twice
 # more, three single repeats, two on one thread.
+# One run of the shipped scripted strokes through the workstation's own loop (issue 42): what a
+# trainee's cut meets, second by second; --quick on the 1500-tet liver.
+step_cutting-live() {
+  local tets=5406
+  ((!quick)) || tets=1500
+  run "$cli" bench-cut --live --trajectory tests/data/trajectories/free-practice-three-strokes.txt \
+    --tets "$tets" --output-dir "$out"
+  doing || return 0
+  stamp cutting-live.md
+}
+
 step_cutting() {
   local args=(--tets 10583 --step-mm 2 --stroke-mm 120) repeats=5 variant r runs=()
   ((!quick)) || { args=(--tets 2000 --step-mm 4 --stroke-mm 120) repeats=1; }
