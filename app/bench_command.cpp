@@ -306,6 +306,12 @@ const std::vector<EffectOffCase>& effect_off_cases() {
        true,
        {StudyEffects::viscoplastic, StudyEffects::fibres},
        kWithoutMooneyRivlin},
+      // Gravity is off in every scene above; its build leaves out the weight and the support.
+      {"gravity",
+       "full: ANP + viscoplastic + fibres",
+       true,
+       {StudyEffects::viscoplastic, StudyEffects::fibres},
+       kWithoutGravity},
   };
   return cases;
 }
@@ -314,10 +320,11 @@ SimModel effect_off_model(const SceneSetup& scene, const EffectOffCase& c) {
   return model_for(scene, EffectSet{c.scene, c.average_nodal_pressure, c.laws});
 }
 
+// compute_tissue_forces of the build without `effect` (0: the normal build).
 InternalForcesFunction build_without(unsigned effect) {
-  if (effect == 0) return &compute_internal_forces;
+  if (effect == 0) return &compute_tissue_forces;
   for (const ForcesVariant& variant : forces_variants())
-    if (variant.without == effect) return variant.compute_internal_forces;
+    if (variant.without == effect) return variant.compute_tissue_forces;
   throw std::logic_error("no build without that effect");
 }
 
@@ -353,7 +360,7 @@ std::optional<double> count_instructions(std::size_t case_index, bool without_ef
   if (error || std::system("command -v valgrind > /dev/null 2>&1") != 0) return std::nullopt;
   command =
       "LIVERSIM_THREADS=1 valgrind --tool=callgrind --callgrind-out-file=/dev/null "
-      "--toggle-collect='liversim::*compute_internal_forces*' " +
+      "--toggle-collect='liversim::*compute_tissue_forces*' " +
       shell_quoted(self.string()) + " bench --tets " + std::to_string(tets) +
       " --effect-off-case " + std::to_string(case_index) +
       (without_effect ? " --without-effect" : "") + " --evaluations " +
@@ -637,7 +644,10 @@ int run_bench(const BenchOptions& o) {
           "chunk are the suspects, not yet measured apart.\n";
   md << "\n## What an effect that is off costs\n\n"
      << "The force loops are also compiled without one effect each (`forces_variants.h`: the "
-        "effect's branches and kernels are not in that build at all). Each row times the same "
+        "effect's branches and kernels are not in that build at all; gravity's are its weight and "
+        "its support's push, added once per evaluation outside the element loops). Each row times "
+        "one evaluation of the tissue's forces (`compute_tissue_forces`: the internal forces and, "
+        "with gravity, the weight and the support's push) on the same "
         "scene, with that effect off, on the normal build and on the build without it, back to "
         "back, "
      << kEffectOffRounds << " rounds of runs of at least " << number(effect_off_run_s * 1e3)
@@ -660,10 +670,9 @@ int run_bench(const BenchOptions& o) {
      << (counting_command.empty() ? std::string("not run: valgrind missing") : counting_command)
      << "`.\n\n"
      << effect_off.str()
-     << "\nGravity, lesions, cutting and haptics are not effects of the force loops: gravity's "
-        "weight and its support's push are added once per force evaluation, outside the element "
-        "loops, and return at once when gravity is off (not yet a row of this table); a lesion is "
-        "only other per-element moduli (the same arrays, no branch); a cut changes the mesh and rebuilds the model (its cost: "
+     << "\nLesions, cutting and haptics are not effects of the force loops: a lesion is only "
+        "other per-element moduli (the same arrays, no branch); a cut changes the mesh and "
+        "rebuilds the model (its cost: "
         "cutting-performance.md), "
         "and the haptic force path runs on the servo thread, outside the force loops.\n"
      << "\n## Memory (bytes per tetrahedron, " << o.tet_counts.back()

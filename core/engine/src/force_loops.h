@@ -37,6 +37,7 @@ constexpr bool kBuiltFibres = !(kWithout & force_loop_bits::fibres);
 constexpr bool kBuiltViscous = !(kWithout & force_loop_bits::viscous);
 constexpr bool kBuiltAveragedPressure = !(kWithout & force_loop_bits::average_nodal_pressure);
 constexpr bool kBuiltMooneyRivlin = !(kWithout & force_loop_bits::mooney_rivlin);
+constexpr bool kBuiltGravity = !(kWithout & force_loop_bits::gravity);
 
 // The model's effects that this build contains (the others are constant false, so the compiler
 // drops their branches).
@@ -46,6 +47,7 @@ EffectSet built(const SimModel& model) {
   on.viscous = kBuiltViscous && on.viscous;
   on.average_nodal_pressure = kBuiltAveragedPressure && on.average_nodal_pressure;
   on.mooney_rivlin = kBuiltMooneyRivlin && on.mooney_rivlin;
+  on.gravity = kBuiltGravity && on.gravity;
   return on;
 }
 
@@ -55,7 +57,7 @@ void require_built(const SimModel& model) {
     const EffectSet& on = model.effects;
     if ((on.fibres && !kBuiltFibres) || (on.viscous && !kBuiltViscous) ||
         (on.average_nodal_pressure && !kBuiltAveragedPressure) ||
-        (on.mooney_rivlin && !kBuiltMooneyRivlin))
+        (on.mooney_rivlin && !kBuiltMooneyRivlin) || (on.gravity && !kBuiltGravity))
       throw std::invalid_argument(
           "this build of the force loops does not contain an effect the "
           "model has on");
@@ -585,6 +587,7 @@ void add_external_forces(const StepInputs& inputs, const NodeArray& position, No
 }
 
 void add_gravity_forces(const SimModel& model, NodeArray& force) {
+  if constexpr (!kBuiltGravity) return;
   if (!model.effects.gravity) return;
   const Eigen::Vector3d g = model.gravity_m_per_s2;
   for (std::size_t n = 0; n < model.node_count; ++n) {
@@ -596,6 +599,7 @@ void add_gravity_forces(const SimModel& model, NodeArray& force) {
 }
 
 void add_support_forces(const SimModel& model, const NodeArray& position, NodeArray& force) {
+  if constexpr (!kBuiltGravity) return;
   if (!model.support) return;
   const SupportSurface& support = *model.support;
   for (std::size_t n = 0; n < model.node_count; ++n) {
@@ -613,6 +617,14 @@ void add_support_forces(const SimModel& model, const NodeArray& position, NodeAr
     force.y[n] += push.y();
     force.z[n] += push.z();
   }
+}
+
+ElasticEvaluation compute_tissue_forces(const SimModel& model, SimState& state,
+                                        double dt_since_last_s) {
+  const ElasticEvaluation seen = here::compute_internal_forces(model, state, dt_since_last_s);
+  here::add_gravity_forces(model, state.force_n);
+  here::add_support_forces(model, state.position_m, state.force_n);
+  return seen;
 }
 
 double strain_energy_j(const SimModel& model, const NodeArray& position) {

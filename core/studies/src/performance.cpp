@@ -106,7 +106,8 @@ BuildComparison compare_force_builds(const SimModel& model, const SimState& stat
     double normal = 0.0, variant = 0.0;
     for (int turn = 0; turn < 2; ++turn) {
       if ((turn == 0) == normal_first)
-        normal = time_force_evaluations(model, a, step_s, min_wall_s, 1).ns_per_tet;
+        normal = time_force_evaluations(model, a, step_s, min_wall_s, 1, &compute_tissue_forces)
+                     .ns_per_tet;
       else
         variant = time_force_evaluations(model, b, step_s, min_wall_s, 1, other).ns_per_tet;
     }

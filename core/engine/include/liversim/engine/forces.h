@@ -50,6 +50,12 @@ ElasticEvaluation compute_elastic_forces(const SimModel& model, const NodeArray&
 ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state,
                                           double dt_since_last_s);
 
+// The tissue's own forces on its nodes, into state.force_n: the internal forces and, with gravity,
+// each node's weight and its support's push (what a force evaluation of a step computes before the
+// inputs'). What the benchmark of an effect left off times on each build (forces_variants.h).
+ElasticEvaluation compute_tissue_forces(const SimModel& model, SimState& state,
+                                        double dt_since_last_s);
+
 // compute_internal_forces' type, for benchmarks that time another build of it (forces_variants.h).
 using InternalForcesFunction = ElasticEvaluation (*)(const SimModel&, SimState&, double);
 

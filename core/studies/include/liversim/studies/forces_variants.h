@@ -17,13 +17,14 @@ inline constexpr unsigned kWithoutFibres = 1;
 inline constexpr unsigned kWithoutViscous = 2;
 inline constexpr unsigned kWithoutAverageNodalPressure = 4;
 inline constexpr unsigned kWithoutMooneyRivlin = 8;
+inline constexpr unsigned kWithoutGravity = 16;
 
 struct ForcesVariant {
   const char* effect;  // the effect the build leaves out
   unsigned without;    // its bit
-  // compute_internal_forces of that build; throws std::invalid_argument for a model with the
+  // compute_tissue_forces of that build; throws std::invalid_argument for a model with the
   // effect on.
-  InternalForcesFunction compute_internal_forces;
+  InternalForcesFunction compute_tissue_forces;
 };
 
 // One build per effect, each without that effect.

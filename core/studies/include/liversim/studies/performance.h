@@ -33,7 +33,8 @@ ForceEvaluationTiming time_force_evaluations(
     const SimModel& model, SimState& state, double step_s, double min_wall_s, int repetitions = 3,
     InternalForcesFunction compute = &compute_internal_forces);
 
-// The normal build against another build of the force loops on the same model and state.
+// The normal build against another build of the force loops on the same model and state: the
+// normal build's compute_tissue_forces against `other`, the other build's.
 struct BuildComparison {
   double normal_ns_per_tet = 0.0, other_ns_per_tet = 0.0;  // each build's best run
   // The median over the rounds of normal / other − 1, each round's two runs back to back: a
