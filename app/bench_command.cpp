@@ -110,8 +110,9 @@ std::string exit_description(int status) {
   return "ended with wait status " + std::to_string(status);
 }
 
-// Runs `workstation --tets N --quit-after S` as a child (offscreen when there is no display) and
-// takes its peak resident set (wait4's ru_maxrss, KiB). A child still running long after it should
+// Runs `workstation --tets N --quit-after S` as a child (on Qt's offscreen platform when there is
+// no display, where the workstation says it cannot show its 3D view and exits: run the bench
+// under xvfb-run to measure it) and takes its peak resident set (wait4's ru_maxrss, KiB). A child still running long after it should
 // have quit is killed, and reported as such.
 WorkstationMemory measure_workstation(const std::filesystem::path& workstation, int tets,
                                       double seconds) {

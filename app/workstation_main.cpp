@@ -254,6 +254,16 @@ int main(int argc, char** argv) {
   QApplication::setDesktopFileName("org.liversim.LiverSim");
   QApplication::setWindowIcon(QIcon(":/icons/liversim.svg"));
   quit_on_stop_signals(app);
+  // The viewport is a QOpenGLWidget, which Qt's offscreen and minimal platforms do not support
+  // (they create a context, but no surface for the widget): said here, rather than VTK crashing
+  // on the missing surface.
+  if (const QString platform = QGuiApplication::platformName();
+      platform == QLatin1String("offscreen") || platform == QLatin1String("minimal")) {
+    std::cerr << "liversim: Qt's '" << platform.toStdString()
+              << "' platform cannot show the 3D view (no OpenGL widget). Run it on a desktop or "
+                 "under xvfb-run -a.\n";
+    return 2;
+  }
   liversim::installTranslations(options.language.isEmpty() ? liversim::languageSetting()
                                                            : options.language);
   try {

@@ -57,7 +57,7 @@ step_table=(
   "haptics|haptics.md|1|1|"
   "session-storage|session-storage.md|1|1|"
   "seed-experiments|seed-experiments.md|4|1|"
-  "performance|performance.md|10|2|valgrind counts instructions; the workstation runs offscreen for its memory"
+  "performance|performance.md|10|2|valgrind counts instructions; the workstation runs under Xvfb for its memory"
   "cutting|cutting-performance.md cutting.md|5|1|eight strokes at 10583 tets"
   "cutting-live|cutting-live.md|1|1|"
   "haptics-servo|haptics-servo.md|1|1|"
@@ -428,8 +428,8 @@ step_performance() {
     --min-time 0.3 --table1-seconds 1 --workstation-tets 10583 --workstation-seconds 10)
   ((!quick)) || args=(--tets 1000 --stepping-tets 1000 --threads 2 --min-time 0.01
     --table1-seconds 0.01 --workstation-tets 1000 --workstation-seconds 1)
-  # Under Xvfb: the workstation whose memory the bench measures needs an OpenGL display (with
-  # Qt's offscreen platform it has no context, and VTK then crashes it).
+  # Under Xvfb: the workstation whose memory the bench measures needs an OpenGL display (Qt's
+  # offscreen platform has no OpenGL widget: the workstation refuses to start on it).
   run "${xvfb[@]}" "$cli" bench "${args[@]}" --output-dir "$out"
   doing || return 0
   stamp performance.md
