@@ -115,9 +115,9 @@ double gravity_potential_energy_j(const SimModel& model, const NodeArray& positi
   const NodeArray& rest = model.rest_position_m;
   double energy = 0.0;
   for (std::size_t n = 0; n < model.node_count; ++n)
-    energy -= model.lumped_mass_kg[n] * (g.x() * (position.x[n] - rest.x[n]) +
-                                         g.y() * (position.y[n] - rest.y[n]) +
-                                         g.z() * (position.z[n] - rest.z[n]));
+    energy -= model.lumped_mass_kg[n] *
+              (g.x() * (position.x[n] - rest.x[n]) + g.y() * (position.y[n] - rest.y[n]) +
+               g.z() * (position.z[n] - rest.z[n]));
   return energy;
 }
 
@@ -126,8 +126,7 @@ double support_energy_j(const SimModel& model, const NodeArray& position) {
   double energy = 0.0;
   for (std::size_t n = 0; n < model.node_count; ++n) {
     if (model.is_fixed[n]) continue;
-    const Eigen::Vector3d x = position.at(n);
-    const double past = x.dot(model.support->down) - model.support->depth_under(x).depth_m;
+    const double past = model.support->depth_under(position.at(n)).past_m;
     if (past > 0.0)
       energy += 0.5 * model.lumped_mass_kg[n] * model.support_stiffness_per_kg * past * past;
   }

@@ -604,9 +604,8 @@ void add_support_forces(const SimModel& model, const NodeArray& position, NodeAr
   const SupportSurface& support = *model.support;
   for (std::size_t n = 0; n < model.node_count; ++n) {
     if (model.is_fixed[n]) continue;
-    const Eigen::Vector3d x = position.at(n);
-    const SupportSurface::Depth under = support.depth_under(x);
-    const double past = x.dot(support.down) - under.depth_m;
+    const SupportSurface::Depth under = support.depth_under(position.at(n));
+    const double past = under.past_m;
     if (!(past > 0.0)) continue;
     // −∇(½·k·p²), p = x·down − depth(u, v).
     const double k = model.lumped_mass_kg[n] * model.support_stiffness_per_kg;

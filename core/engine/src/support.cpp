@@ -12,7 +12,8 @@ namespace liversim {
 SupportSurface::Depth SupportSurface::depth_under(const Eigen::Vector3d& point_m) const {
   const double u = (point_m.dot(axis_u) - origin_u_m) / cell_m;
   const double v = (point_m.dot(axis_v) - origin_v_m) / cell_m;
-  if (!(u >= 0.0 && v >= 0.0 && u <= cells_u && v <= cells_v)) return {floor_depth_m, 0.0, 0.0};
+  if (!(u >= 0.0 && v >= 0.0 && u <= cells_u && v <= cells_v))
+    return {floor_depth_m, 0.0, 0.0, point_m.dot(down) - floor_depth_m};
   const int i = std::min(static_cast<int>(u), cells_u - 1);
   const int j = std::min(static_cast<int>(v), cells_v - 1);
   const double a = u - i, b = v - j;
@@ -24,6 +25,7 @@ SupportSurface::Depth SupportSurface::depth_under(const Eigen::Vector3d& point_m
   out.depth_m = (1 - a) * (1 - b) * d00 + a * (1 - b) * d10 + (1 - a) * b * d01 + a * b * d11;
   out.slope_u = ((1 - b) * (d10 - d00) + b * (d11 - d01)) / cell_m;
   out.slope_v = ((1 - a) * (d01 - d00) + a * (d11 - d10)) / cell_m;
+  out.past_m = point_m.dot(down) - out.depth_m;
   return out;
 }
 

@@ -148,8 +148,9 @@ Scenario Workstation::described_scenario() const {
                parenchyma.viscoplastic.has_value(), s.parenchyma.fibres.has_value()};
   if (const Eigen::Vector3d& g = options.gravity_m_per_s2; !g.isZero(0.0)) {
     s.effects.gravity = true;
+    const Eigen::Vector3d down = g.normalized();
     s.effects.gravity_m_per_s2 = g.norm();
-    s.effects.gravity_direction = {g.x() / g.norm(), g.y() / g.norm(), g.z() / g.norm()};
+    s.effects.gravity_direction = {down.x(), down.y(), down.z()};
   }
   s.organ.target_tet_count = setup_.built_in_liver_tets.value_or(s.organ.target_tet_count);
   s.integrator = options.integrator;

@@ -32,8 +32,10 @@ struct SupportSurface {
   struct Depth {
     double depth_m = 0.0;
     double slope_u = 0.0, slope_v = 0.0;  // ∂depth/∂u, ∂depth/∂v
+    double past_m = 0.0;  // how far the point is deeper than the support (≤ 0: clear of it)
   };
-  // The support's depth and slope under the point `point_m` (its u, v), bilinear in the grid.
+  // The support's depth and slope under the point `point_m` (its u, v), bilinear in the grid, and
+  // how far the point has gone past it.
   Depth depth_under(const Eigen::Vector3d& point_m) const;
 };
 
