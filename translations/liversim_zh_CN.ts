@@ -2675,8 +2675,8 @@ Simulated: %2.
         <translation>手术刀(&amp;S)</translation>
     </message>
     <message>
-        <source>Press the left mouse button on the liver to put the blade on it and drag: it breaks in where the tissue is stressed past its cutting threshold and cuts along its path</source>
-        <translation>在肝脏上按下鼠标左键放下刀片并拖动：刀片在组织应力超过切割阈值处切入，并沿拖动路径切割</translation>
+        <source>Press the left mouse button on the liver to put the blade on it and drag: it breaks in once pressed hard enough to part the tissue and cuts along its path</source>
+        <translation>在肝脏上按下鼠标左键放下刀片并拖动：用力压到足以分开组织时刀片切入，并沿拖动路径切割</translation>
     </message>
     <message>
         <source>Force on the tool: %1 N (holding tissue)</source>

@@ -96,7 +96,7 @@ ToolPanel::ToolPanel(QWidget* parent) : QWidget(parent) {
          "to let go"));
   add(tr("&Scalpel"), "toolScalpel", static_cast<int>(ToolKind::scalpel),
       tr("Press the left mouse button on the liver to put the blade on it and drag: it breaks in "
-         "where the tissue is stressed past its cutting threshold and cuts along its path"));
+         "once pressed hard enough to part the tissue and cuts along its path"));
   force_ = new QLabel(this);
   force_->setObjectName("toolForce");
   layout->addWidget(force_);

@@ -170,6 +170,48 @@ TEST(Tools, ProbeContactPushesTheTissueAndFeelsTheSupportReaction) {
   EXPECT_LE((on_tool + balance.support_n).norm(), balance.residual_n + 1e-12 * on_tool.norm());
 }
 
+// A part whose axis lies behind a face's plane but passes beside the face (its closest point on
+// the face's edge) has not gone through it: the face is pushed aside by what the part overlaps it
+// (radius − distance), not along its normal by the axis's depth, which jumped from nothing to
+// millimetres as the axis passed the edge and flung the light nodes of a cut (issue 42).
+TEST(Tools, AFaceAPartPassesBesideIsPushedAsideNotThroughItsDepth) {
+  const Block block;
+  const SimModel& model = block.model;
+  ContactScratch scratch;
+  std::vector<NodeSpring> springs;
+  // A blade upright, its axis 0.2 mm outside the block's side face x = 0.06 and reaching 8 mm
+  // below the top: behind the top faces' plane, beside them.
+  const double radius = 0.0005, outside = 0.0002;
+  const Capsule beside{{0.06 + outside, 0.025, kBlockTop + 0.01},
+                       {0.06 + outside, 0.025, kBlockTop - 0.008},
+                       radius};
+  std::vector<PartContact> met(1);
+  add_contact_springs(model, SurfaceBvh(block.surface, model.rest_position_m),
+                      model.rest_position_m, std::span(&beside, 1), ContactSettings{}, scratch,
+                      springs, met);
+  ASSERT_FALSE(springs.empty());
+  // Away from the upright axis, horizontally; a node's spring sums its faces' shares (force
+  // Σ w·k·push over stiffness Σ w²·k), so its anchor may lie a few pushes away, never the 8.5 mm
+  // of the axis's depth.
+  for (const NodeSpring& spring : springs) {
+    const Eigen::Vector3d push = spring.anchor_m - model.rest_position_m.at(spring.node);
+    EXPECT_LT(push.x(), 0.0) << "node " << spring.node << " not pushed away from the blade";
+    EXPECT_NEAR(push.z(), 0.0, 1e-12) << "node " << spring.node << " pushed along the top's normal";
+    EXPECT_LE(push.norm(), 6.0 * (radius - outside)) << "node " << spring.node;
+  }
+  // What the blade met: the reaction of the springs at those positions, and where along it.
+  Eigen::Vector3d reaction = Eigen::Vector3d::Zero();
+  for (const NodeSpring& spring : springs)
+    reaction -=
+        spring.stiffness_n_per_m * (spring.anchor_m - model.rest_position_m.at(spring.node));
+  ASSERT_TRUE(met[0].touched());
+  EXPECT_LT((met[0].force_on_part_n - reaction).norm(), 1e-9 * reaction.norm());
+  EXPECT_GT(met[0].force_on_part_n.x(), 0.0);           // the side face pushes the blade away
+  const double top_at = 0.01 / 0.018, bottom_at = 1.0;  // the block's side from top to tip
+  EXPECT_GE(met[0].touched_from, top_at - 1e-9);
+  EXPECT_LE(met[0].touched_to, bottom_at + 1e-9);
+}
+
 TEST(Tools, ForcepsGraspOnClosingPullAndReleaseOnOpening) {
   const Block block;
   const SimModel& model = block.model;

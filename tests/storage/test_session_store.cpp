@@ -347,38 +347,30 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
 
 // The simulation's input log goes in chunks, one per commit, and reads back whole and in order,
 // with how the scene was built; a chunk damaged in the file is named with its session.
-// A session recorded by `liversim-cli record` before the station existed (commit 0c1087a: 2.5 s
-// of a scripted scalpel drawn through the 1500-element built-in liver, two cuts, at 1 kHz; the
-// file is tests/data/storage/session-v5-scalpel-cut.sqlite), replayed by today's engine: its final
-// positions and velocities are those the replay of that commit gave, to the last bit. The digest
-// is 64-bit FNV-1a over the position then the velocity arrays (x, y, z each), taken then by the
-// same function. Bit for bit holds for one build of the engine, the one the digest was taken
-// with: GCC's optimised build with the AVX2+FMA element kernels. Other builds skip. A deliberate
-// change of the engine's numerics fails it: old sessions then no longer replay as recorded, which
-// is for that change to say (and to record a new file and digest).
-TEST(SessionReplay, ASessionRecordedBeforeTheStationReplaysToTheSameStateBitForBit) {
-#if !defined(__GNUC__) || defined(__clang__) || !defined(__OPTIMIZE__) || \
-    defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "the digest is of GCC's optimised build without sanitizers";
-#endif
-  if (element_kernel_instruction_set() != "avx2+fma")
-    GTEST_SKIP() << "the digest is of the AVX2+FMA element kernels; these are "
-                 << element_kernel_instruction_set();
-  const fs::path file = fresh_database("recorded-before-the-station");
-  fs::copy_file(fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cut.sqlite",
-                file);
+// The final state of a recorded session replayed by today's engine: node count, steps, simulated
+// time, and a 64-bit FNV-1a digest over the position then the velocity arrays (x, y, z each).
+struct ReplayedEnd {
+  std::size_t nodes = 0;
+  std::uint64_t steps = 0;
+  double time_s = 0.0;
+  std::uint64_t digest = 1469598103934665603ull;
+};
+ReplayedEnd replay_to_the_end(const fs::path& recorded, const std::string& name) {
+  const fs::path file = fresh_database(name);
+  fs::copy_file(recorded, file);
   SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
   const std::optional<ReplaySetup> setup = store.replay_setup(1);
-  ASSERT_TRUE(setup);
+  EXPECT_TRUE(setup);
+  if (!setup) return {};
   SessionReplay replay(replay_scene(*setup, store.scenario_text(1)), store.inputs(1));
-  ASSERT_TRUE(replay.advance_to(std::numeric_limits<double>::infinity()));
+  EXPECT_TRUE(replay.advance_to(std::numeric_limits<double>::infinity()));
   const SimState& state = replay.simulation().state();
-  std::uint64_t digest = 1469598103934665603ull;
+  ReplayedEnd end{state.position_m.size(), state.step_count, state.time_s};
   const auto fold = [&](const std::vector<double>& values) {
     const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
     for (std::size_t i = 0; i < values.size() * sizeof(double); ++i) {
-      digest ^= bytes[i];
-      digest *= 1099511628211ull;
+      end.digest ^= bytes[i];
+      end.digest *= 1099511628211ull;
     }
   };
   for (const NodeArray* array : {&state.position_m, &state.velocity_m_per_s}) {
@@ -386,10 +378,47 @@ TEST(SessionReplay, ASessionRecordedBeforeTheStationReplaysToTheSameStateBitForB
     fold(array->y);
     fold(array->z);
   }
-  EXPECT_EQ(state.position_m.size(), 437u) << "the cuts made other nodes";
-  EXPECT_EQ(state.step_count, 10038u);
-  EXPECT_EQ(state.time_s, 2.4936618463282314);
-  EXPECT_EQ(digest, 0x51bb48c117507a0aull);
+  return end;
+}
+
+// A session recorded by `liversim-cli record` before the station existed (commit 0c1087a: 2.5 s
+// of a scripted scalpel drawn through the 1500-element built-in liver, two cuts, at 1 kHz;
+// tests/data/storage/session-v5-scalpel-cut.sqlite) still reads and replays to its end with its
+// cuts. Until the scalpel broke in by the tissue's toughness (issue 42) its replay gave that
+// commit's state to the last bit; a deliberate change of the cutting physics ends that, and the
+// bit-for-bit guard moved to a session recorded with the new physics (below).
+TEST(SessionReplay, ASessionRecordedBeforeTheStationStillReplaysToItsEndWithItsCuts) {
+  const ReplayedEnd end = replay_to_the_end(
+      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cut.sqlite",
+      "recorded-before-the-station");
+  EXPECT_GT(end.nodes, 434u) << "its scalpel cut nothing (the uncut liver has 434 nodes)";
+  EXPECT_GT(end.time_s, 2.4);
+}
+
+// A session recorded when the scalpel came to break in by the tissue's toughness (issue 42):
+// `liversim-cli record --tets 1500 --tool scalpel --duration 2.6 --trajectory
+// tests/data/trajectories/free-practice-three-strokes.txt`, two cuts
+// (tests/data/storage/session-v5-scalpel-cuts-toughness.sqlite). Replayed by today's engine, its
+// final positions and velocities are those its replay gave when it was recorded, to the last bit.
+// Bit for bit holds for one build of the engine, the one the digest was taken with: GCC's
+// optimised build with the AVX2+FMA element kernels. Other builds skip. A deliberate change of the
+// engine's numerics fails it: old sessions then no longer replay as recorded, which is for that
+// change to say (and to record a new file and digest).
+TEST(SessionReplay, ARecordedSessionReplaysToTheSameStateBitForBit) {
+#if !defined(__GNUC__) || defined(__clang__) || !defined(__OPTIMIZE__) || \
+    defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "the digest is of GCC's optimised build without sanitizers";
+#endif
+  if (element_kernel_instruction_set() != "avx2+fma")
+    GTEST_SKIP() << "the digest is of the AVX2+FMA element kernels; these are "
+                 << element_kernel_instruction_set();
+  const ReplayedEnd end = replay_to_the_end(
+      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cuts-toughness.sqlite",
+      "recorded-with-toughness");
+  EXPECT_EQ(end.nodes, 436u) << "the cuts made other nodes";
+  EXPECT_EQ(end.steps, 4429u);
+  EXPECT_EQ(end.time_s, 2.5990115343578988);
+  EXPECT_EQ(end.digest, 0x6fd25802af5df98cull);
 }
 
 TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {

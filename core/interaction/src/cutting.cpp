@@ -25,6 +25,10 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
   };
   if (!std::isfinite(settings.cutting_stress_pa) || settings.cutting_stress_pa < 0.0)
     return out_of_range("cutting stress (Pa)", settings.cutting_stress_pa, "a finite value >= 0");
+  if (!std::isfinite(settings.fracture_toughness_j_per_m2) ||
+      settings.fracture_toughness_j_per_m2 < 0.0)
+    return out_of_range("fracture toughness (J/m²)", settings.fracture_toughness_j_per_m2,
+                        "a finite value >= 0");
   if (!(settings.snap_fraction >= 0.0 && settings.snap_fraction <= 0.5))
     return out_of_range("snap fraction", settings.snap_fraction, "a value in [0, 0.5]");
   if (!(settings.snap_min_shape_fraction > 0.0 && settings.snap_min_shape_fraction < 1.0))

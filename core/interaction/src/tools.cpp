@@ -124,8 +124,8 @@ int tool_capsules(const Tool& tool, std::array<Capsule, 3>& parts) {
       return 3;
     case ToolKind::scalpel:
       parts[0] = {pose.origin_m, hand_end, g.shaft_radius_m};
-      parts[1] = {pose.origin_m, pose.to_scene({0.0, 0.0, -g.blade_length_m}),
-                  g.blade_half_thickness_m};
+      parts[kScalpelBlade] = {pose.origin_m, pose.to_scene({0.0, 0.0, -g.blade_length_m}),
+                              g.blade_half_thickness_m};
       return 2;
   }
   return 0;
@@ -187,10 +187,12 @@ SegmentTriangleClosest segment_triangle_closest(const Eigen::Vector3d& a, const 
 std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
                                 const NodeArray& position, std::span<const Capsule> parts,
                                 const ContactSettings& settings, ContactScratch& scratch,
-                                std::vector<NodeSpring>& springs) {
+                                std::vector<NodeSpring>& springs, std::span<PartContact> per_part) {
   const double omega_sq = std::pow(2.0 * std::numbers::pi * settings.frequency_hz, 2);
   scratch.resize(model.node_count);
-  for (const Capsule& part : parts) {
+  for (PartContact& met : per_part) met = {};
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const Capsule& part = parts[p];
     bvh.for_each_triangle_overlapping(
         Aabb::around(part.a_m, part.b_m, part.radius_m), [&](std::size_t t) {
           const SurfaceBvh::Triangle& triangle = bvh.triangles()[t];
@@ -205,7 +207,13 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
           const Eigen::Vector3d axis_to_surface = closest.on_triangle - closest.on_segment;
           const double height = -axis_to_surface.dot(normal);  // of the axis above the face
           Eigen::Vector3d push;  // how far the face's point must move to clear the part
-          if (height > 0.0 && closest.distance > 0.0) {
+          // Behind the face's plane but beside the face (its closest point on an edge or a
+          // corner), the axis has not gone through it: the face is pushed aside radially. Pushed
+          // along its normal by the axis's depth, it jumped millimetres as the axis passed a
+          // corner, flinging the light nodes a cut leaves at metres per second (issue 42).
+          const bool beside =
+              std::min({closest.weight[0], closest.weight[1], closest.weight[2]}) <= 0.0;
+          if ((height > 0.0 || beside) && closest.distance > 0.0) {
             if (closest.distance >= part.radius_m) return;
             push = (part.radius_m - closest.distance) / closest.distance * axis_to_surface;
           } else {  // the axis has gone through the face: back out along the inward normal
@@ -218,13 +226,24 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
             point_mass +=
                 closest.weight[i] * model.lumped_mass_kg[static_cast<std::size_t>(triangle[i])];
           const double stiffness = omega_sq * point_mass;
+          double free_weight = 0.0;
           for (int i = 0; i < 3; ++i) {
             const auto node = static_cast<std::size_t>(triangle[i]);
             if (model.inverse_mass_per_kg[node] == 0.0 || closest.weight[i] == 0.0) continue;
+            free_weight += closest.weight[i];
             if (scratch.stiffness_n_per_m[node] == 0.0) scratch.touched.push_back(triangle[i]);
             scratch.stiffness_n_per_m[node] += closest.weight[i] * closest.weight[i] * stiffness;
             scratch.force_n[node] += closest.weight[i] * stiffness * push;
           }
+          if (per_part.empty() || free_weight == 0.0) return;
+          PartContact& met = per_part[p];
+          met.force_on_part_n -= free_weight * stiffness * push;
+          const Eigen::Vector3d axis = part.b_m - part.a_m;
+          const double length_sq = axis.squaredNorm();
+          const double s =
+              length_sq > 0.0 ? (closest.on_segment - part.a_m).dot(axis) / length_sq : 0.0;
+          met.touched_from = std::min(met.touched_from, s);
+          met.touched_to = std::max(met.touched_to, s);
         });
   }
   // One spring per node, giving its summed force at `position` with its summed stiffness.
@@ -325,7 +344,8 @@ std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const Node
   if (blade_cuts && tool.kind == ToolKind::scalpel) count = 1;  // the blade passes: shaft only
   contact_count_ =
       add_contact_springs(*model_, bvh_, position, std::span<const Capsule>(parts.data(), count),
-                          contact_, contact_scratch_, springs_);
+                          contact_, contact_scratch_, springs_,
+                          std::span<PartContact>(part_contact_.data(), part_contact_.size()));
   return springs_;
 }
 

@@ -121,14 +121,16 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   const auto edge = blade_edge_m(scalpel);
   if (!blade_in_tissue_) {
     if (!scalpel.blade_armed) return;
-    // Breaks in where an element the blade pushes is stressed to the cutting threshold.
-    double stress_pa = -1.0;
-    for (const NodeSpring& spring : tools_->springs())
-      for (std::int32_t s = model_->node_slot_begin[spring.node];
-           s < model_->node_slot_begin[spring.node + 1]; ++s)
-        stress_pa = std::max(
-            stress_pa, element_cutting_stress_pa(*model_, state_, model_->node_slot_element[s]));
-    if (stress_pa < cutting_->cutting_stress_pa) return;
+    // Breaks in once the force on the blade reaches the tissue's toughness times the length of
+    // its edge in contact: the tissue would give way at that load (CuttingSettings). An element's
+    // average stress under a thin blade depends on the element's size, not the blade's load.
+    const PartContact& blade = tools_->part_contact(kScalpelBlade);
+    if (!blade.touched()) return;
+    const double edge_in_contact_m =
+        (blade.touched_to - blade.touched_from) * scalpel.geometry.blade_length_m +
+        2.0 * scalpel.geometry.blade_half_thickness_m;
+    if (blade.force_on_part_n.norm() < cutting_->fracture_toughness_j_per_m2 * edge_in_contact_m)
+      return;
     blade_in_tissue_ = true;
     stroke_.edges_m.assign(1, edge);
     return;
@@ -448,7 +450,8 @@ void RealtimeSimulation::log_input(SimulationInput input) {
   input_log_.push_back(std::move(input));
 }
 
-void RealtimeSimulation::replay(std::span<const SimulationInput> inputs) {
+void RealtimeSimulation::replay(std::span<const SimulationInput> inputs,
+                                const CycleObserver& each_cycle) {
   if (running()) throw std::logic_error("replay needs the simulation stopped");
   for (const SimulationInput& input : inputs) switch (input.kind) {
       case SimulationInput::Kind::tool:
@@ -463,11 +466,14 @@ void RealtimeSimulation::replay(std::span<const SimulationInput> inputs) {
                                         std::to_string(model_->node_count) + " nodes");
         active_springs_.assign(input.springs.begin(), input.springs.end());
         break;
-      case SimulationInput::Kind::cycle:
+      case SimulationInput::Kind::cycle: {
         if (halted_.load()) break;
-        advance_cycle(input.steps, input.check_energy);
+        const std::uint64_t topology_before = topology_version_;
+        const GuardedReport guarded = advance_cycle(input.steps, input.check_energy);
         publish_cycle();  // as the live loop does: the snapshot shows the replayed cycle
+        if (each_cycle) each_cycle(guarded.steps, topology_version_ != topology_before);
         break;
+      }
     }
 }
 

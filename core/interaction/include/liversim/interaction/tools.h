@@ -69,6 +69,7 @@ struct Tool {
 // The tool's parts in the scene: shaft and ball (probe), shaft and two jaws (forceps), shaft and
 // blade (scalpel). Returns how many of `parts` it wrote.
 int tool_capsules(const Tool& tool, std::array<Capsule, 3>& parts);
+inline constexpr int kScalpelBlade = 1;  // the scalpel's blade among its parts (heel to tip)
 // Forceps: the point midway between the jaws, where a closing grasp takes hold.
 Eigen::Vector3d forceps_grasp_point_m(const Tool& tool);
 
@@ -95,7 +96,8 @@ SegmentTriangleClosest segment_triangle_closest(const Eigen::Vector3d& a, const 
 
 // Penalty contact against the surface triangles: where a part reaches within its radius of a
 // triangle, the triangle's closest point is pushed out of the part (radially from the part's axis,
-// or along the face's inward normal once the axis has gone through the face) by a critically
+// or, once the axis has gone through the face or lies behind its interior, along the face's
+// inward normal by the radius and the axis's depth behind it) by a critically
 // damped spring whose stiffness gives the mass at that point the contact frequency; the corners
 // share it by their barycentric weights (force w·k·push, stiffness w²·k), and each node gets one
 // spring with the sum of its shares. A thin tool between nodes still meets the faces.
@@ -119,13 +121,24 @@ struct ContactScratch {
   }
 };
 
+// What one tool part met in a contact evaluation: the tissue's force on it (the springs' elastic
+// part at the positions evaluated, N) and the stretch of its axis that touched the tissue, as
+// parameters along it (0 at a, 1 at b).
+struct PartContact {
+  Eigen::Vector3d force_on_part_n = Eigen::Vector3d::Zero();
+  double touched_from = 1.0, touched_to = 0.0;  // from > to: it touched nothing
+  bool touched() const { return touched_from <= touched_to; }
+};
+
 // Finds the faces in contact through the hierarchy (refitted to `position` by the caller) and
-// appends one spring per pushed free node to `springs`; returns how many. Allocates nothing when
-// the scratch is sized and `springs` has the capacity.
+// appends one spring per pushed free node to `springs`; returns how many. `per_part` (empty, or
+// one per part) receives what each part met. Allocates nothing when the scratch is sized and
+// `springs` has the capacity.
 std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
                                 const NodeArray& position, std::span<const Capsule> parts,
                                 const ContactSettings& settings, ContactScratch& scratch,
-                                std::vector<NodeSpring>& springs);
+                                std::vector<NodeSpring>& springs,
+                                std::span<PartContact> per_part = {});
 
 // The forceps' hold on the tissue: the surface nodes near the jaws when they closed,
 // carried rigidly with the tool from then on. Empty: no hold.
@@ -176,10 +189,16 @@ class ToolInteraction {
   void release() {
     grasp_.clear();
     springs_.clear();
+    part_contact_ = {};
     contact_count_ = 0;
   }
   const ForcepsGrasp* grasp() const { return grasping() ? &grasp_ : nullptr; }
   std::size_t contact_count() const { return contact_count_; }
+  // What part `i` of the tool (tool_capsules' order) met in the last update; a part that did not
+  // push (the jaws of a hold, a cutting blade) met nothing.
+  const PartContact& part_contact(int i) const {
+    return part_contact_[static_cast<std::size_t>(i)];
+  }
   const SurfaceBvh& bvh() const { return bvh_; }
 
  private:
@@ -195,6 +214,7 @@ class ToolInteraction {
   std::vector<std::uint8_t> node_mark_;
   ContactScratch contact_scratch_;
   std::vector<NodeSpring> springs_;
+  std::array<PartContact, 3> part_contact_;
   std::size_t contact_count_ = 0;
 };
 

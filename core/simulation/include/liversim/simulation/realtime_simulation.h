@@ -23,6 +23,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -190,7 +191,8 @@ class RealtimeSimulation {
                     GraspSettings grasp = {});
   bool tools_enabled() const { return tools_.has_value(); }
   // From then on a scalpel cuts (cutting.h). Its blade presses on the tissue like any tool until
-  // the stress in an element it pushes reaches the cutting threshold; then the blade breaks in:
+  // the force on it reaches the tissue's toughness times its edge in contact
+  // (CuttingSettings::fracture_toughness_j_per_m2); then the blade breaks in:
   // it stops pushing (only the shaft still does), its edge at each cycle extends the stroke, and
   // the tissue the stroke has passed through is separated. Taking the scalpel away or changing
   // the tool ends the stroke. A cut replaces the model and state (see SimulationSnapshot::model)
@@ -237,8 +239,11 @@ class RealtimeSimulation {
   std::vector<SimulationInput> take_input_log();
   // While stopped: takes `inputs` (an input log of a simulation built from the same model and
   // state, with the same tools and cutting enabled) exactly as the loop took them, and publishes
-  // a snapshot after each cycle as the loop does.
-  void replay(std::span<const SimulationInput> inputs);
+  // a snapshot after each cycle as the loop does. `each_cycle` (optional) hears what the
+  // integrator reported of each cycle, and whether the cut after it parted tissue: what a run in
+  // simulated time (a test, a benchmark) looks at.
+  using CycleObserver = std::function<void(const StepReport& steps, bool parted)>;
+  void replay(std::span<const SimulationInput> inputs, const CycleObserver& each_cycle = {});
 
   // Consumer side (one thread, e.g. the UI): the newest snapshot, if one was published since.
   bool update_snapshot() { return snapshots_.update(); }
