@@ -177,22 +177,27 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << "to a database thrown away after. Each second of wall time: the simulated time it "
       << "advanced (the real-time factor), the smallest step taken and what limited it (the mesh "
       << "with its stiffening, the springs of the tool, or the node-travel limit), and the cut "
-      << "updates made in it. Targets (issue 42): a real-time factor of at least "
-      << kLeastRealTimeFactor << " in every second, no step below " << kLeastStepMs
+      << "updates made in it. The loop is paced by the clock, so a second that keeps up shows a "
+      << "factor a little under 1 (the cycle it waits for); one that cannot keep up is capped and "
+      << "drops time (\"fell behind\"). Targets (issue 42): the loop keeps up in every second (a "
+      << "real-time factor of " << kLeastRealTimeFactor << "), no step below " << kLeastStepMs
       << " ms, every cut update within a frame (" << kFrameMs << " ms).\n\n"
-      << "| second | blade in | real-time factor | smallest step (ms) | mesh limit (ms) | "
-         "with springs (ms) | travel limit (ms) | force evaluations / simulated ms | cut updates "
-         "| parted |\n"
-      << "|---:|:---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+      << "| second | blade in | real-time factor | fell behind | smallest step (ms) | mesh limit "
+         "(ms) | with springs (ms) | travel limit (ms) | force evaluations / simulated ms | cut "
+         "updates | parted |\n"
+      << "|---:|:---:|---:|:---:|---:|---:|---:|---:|---:|---:|---:|\n";
   double least_factor = std::numeric_limits<double>::infinity();
+  int seconds_behind = 0;
   for (const auto& [second, s] : seconds) {
     if (s.wall_s <= 0.0) continue;
     const double factor = s.simulated_s / s.wall_s;
     least_factor = std::min(least_factor, factor);
+    seconds_behind += s.behind;
     doc << "| " << second << " | " << (s.blade_in_tissue ? "yes" : "") << " | " << std::fixed
-        << std::setprecision(2) << factor << " | " << ms_text(s.smallest_step_s) << " | "
-        << ms_text(s.smallest_mesh_limit_s) << " | " << ms_text(s.smallest_spring_limit_s) << " | "
-        << ms_text(s.smallest_travel_limit_s) << " | " << std::setprecision(1)
+        << std::setprecision(3) << factor << " | " << (s.behind ? "**yes**" : "") << " | "
+        << ms_text(s.smallest_step_s) << " | " << ms_text(s.smallest_mesh_limit_s) << " | "
+        << ms_text(s.smallest_spring_limit_s) << " | " << ms_text(s.smallest_travel_limit_s)
+        << " | " << std::setprecision(1)
         << (s.simulated_s > 0.0 ? s.force_evaluations / (s.simulated_s * 1e3) : 0.0) << " | "
         << s.cuts << " | " << s.parts << " |\n";
   }
@@ -208,9 +213,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   const double slowest_ms =
       update_ms.empty() ? 0.0 : *std::max_element(update_ms.begin(), update_ms.end());
   doc << "\n"
-      << start_tets << " tetrahedra before, " << end_tets << " after. Least real-time "
-      << "factor " << std::setprecision(2) << least_factor << " (target " << kLeastRealTimeFactor
-      << ": " << (least_factor >= kLeastRealTimeFactor ? "met" : "**not met**")
+      << start_tets << " tetrahedra before, " << end_tets << " after. Seconds the loop fell "
+      << "behind: " << seconds_behind << " (least real-time factor " << std::setprecision(3)
+      << least_factor << "; target: it keeps up, " << (seconds_behind == 0 ? "met" : "**not met**")
       << "); smallest step " << ms_text(smallest_step_s) << " ms (target " << kLeastStepMs
       << " ms: " << (smallest_step_s * 1e3 >= kLeastStepMs ? "met" : "**not met**")
       << "); slowest cut update " << std::setprecision(2) << slowest_ms << " ms (target "
