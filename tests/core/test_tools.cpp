@@ -210,6 +210,16 @@ TEST(Tools, AFaceAPartPassesBesideIsPushedAsideNotThroughItsDepth) {
   const double top_at = 0.01 / 0.018, bottom_at = 1.0;  // the block's side from top to tip
   EXPECT_GE(met[0].touched_from, top_at - 1e-9);
   EXPECT_LE(met[0].touched_to, bottom_at + 1e-9);
+  EXPECT_FALSE(met[0].pierced) << "beside the block, the blade is not through its surface";
+
+  // Moved 1 mm inside the side, the blade's axis passes through the top: it is through.
+  const Capsule through{
+      {0.059, 0.025, kBlockTop + 0.01}, {0.059, 0.025, kBlockTop - 0.008}, radius};
+  springs.clear();
+  add_contact_springs(model, SurfaceBvh(block.surface, model.rest_position_m),
+                      model.rest_position_m, std::span(&through, 1), ContactSettings{}, scratch,
+                      springs, met);
+  EXPECT_TRUE(met[0].pierced);
 }
 
 TEST(Tools, ForcepsGraspOnClosingPullAndReleaseOnOpening) {

@@ -1036,10 +1036,72 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     return any_fixed ? piece_fixed[root] != 0 : root == largest;
   };
 
+  // 6b. Flaps: an element the cut leaves joined to the rest through one face or none, with a
+  // corner no other element holds. That corner carries a quarter of one small element's mass, and
+  // when the cut releases the stress around it, it flies off at metres per second and sets the
+  // explicit step (issue 42). The flap is merged into the element across its joined face (or one
+  // sharing its nodes), which takes its mass: no mass is lost, a sliver of volume is.
+  std::vector<std::uint8_t> merged(tets, 0), exposed(tets, 0);  // exposed: faces bared by a merge
+  std::vector<std::size_t> cut_elements;
+  for (const FaceKey& key : separated)
+    for (NodeIndex n : key)
+      for_each_element_of(model, n, [&](std::size_t e) { cut_elements.push_back(e); });
+  std::sort(cut_elements.begin(), cut_elements.end());
+  cut_elements.erase(std::unique(cut_elements.begin(), cut_elements.end()), cut_elements.end());
+  auto holds = [&](std::size_t e, NodeIndex copy) {
+    for (int c = 0; c < 4; ++c)
+      if (corner[c][e] == copy) return true;
+    return false;
+  };
+  // Merging one flap may leave its neighbour hanging: again until none is left.
+  for (bool merged_one = true; merged_one;) {
+    merged_one = false;
+    for (std::size_t e : cut_elements) {
+      if (merged[e] || !keeps(pieces.find(corner[0][e]))) continue;
+      bool lone_corner = false, holds_fixed = false;
+      std::optional<std::size_t> touching, across;
+      for (int c = 0; c < 4; ++c) {
+        const NodeIndex copy = corner[c][e];
+        holds_fixed |= model.is_fixed[node_origin[copy]] != 0;
+        bool shared = false;
+        for_each_element_of(model, node_origin[copy], [&](std::size_t o) {
+          if (o == e || merged[o] || !holds(o, copy)) return;
+          shared = true;
+          if (!touching) touching = o;
+        });
+        lone_corner |= !shared;
+      }
+      if (!lone_corner || holds_fixed || !touching) continue;
+      int joined_faces = 0, across_face = -1;
+      for (int f = 0; f < 4; ++f) {
+        const NodeIndex a = corner[kTetFace[f][0]][e], b = corner[kTetFace[f][1]][e],
+                        c = corner[kTetFace[f][2]][e];
+        for_each_element_of(model, node_origin[a], [&](std::size_t o) {
+          if (o == e || merged[o] || !holds(o, a) || !holds(o, b) || !holds(o, c)) return;
+          ++joined_faces;
+          across = o;
+          for (int g = 0; g < 4; ++g) {  // the face of o opposite its corner off the joined face
+            const NodeIndex off = corner[g][o];
+            if (off != a && off != b && off != c) across_face = g;
+          }
+        });
+      }
+      if (joined_faces > 1) continue;
+      const std::size_t into = across ? *across : *touching;
+      if (across) exposed[into] |= std::uint8_t(1u << across_face);
+      merged[e] = 1;
+      merged_one = true;
+      geometry.element_mass_kg[into] += geometry.element_mass_kg[e];
+      ++report.merged_elements;
+      report.merged_volume_m3 += shape_of(corners_at(model, geometry.rest_m, e)).volume_m3;
+    }
+  }
+
   // 7. The new model: the kept elements (in their old order) and the nodes they use.
   std::vector<TetIndex> element_origin;
   element_origin.reserve(tets);
   for (std::size_t e = 0; e < tets; ++e) {
+    if (merged[e]) continue;
     if (keeps(pieces.find(corner[0][e]))) {
       element_origin.push_back(static_cast<TetIndex>(e));
     } else {
@@ -1127,6 +1189,8 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
           m.cut_face_mask[i] |= std::uint8_t(1u << f);
           m.boundary_face_mask[i] |= std::uint8_t(1u << f);
         }
+    m.cut_face_mask[i] |= exposed[old];  // inside tissue a merged flap covered
+    m.boundary_face_mask[i] |= exposed[old];
     reshaped[i] = moved;
     if (!moved) continue;
     const Eigen::Vector3d x0 = m.rest_position_m.at(m.corner[0][i]);

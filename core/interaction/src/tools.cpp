@@ -244,6 +244,7 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
               length_sq > 0.0 ? (closest.on_segment - part.a_m).dot(axis) / length_sq : 0.0;
           met.touched_from = std::min(met.touched_from, s);
           met.touched_to = std::max(met.touched_to, s);
+          met.pierced |= closest.distance == 0.0;
         });
   }
   // One spring per node, giving its summed force at `position` with its summed stiffness.

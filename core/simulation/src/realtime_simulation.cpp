@@ -123,13 +123,16 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     if (!scalpel.blade_armed) return;
     // Breaks in once the force on the blade reaches the tissue's toughness times the length of
     // its edge in contact: the tissue would give way at that load (CuttingSettings). An element's
-    // average stress under a thin blade depends on the element's size, not the blade's load.
+    // average stress under a thin blade depends on the element's size, not the blade's load. An
+    // edge already through the surface (put in deep, or pressed through faster than the tissue
+    // gave way) has made its way in: it is in.
     const PartContact& blade = tools_->part_contact(kScalpelBlade);
     if (!blade.touched()) return;
     const double edge_in_contact_m =
         (blade.touched_to - blade.touched_from) * scalpel.geometry.blade_length_m +
         2.0 * scalpel.geometry.blade_half_thickness_m;
-    if (blade.force_on_part_n.norm() < cutting_->fracture_toughness_j_per_m2 * edge_in_contact_m)
+    if (!blade.pierced &&
+        blade.force_on_part_n.norm() < cutting_->fracture_toughness_j_per_m2 * edge_in_contact_m)
       return;
     blade_in_tissue_ = true;
     stroke_.edges_m.assign(1, edge);

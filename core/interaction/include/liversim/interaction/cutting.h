@@ -84,6 +84,10 @@ struct CutReport {
   std::size_t removed_nodes = 0;
   double resected_volume_m3 = 0.0;  // rest volume of those pieces
   double resected_mass_kg = 0.0;
+  // Flaps the cut left hanging by one face or none, with a corner of their own: merged into a
+  // neighbour that takes their mass (cut_tissue step 6b); their rest volume.
+  std::size_t merged_elements = 0;
+  double merged_volume_m3 = 0.0;
 };
 
 struct CutResult {

@@ -127,6 +127,7 @@ struct ContactScratch {
 struct PartContact {
   Eigen::Vector3d force_on_part_n = Eigen::Vector3d::Zero();
   double touched_from = 1.0, touched_to = 0.0;  // from > to: it touched nothing
+  bool pierced = false;  // its axis passes through a face: it is through the surface
   bool touched() const { return touched_from <= touched_to; }
 };
 
