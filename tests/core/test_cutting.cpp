@@ -580,6 +580,13 @@ TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
   settings.fracture_toughness_j_per_m2 = -200.0;
   EXPECT_TRUE(validate(settings).has_value());
   settings = {};
+  settings.region_fracture_toughness_j_per_m2 = {200.0, std::nan("")};
+  ASSERT_TRUE(validate(settings).has_value());
+  EXPECT_NE(validate(settings)->find("region fracture toughness"), std::string::npos);
+  settings = {};
+  settings.full_resistance_speed_m_per_s = 0.0;
+  EXPECT_TRUE(validate(settings).has_value());
+  settings = {};
   settings.snap_fraction = 0.7;
   EXPECT_TRUE(validate(settings).has_value());
   settings = {};

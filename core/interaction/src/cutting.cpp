@@ -15,6 +15,7 @@
 #include <optional>
 #include <random>
 #include <stdexcept>
+#include <utility>
 
 namespace liversim {
 
@@ -29,6 +30,13 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
       settings.fracture_toughness_j_per_m2 < 0.0)
     return out_of_range("fracture toughness (J/m²)", settings.fracture_toughness_j_per_m2,
                         "a finite value >= 0");
+  for (double toughness : settings.region_fracture_toughness_j_per_m2)
+    if (!std::isfinite(toughness) || toughness < 0.0)
+      return out_of_range("region fracture toughness (J/m²)", toughness, "a finite value >= 0");
+  if (!(settings.full_resistance_speed_m_per_s > 0.0) ||
+      !std::isfinite(settings.full_resistance_speed_m_per_s))
+    return out_of_range("full resistance speed (m/s)", settings.full_resistance_speed_m_per_s,
+                        "a finite value > 0");
   if (!(settings.snap_fraction >= 0.0 && settings.snap_fraction <= 0.5))
     return out_of_range("snap fraction", settings.snap_fraction, "a value in [0, 0.5]");
   if (!(settings.snap_min_shape_fraction > 0.0 && settings.snap_min_shape_fraction < 1.0))
@@ -676,35 +684,90 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
   return std::sqrt(std::max(settled ? *settled : largest_ritz_value(), 0.0));
 }
 
+namespace {
+
+// The stretch [t_in, t_out] of the segment heel + t·(tip − heel), t in [0, 1], inside element e
+// with its faces pushed out by `reach_m` (in by −reach_m), by Cyrus–Beck clipping; empty when
+// t_in > t_out.
+std::pair<double, double> edge_within_element(const std::array<Eigen::Vector3d, 4>& p,
+                                              const std::array<Eigen::Vector3d, 2>& edge_m,
+                                              double reach_m) {
+  const Eigen::Vector3d along = edge_m[1] - edge_m[0];
+  double t_in = 0.0, t_out = 1.0;
+  for (int f = 0; f < 4 && t_in <= t_out; ++f) {
+    const auto& face = kTetFace[f];
+    const Eigen::Vector3d& a = p[face[0]];
+    Eigen::Vector3d normal = (p[face[1]] - a).cross(p[face[2]] - a).normalized();
+    if ((p[f] - a).dot(normal) > 0.0) normal = -normal;  // outward: away from the fourth corner
+    const double height = normal.dot(edge_m[0] - a) - reach_m;  // > 0 outside the pushed face
+    const double rate = normal.dot(along);
+    if (rate == 0.0) {
+      if (height > 0.0) t_out = -1.0;
+    } else if (rate < 0.0) {
+      t_in = std::max(t_in, -height / rate);
+    } else {
+      t_out = std::min(t_out, -height / rate);
+    }
+  }
+  return {t_in, t_out};
+}
+
+}  // namespace
+
 bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
                           const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m) {
   const Aabb edge_box = Aabb::around(edge_m[0], edge_m[1], reach_m);
-  const Eigen::Vector3d along = edge_m[1] - edge_m[0];
   for (std::size_t e = 0; e < model.tet_count; ++e) {
     const auto p = corners_at(model, position_m, e);
     Aabb box;
     for (const auto& q : p) box.grow(q);
     if (!box.overlaps(edge_box)) continue;
-    // Clip the segment heel + t·along, t in [0, 1], by the element's four faces (Cyrus–Beck).
-    double t_in = 0.0, t_out = 1.0;
-    for (int f = 0; f < 4 && t_in <= t_out; ++f) {
-      const auto& face = kTetFace[f];
-      const Eigen::Vector3d& a = p[face[0]];
-      Eigen::Vector3d normal = (p[face[1]] - a).cross(p[face[2]] - a).normalized();
-      if ((p[f] - a).dot(normal) > 0.0) normal = -normal;  // outward: away from the fourth corner
-      const double height = normal.dot(edge_m[0] - a) - reach_m;  // > 0 outside the pushed face
-      const double rate = normal.dot(along);
-      if (rate == 0.0) {
-        if (height > 0.0) t_out = -1.0;
-      } else if (rate < 0.0) {
-        t_in = std::max(t_in, -height / rate);
-      } else {
-        t_out = std::min(t_out, -height / rate);
-      }
-    }
+    const auto [t_in, t_out] = edge_within_element(p, edge_m, reach_m);
     if (t_in <= t_out) return true;
   }
   return false;
+}
+
+double fracture_toughness_j_per_m2(const CuttingSettings& settings, std::size_t region) {
+  return region < settings.region_fracture_toughness_j_per_m2.size()
+             ? settings.region_fracture_toughness_j_per_m2[region]
+             : settings.fracture_toughness_j_per_m2;
+}
+
+EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
+                            const std::array<Eigen::Vector3d, 2>& edge_m,
+                            const CuttingSettings& settings, double margin_m) {
+  // Each element's stretch of the edge, its faces pushed out by the margin so that an edge lying
+  // along faces (its own cut, faces snapped onto it) is in; overlaps counted once.
+  struct Stretch {
+    double from, to, toughness;
+  };
+  constexpr std::size_t kMostStretches = 128;  // elements along one edge: a few dozen at most
+  std::array<Stretch, kMostStretches> stretches;
+  std::size_t count = 0;
+  const Aabb edge_box = Aabb::around(edge_m[0], edge_m[1], margin_m);
+  for (std::size_t e = 0; e < model.tet_count && count < kMostStretches; ++e) {
+    const auto p = corners_at(model, position_m, e);
+    Aabb box;
+    for (const auto& q : p) box.grow(q);
+    if (!box.overlaps(edge_box)) continue;
+    const auto [t_in, t_out] = edge_within_element(p, edge_m, margin_m);
+    if (t_in < t_out)
+      stretches[count++] = {t_in, t_out, fracture_toughness_j_per_m2(settings, model.region[e])};
+  }
+  std::sort(stretches.begin(), stretches.begin() + static_cast<std::ptrdiff_t>(count),
+            [](const Stretch& a, const Stretch& b) { return a.from < b.from; });
+  EdgeInTissue in;
+  const double edge_length_m = (edge_m[1] - edge_m[0]).norm();
+  double covered_to = 0.0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double new_m =
+        std::max(0.0, stretches[i].to - std::max(stretches[i].from, covered_to)) * edge_length_m;
+    in.length_m += new_m;
+    in.resistance_n += stretches[i].toughness * new_m;
+    covered_to = std::max(covered_to, stretches[i].to);
+  }
+  return in;
 }
 
 CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,

@@ -138,6 +138,7 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     stroke_.edges_m.assign(1, edge);
     return;
   }
+  resist_cutting(edge);
   // A new instant of the stroke once the edge has moved a tenth of a millimetre (a broken-in
   // blade's stroke starts where it broke in).
   const auto& last = stroke_.edges_m.back();
@@ -247,9 +248,36 @@ void RealtimeSimulation::observe_outcome() {
   outcome_->model = model_;
 }
 
+void RealtimeSimulation::resist_cutting(const std::array<Eigen::Vector3d, 2>& edge) {
+  // The edge's velocity across itself, from its midpoint cycle to cycle in simulated time,
+  // smoothed over 10 ms (a device's frames come at the servo's rate, cycles at the loop's).
+  constexpr double kSmoothingS = 0.01;
+  const Eigen::Vector3d middle = 0.5 * (edge[0] + edge[1]);
+  const double dt = state_.time_s - blade_time_s_;
+  if (blade_time_s_ >= 0.0 && dt > 0.0)
+    blade_velocity_m_per_s_ +=
+        dt / (kSmoothingS + dt) * ((middle - blade_middle_m_) / dt - blade_velocity_m_per_s_);
+  blade_middle_m_ = middle;
+  blade_time_s_ = state_.time_s;
+  const Eigen::Vector3d axis = (edge[1] - edge[0]).normalized();
+  const Eigen::Vector3d across = blade_velocity_m_per_s_ - blade_velocity_m_per_s_.dot(axis) * axis;
+  const double speed = across.norm();
+  if (!(speed > 0.0)) {
+    cutting_force_n_.setZero();
+    return;
+  }
+  const EdgeInTissue in = edge_in_tissue(*model_, state_.position_m, edge, *cutting_);
+  cutting_force_n_ = -in.resistance_n *
+                     std::min(1.0, speed / cutting_->full_resistance_speed_m_per_s) * across /
+                     speed;
+}
+
 void RealtimeSimulation::end_stroke() {
   stroke_.edges_m.clear();
   blade_in_tissue_ = false;
+  cutting_force_n_.setZero();
+  blade_velocity_m_per_s_.setZero();
+  blade_time_s_ = -1.0;
 }
 
 double RealtimeSimulation::haptic_servo_period_s() const {
@@ -490,11 +518,13 @@ void RealtimeSimulation::publish_cycle() {
   out.time_s = state_.time_s;
   out.step_count = state_.step_count;
   // The local model of the force on the tool: its F0 is the snapshot's tool force.
-  const LocalForceModel force_model =
+  LocalForceModel force_model =
       tool_acts ? tool_force_model(tools_->springs(), state_.position_m,
                                    active_tool_->pose.origin_m, haptic_servo_period_s())
                 : LocalForceModel{};
+  if (tool_acts && blade_in_tissue_) force_model.force_n += cutting_force_n_;  // the cut's pull
   out.tool_force_n = force_model.force_n;
+  out.cutting_force_n = tool_acts && blade_in_tissue_ ? cutting_force_n_ : Eigen::Vector3d::Zero();
   out.tool_grasping = tool_acts && tools_->grasping();
   out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
   out.blade_cutting = tool_acts && blade_in_tissue_;

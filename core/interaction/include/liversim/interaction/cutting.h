@@ -45,6 +45,13 @@ struct CuttingSettings {
   // rendering of cutting). Porcine liver cut by a scalpel: 187–225 J/m² (Chanthasopeephan, Desai
   // & Lau 2006); 0: it breaks in at a touch.
   double fracture_toughness_j_per_m2 = 200.0;
+  // Per region (the model's region indices), when the regions differ (a lesion harder to cut
+  // than parenchyma); empty: every region has the toughness above.
+  std::vector<double> region_fracture_toughness_j_per_m2;
+  // A cutting blade is held back by the toughness times its edge in the tissue, against its
+  // motion across the edge; below this speed the resistance grows from zero with the speed (a
+  // still blade is not pushed back, and the force does not flip with the hand's tremor).
+  double full_resistance_speed_m_per_s = 0.005;
   // A node is moved onto the cut when the cut crosses one of its edges within this fraction of
   // the edge's length from it, and when every element it belongs to keeps at least
   // `snap_min_shape_fraction` of its smallest height and of its volume, at rest and deformed.
@@ -68,6 +75,20 @@ struct BladeStroke {
 
 // The scalpel's edge (heel, tip) in the scene.
 std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel);
+
+// The blade's edge in the tissue: the length of the edge within the elements (their faces pushed
+// out by `margin_m`, so that an edge along faces, as in its own cut, is in), and the force that
+// crack front holds back: each stretch times its element's region's toughness (N), the work per
+// unit advance of the crack (Mahvash & Hayward 2001). Allocates nothing.
+struct EdgeInTissue {
+  double length_m = 0.0;
+  double resistance_n = 0.0;
+};
+EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
+                            const std::array<Eigen::Vector3d, 2>& edge_m,
+                            const CuttingSettings& settings, double margin_m = 1e-6);
+// The toughness (J/m²) of `region` under `settings`.
+double fracture_toughness_j_per_m2(const CuttingSettings& settings, std::size_t region);
 
 // Whether the edge (heel, tip) passes through any element of the model in `position`, or within
 // about `reach_m` of one (each element's faces pushed out by that much).

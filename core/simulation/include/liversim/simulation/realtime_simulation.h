@@ -45,6 +45,9 @@ struct SimulationSnapshot {
   bool tool_grasping = false;
   std::size_t tool_contacts = 0;
   bool blade_cutting = false;  // the scalpel has broken into the tissue
+  // Of tool_force_n, the tissue's resistance to the cutting blade (CuttingSettings): its
+  // toughness times the edge in the tissue, against the blade's motion across its edge.
+  Eigen::Vector3d cutting_force_n = Eigen::Vector3d::Zero();
   // The tool acting in the last cycle (set_tool's, or the device's), for drawing.
   std::optional<Tool> tool;
   // The haptic device's newest frame (set_haptic_servo), which the device's tool follows.
@@ -291,12 +294,18 @@ class RealtimeSimulation {
   std::optional<CuttingSettings> cutting_;
   BladeStroke stroke_;            // simulation thread only
   bool blade_in_tissue_ = false;  // the scalpel broke in: its blade passes and cuts
+  Eigen::Vector3d cutting_force_n_ = Eigen::Vector3d::Zero();  // on the blade, while it cuts
+  Eigen::Vector3d blade_velocity_m_per_s_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d blade_middle_m_ = Eigen::Vector3d::Zero();
+  double blade_time_s_ = -1.0;  // when blade_middle_m_ was; < 0: not yet
   std::uint64_t topology_version_ = 0;
   double resected_volume_m3_ = 0.0;
   IntegratorKind integrator_kind_;  // the model's, fixed: stats() reads it from any thread
   // Extends the stroke with the scalpel's edge, cuts, and swaps in the cut model and state.
   void cut_with_scalpel(const Tool& scalpel);
   void end_stroke();  // the blade is out: the next cut needs a new break-in
+  // While the blade cuts: the tissue's resistance to it (CuttingSettings), from its edge `edge`.
+  void resist_cutting(const std::array<Eigen::Vector3d, 2>& edge);
   // Takes the inputs set from other threads (springs, tool, device tool) for the next cycle.
   void take_inputs();
   void change_tool(const std::optional<Tool>& tool);
