@@ -40,6 +40,18 @@ double top_at(const SimModel& model, double x, double y) {
   return top;
 }
 
+// One cycle of `steps` steps with the tool at its pose, as the loop logs it.
+void add_cycle(std::vector<SimulationInput>& inputs, const Tool& tool, int steps) {
+  SimulationInput taken;
+  taken.kind = SimulationInput::Kind::tool;
+  taken.tool = tool;
+  inputs.push_back(taken);
+  SimulationInput cycle;
+  cycle.kind = SimulationInput::Kind::cycle;
+  cycle.steps = steps;
+  inputs.push_back(cycle);
+}
+
 // The scalpel held upright (its 2 cm blade down) over the middle of the liver's top: lowered in
 // 0.5 s from 5 mm above it until the blade's tip is `depth_m` under it, drawn 6 cm along x at
 // `speed_m_per_s` with the tip that deep under the sloping top, lifted out in 0.5 s, then left
@@ -72,14 +84,7 @@ std::vector<SimulationInput> stroke(const SimModel& model, double step_s, double
       scalpel.pose.origin_m = end + (end_above - end) * ((t - lower_s - draw_s) / lift_s);
     else
       scalpel.pose.origin_m = end_above;
-    SimulationInput tool;
-    tool.kind = SimulationInput::Kind::tool;
-    tool.tool = scalpel;
-    inputs.push_back(tool);
-    SimulationInput cycle;
-    cycle.kind = SimulationInput::Kind::cycle;
-    cycle.steps = steps;
-    inputs.push_back(cycle);
+    add_cycle(inputs, scalpel, steps);
   }
   return inputs;
 }
@@ -193,14 +198,7 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
   std::vector<SimulationInput> inputs;
   for (int c = 0; c * kCycleS * kSpeedMPerS <= kTravelM; ++c) {
     scalpel.pose.origin_m = start + Eigen::Vector3d(c * kCycleS * kSpeedMPerS, 0.0, 0.0);
-    SimulationInput tool;
-    tool.kind = SimulationInput::Kind::tool;
-    tool.tool = scalpel;
-    inputs.push_back(tool);
-    SimulationInput cycle;
-    cycle.kind = SimulationInput::Kind::cycle;
-    cycle.steps = steps;
-    inputs.push_back(cycle);
+    add_cycle(inputs, scalpel, steps);
   }
   std::vector<Eigen::Vector3d> steady;  // the force on the blade from 1 cm of travel on
   double top_shift_m = 0.0;             // how far the top near the blade moved, up or down
