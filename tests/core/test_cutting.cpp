@@ -640,10 +640,8 @@ PressedBlade press_blade_and_lift(bool plastic) {
                    element_cutting_stress_pa(model, state, model.node_slot_element[s]));
   const PartContact& blade = hand.part_contact(kScalpelBlade);
   result.blade_force_n = blade.force_on_part_n.norm();
-  result.breaking_in_force_n =
-      CuttingSettings{}.fracture_toughness_j_per_m2 *
-      ((blade.touched_to - blade.touched_from) * scalpel.geometry.blade_length_m +
-       2.0 * scalpel.geometry.blade_half_thickness_m);
+  result.breaking_in_force_n = CuttingSettings{}.fracture_toughness_j_per_m2 *
+                               blade_edge_in_contact_m(blade, scalpel.geometry);
   // Lifted: two seconds free.
   for (int interval = 0; interval < 2000; ++interval) advance(model, state, {}, 1e-3);
   for (std::size_t e = 0; e < model.tet_count; ++e)

@@ -728,6 +728,11 @@ bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
   return false;
 }
 
+double blade_edge_in_contact_m(const PartContact& blade, const ToolGeometry& geometry) {
+  return (blade.touched_to - blade.touched_from) * geometry.blade_length_m +
+         2.0 * geometry.blade_half_thickness_m;
+}
+
 double fracture_toughness_j_per_m2(const CuttingSettings& settings, std::size_t region) {
   return region < settings.region_fracture_toughness_j_per_m2.size()
              ? settings.region_fracture_toughness_j_per_m2[region]
@@ -763,7 +768,6 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
   for (std::size_t i = 0; i < count; ++i) {
     const double new_m =
         std::max(0.0, stretches[i].to - std::max(stretches[i].from, covered_to)) * edge_length_m;
-    in.length_m += new_m;
     in.resistance_n += stretches[i].toughness * new_m;
     covered_to = std::max(covered_to, stretches[i].to);
   }

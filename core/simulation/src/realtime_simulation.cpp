@@ -128,11 +128,9 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     // gave way) has made its way in: it is in.
     const PartContact& blade = tools_->part_contact(kScalpelBlade);
     if (!blade.touched()) return;
-    const double edge_in_contact_m =
-        (blade.touched_to - blade.touched_from) * scalpel.geometry.blade_length_m +
-        2.0 * scalpel.geometry.blade_half_thickness_m;
     if (!blade.pierced &&
-        blade.force_on_part_n.norm() < cutting_->fracture_toughness_j_per_m2 * edge_in_contact_m)
+        blade.force_on_part_n.norm() < cutting_->fracture_toughness_j_per_m2 *
+                                           blade_edge_in_contact_m(blade, scalpel.geometry))
       return;
     blade_in_tissue_ = true;
     stroke_.edges_m.assign(1, edge);

@@ -76,17 +76,20 @@ struct BladeStroke {
 // The scalpel's edge (heel, tip) in the scene.
 std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel);
 
-// The blade's edge in the tissue: the length of the edge within the elements (their faces pushed
-// out by `margin_m`, so that an edge along faces, as in its own cut, is in), and the force that
-// crack front holds back: each stretch times its element's region's toughness (N), the work per
+// The blade's edge in the tissue: the force the crack front along it holds back, each stretch of
+// the edge within an element (its faces pushed out by `margin_m`, so that an edge along faces, as
+// in its own cut, is in; overlaps once) times the element's region's toughness (N): the work per
 // unit advance of the crack (Mahvash & Hayward 2001). Allocates nothing.
 struct EdgeInTissue {
-  double length_m = 0.0;
   double resistance_n = 0.0;
 };
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
                             const std::array<Eigen::Vector3d, 2>& edge_m,
                             const CuttingSettings& settings, double margin_m = 1e-6);
+// The length of the scalpel's edge in contact that `blade` (its part's contact) reports: the
+// stretch of its axis that touched the tissue and the blade's thickness (a tip's crack is that
+// wide). Times the toughness, the force at which it breaks in.
+double blade_edge_in_contact_m(const PartContact& blade, const ToolGeometry& geometry);
 // The toughness (J/m²) of `region` under `settings`.
 double fracture_toughness_j_per_m2(const CuttingSettings& settings, std::size_t region);
 
