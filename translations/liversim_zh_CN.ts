@@ -883,6 +883,18 @@
         <source>the parenchyma&apos;s</source>
         <translation>同实质</translation>
     </message>
+    <message>
+        <source>Fracture toughness J</source>
+        <translation>断裂韧性 J</translation>
+    </message>
+    <message>
+        <source>Change the lesion&apos;s fracture toughness</source>
+        <translation>更改病灶的断裂韧性</translation>
+    </message>
+    <message>
+        <source>How hard the lesion is to cut: the scalpel is held back by this times the length of its edge in the lesion. </source>
+        <translation>病灶的切割难度：手术刀受到的阻力为此值乘以刀刃在病灶内的长度。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::EditorOrganPanel</name>
@@ -1309,6 +1321,18 @@
     <message>
         <source>Change gravity&apos;s strength</source>
         <translation>更改重力大小</translation>
+    </message>
+    <message>
+        <source>The energy to cut new surface: the scalpel is held back by it times the length of its edge in the tissue, and breaks in when pressed that hard. </source>
+        <translation>切出新表面所需的能量：手术刀受到的阻力为此值乘以刀刃在组织内的长度，按压达到该力时刀刃切入。</translation>
+    </message>
+    <message>
+        <source>Fracture toughness J</source>
+        <translation>断裂韧性 J</translation>
+    </message>
+    <message>
+        <source>Change the fracture toughness</source>
+        <translation>更改断裂韧性</translation>
     </message>
 </context>
 <context>
@@ -1969,6 +1993,18 @@ The scene that was running goes on.</source>
     <message>
         <source>Switching gravity off…</source>
         <translation>正在关闭重力…</translation>
+    </message>
+    <message>
+        <source> J/m²</source>
+        <translation> J/m²</translation>
+    </message>
+    <message>
+        <source>Fracture toughness J</source>
+        <translation>断裂韧性 J</translation>
+    </message>
+    <message>
+        <source>. What holds the scalpel back as it cuts.</source>
+        <translation>。切割时阻碍手术刀的正是它。</translation>
     </message>
 </context>
 <context>

@@ -110,6 +110,14 @@ EditorLesionPanel::EditorLesionPanel(ScenarioDocument& scenarioDocument, QWidget
   lesionViscosity_ = optionalLesionValue(form, parameter::eta1, " Pa·s", "lesionViscosity",
                                          tr("Viscosity η1"), tr("Change the lesion's viscosity"),
                                          kLesionViscosity, &LesionSpec::viscosity_pa_s);
+  lesionFractureToughness_ =
+      optionalLesionValue(form, parameter::fracture_toughness, " J/m²", "lesionFractureToughness",
+                          tr("Fracture toughness J"), tr("Change the lesion's fracture toughness"),
+                          kLesionFractureToughness, &LesionSpec::fracture_toughness_j_per_m2);
+  lesionFractureToughness_->setToolTip(
+      tr("How hard the lesion is to cut: the scalpel is held back by this times the length of "
+         "its edge in the lesion. ") +
+      lesionFractureToughness_->toolTip());
   lesionHidden_ = new QCheckBox(tr("Hidden from the trainee"));
   lesionHidden_->setObjectName("lesionHidden");
   lesionHidden_->setToolTip(tr("Not drawn in the workstation (palpation tasks)"));
@@ -141,6 +149,8 @@ void EditorLesionPanel::refresh(int selected) {
       lesionStiffness_->setValue(l.youngs_modulus_pa / 1e3);
       lesionYieldLimit_->setValue(l.yield_limit_pa.value_or(lesionYieldLimit_->minimum()));
       lesionViscosity_->setValue(l.viscosity_pa_s.value_or(lesionViscosity_->minimum()));
+      lesionFractureToughness_->setValue(
+          l.fracture_toughness_j_per_m2.value_or(lesionFractureToughness_->minimum()));
       lesionHidden_->setChecked(l.hidden);
     }
     lesionYieldLimit_->setEnabled(s.effects.viscoplastic);

@@ -55,6 +55,8 @@ class EditorPanel : public QWidget {
     kDamageCompression,
     kLift,
     kGravityStrength,
+    kFractureToughness,
+    kLesionFractureToughness,
   };
 
  protected:

@@ -28,9 +28,12 @@ struct PatientPosition {
   std::array<double, 3> down;
 };
 const PatientPosition kPatientPositions[] = {
-    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Supine: toward the back (−z)"), {0.0, 0.0, -1.0}},
-    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Upright: toward the feet (−y)"), {0.0, -1.0, 0.0}},
-    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Prone: toward the front (+z)"), {0.0, 0.0, 1.0}},
+    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Supine: toward the back (−z)"),
+     {0.0, 0.0, -1.0}},
+    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Upright: toward the feet (−y)"),
+     {0.0, -1.0, 0.0}},
+    {QT_TRANSLATE_NOOP("liversim::EditorTissuePanel", "Prone: toward the front (+z)"),
+     {0.0, 0.0, 1.0}},
 };
 
 }  // namespace
@@ -63,6 +66,16 @@ EditorTissuePanel::EditorTissuePanel(
   form->addRow(tr("Poisson's ratio ν"), poissonRatio_);
   bindSpinBox(poissonRatio_, tr("Change Poisson's ratio"), kPoissonRatio,
               [](Scenario& s, double v) { s.parenchyma.elastic.poisson_ratio = v; });
+  // Not an effect: it is what holds the scalpel back, in any scene that offers it.
+  fractureToughness_ = rangeSpinBox(parameter::fracture_toughness, 1.0, " J/m²", 0);
+  fractureToughness_->setObjectName("parenchymaFractureToughness");
+  fractureToughness_->setToolTip(
+      tr("The energy to cut new surface: the scalpel is held back by it times the length of its "
+         "edge in the tissue, and breaks in when pressed that hard. ") +
+      fractureToughness_->toolTip());
+  form->addRow(tr("Fracture toughness J"), fractureToughness_);
+  bindSpinBox(fractureToughness_, tr("Change the fracture toughness"), kFractureToughness,
+              [](Scenario& s, double v) { s.parenchyma.fracture_toughness_j_per_m2 = v; });
   layout->addLayout(form);
 
   auto* effects = new QGroupBox(tr("Effects simulated (an effect off costs nothing)"));
@@ -256,6 +269,7 @@ void EditorTissuePanel::refresh() {
   fillFields([&] {
     youngsModulus_->setValue(s.parenchyma.elastic.youngs_modulus_pa / 1e3);
     poissonRatio_->setValue(s.parenchyma.elastic.poisson_ratio);
+    fractureToughness_->setValue(s.parenchyma.fracture_toughness_j_per_m2);
     const bool on[4] = {s.effects.near_incompressibility, s.effects.viscoelastic,
                         s.effects.viscoplastic, s.effects.fibres};
     for (int i = 0; i < 4; ++i) effects_[i]->setChecked(on[i]);

@@ -1,8 +1,9 @@
 #pragma once
-// The scenario editor's Tissue and effects panel: the parenchyma's stiffness and Poisson's ratio,
+// The scenario editor's Tissue and effects panel: the parenchyma's stiffness, Poisson's ratio and
+// fracture toughness,
 // the effects simulated with what they cost (measured by the editor), gravity's direction and
-// strength, the laws of the effects that are on, the fibres' direction, and the fixed regions: the brush that paints them on the organ,
-// what is painted, and the built-in liver's ligament.
+// strength, the laws of the effects that are on, the fibres' direction, and the fixed regions: the
+// brush that paints them on the organ, what is painted, and the built-in liver's ligament.
 
 #include "editor_panel.h"
 
@@ -40,6 +41,7 @@ class EditorTissuePanel : public EditorPanel {
   std::function<std::optional<Eigen::Vector3d>()> screenHorizontal_;
   QDoubleSpinBox* youngsModulus_ = nullptr;
   QDoubleSpinBox* poissonRatio_ = nullptr;
+  QDoubleSpinBox* fractureToughness_ = nullptr;  // J/m²
   QCheckBox* effects_[4] = {};  // near-incompressibility, viscoelastic, viscoplastic, fibres
   QDoubleSpinBox* viscoelasticE1_ = nullptr;
   QDoubleSpinBox* viscoelasticEta1_ = nullptr;

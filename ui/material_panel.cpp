@@ -34,6 +34,10 @@ MaterialPanel::MaterialPanel(QWidget* parent) : QWidget(parent) {
       tr("Poisson's ratio ν"));
   poissonRatio_->setSingleStep(0.005);
   add(density_, parameter::density, 1.0, tr(" kg/m³"), 0, "materialDensity", tr("Density ρ"));
+  add(fractureToughness_, parameter::fracture_toughness, 1.0, tr(" J/m²"), 0,
+      "materialFractureToughness", tr("Fracture toughness J"));
+  fractureToughness_->setToolTip(fractureToughness_->toolTip() +
+                                 tr(". What holds the scalpel back as it cuts."));
   add(e1_, parameter::e1, 1.0, tr(" Pa"), 0, "materialE1", tr("Maxwell arm E1"));
   e1_->setToolTip(e1_->toolTip() + tr(". E2 = E − E1 follows."));
   add(eta1_, parameter::eta1, 1.0, tr(" Pa·s"), 0, "materialEta1", tr("Maxwell arm η1"));
@@ -92,6 +96,7 @@ void MaterialPanel::showTissue(const TissueSpec& tissue, const EffectsSpec& effe
   shownModulusKpa_ = youngsModulusKpa_->value();
   poissonRatio_->setValue(tissue.elastic.poisson_ratio);
   density_->setValue(tissue.elastic.density_kg_per_m3);
+  fractureToughness_->setValue(tissue.fracture_toughness_j_per_m2);
   const bool viscoelastic = effects.viscoelastic && tissue.viscoelastic;
   const bool viscoplastic = effects.viscoplastic && tissue.viscoplastic;
   const bool fibres = effects.fibres && tissue.fibres;
@@ -139,6 +144,7 @@ TissueSpec MaterialPanel::requestedTissue() const {
   tissue.elastic.youngs_modulus_pa = youngsModulusKpa_->value() * 1e3;
   tissue.elastic.poisson_ratio = poissonRatio_->value();
   tissue.elastic.density_kg_per_m3 = density_->value();
+  tissue.fracture_toughness_j_per_m2 = fractureToughness_->value();
   if (effects_.viscoelastic && tissue.viscoelastic) {
     tissue.viscoelastic =
         with_maxwell_arm(*tissue.viscoelastic, e1_->value(), tissue.elastic.youngs_modulus_pa);

@@ -57,6 +57,7 @@ class MaterialPanel : public QWidget {
   QDoubleSpinBox* youngsModulusKpa_ = nullptr;
   QDoubleSpinBox* poissonRatio_ = nullptr;
   QDoubleSpinBox* density_ = nullptr;
+  QDoubleSpinBox* fractureToughness_ = nullptr;  // J/m²
   QDoubleSpinBox* e1_ = nullptr;
   QDoubleSpinBox* eta1_ = nullptr;
   QDoubleSpinBox* yieldLimit_ = nullptr;

@@ -162,7 +162,7 @@ INSTANTIATE_TEST_SUITE_P(Strokes, ScalpelInTheLoopTest,
 // A blade you feel (issue 42, item 4): drawn straight through a block, a cutting blade is held back
 // by the toughness times its edge in the tissue, against its motion. The block (6 × 5 × 4 cm,
 // fixed at its base) is two layers: the top centimetre of toughness 400 J/m², the rest 200 J/m²
-// (CuttingSettings::region_fracture_toughness_j_per_m2). The upright blade, its tip 15 mm under
+// (RegionMaterial::fracture_toughness_j_per_m2). The upright blade, its tip 15 mm under
 // the top, is drawn 3 cm along x at 1 cm/s; once it is under way the force on it is
 // 400·0.010 + 200·0.005 = 5 N along −x. What may differ: the elements' faces are pushed out by a
 // 1 µm margin (so an edge along faces is in), which the edge crosses at a slant and may count a
@@ -179,15 +179,15 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
   }
   ModelOptions options;
   options.regions = {RegionMaterial{}, RegionMaterial{}};
+  options.regions[0].fracture_toughness_j_per_m2 = 200.0;
+  options.regions[1].fracture_toughness_j_per_m2 = 400.0;
   options.mass_damping_per_s = 30.0;
   for (std::size_t n = 0; n < mesh.node_count(); ++n)
     if (mesh.rest_position_m.z[n] < 1e-9) options.fixed_nodes.push_back(static_cast<NodeIndex>(n));
   const auto model = std::make_shared<const SimModel>(build_model(mesh, options));
   RealtimeSimulation simulation(model, make_rest_state(*model));
   simulation.enable_tools(extract_surface(mesh));
-  CuttingSettings settings;
-  settings.region_fracture_toughness_j_per_m2 = {200.0, 400.0};
-  simulation.enable_cutting(settings);
+  simulation.enable_cutting();
 
   Tool scalpel;
   scalpel.kind = ToolKind::scalpel;

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <span>
 #include <stdexcept>
@@ -658,6 +659,50 @@ TEST_F(RealtimeSteppingFixture, FramesFromBeforeTheDeviceToolWasSetAreNotTaken) 
   simulation.stop();
   ASSERT_TRUE(after.tool) << "the frame stamped at the press was not taken";
   EXPECT_LT((after.tool->pose.origin_m - new_mm * 1e-3).norm(), 1e-12);
+}
+
+// The blade breaks in by the toughness of the tissue it presses on (RegionMaterial): pressed in
+// step by step at the same place, it goes deeper into tissue ten times as tough before it does.
+TEST_F(RealtimeSteppingFixture, ABladeBreaksIntoTougherTissueOnlyUnderAHarderPress) {
+  auto depth_at_break_in_m = [](double toughness_j_per_m2) {
+    ModelOptions options;
+    options.fixed_nodes = mesh_->node_sets.at("ligament");
+    options.regions[0].fracture_toughness_j_per_m2 = toughness_j_per_m2;
+    const auto model = std::make_shared<const SimModel>(build_model(*mesh_, options));
+    RealtimeSimulation simulation(model, make_rest_state(*model));
+    simulation.enable_tools(extract_surface(*mesh_));
+    simulation.enable_cutting();
+    const Eigen::AlignedBox3d box = rest_box(*model);
+    const Eigen::Vector2d where(box.center().x() - 0.04, box.center().y());
+    const double top_m = column_at(*model, where).top_m;
+    Tool scalpel;
+    scalpel.kind = ToolKind::scalpel;
+    scalpel.geometry.blade_length_m = 0.04;
+    const double touching_z_m = top_m + scalpel.geometry.blade_length_m;
+    scalpel.pose.origin_m = {where.x(), where.y(), touching_z_m + 0.001};
+    simulation.set_tool(scalpel);
+    simulation.start();
+    double depth_m = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 300; ++k) {  // up to 30 mm
+      scalpel.pose.origin_m.z() -= 1e-4;
+      simulation.set_tool(scalpel);
+      if (run_until(simulation, 0.01, [](const SimulationSnapshot&) {
+            return false;
+          }).blade_cutting) {
+        depth_m = touching_z_m - scalpel.pose.origin_m.z();
+        break;
+      }
+    }
+    simulation.stop();
+    EXPECT_FALSE(simulation.stats().halted);
+    return depth_m;
+  };
+  const double liver_m = depth_at_break_in_m(200.0), tough_m = depth_at_break_in_m(2000.0);
+  std::cout << "the blade broke in with its tip " << liver_m * 1e3
+            << " mm below the highest node near it at 200 J/m², " << tough_m * 1e3
+            << " mm at 2000 J/m²\n";
+  ASSERT_TRUE(std::isfinite(liver_m)) << "pressed 30 mm in, the blade did not break into liver";
+  EXPECT_GT(tough_m, liver_m + 0.001) << "tissue ten times as tough gave way as soon";
 }
 
 // A disarmed blade (the cut button up) only pushes: pressed far past the point where an armed one

@@ -33,6 +33,7 @@ Scenario every_field_set() {
   s.parenchyma.viscoelastic = ViscoelasticParameters{2500.0, 1500.0, 3000.0};
   s.parenchyma.viscoplastic = ViscoplasticParameters{60.0, 5000.0, 0.6};
   s.parenchyma.fibres = FibreSpec{1200.0, 3.0, {0.0, 0.6, 0.8}};
+  s.parenchyma.fracture_toughness_j_per_m2 = 180.0;
   LesionSpec lesion;
   lesion.name = "tumour";
   lesion.centre_mm = {-45.0, 5.0, 30.0};
@@ -40,6 +41,7 @@ Scenario every_field_set() {
   lesion.youngs_modulus_pa = 20000.0;
   lesion.yield_limit_pa = 400.0;
   lesion.viscosity_pa_s = 9000.0;
+  lesion.fracture_toughness_j_per_m2 = 450.0;
   lesion.hidden = true;
   s.lesions = {lesion};
   s.effects = {false, true, true, true};
@@ -98,6 +100,8 @@ TEST(ScenarioFile, EveryFieldSurvivesASaveAndALoad) {
       {"parenchyma.viscoplastic.n",
        [](Scenario& s) { s.parenchyma.viscoplastic->creep_index_n = 1.0; }},
       {"parenchyma.fibres.k1", [](Scenario& s) { s.parenchyma.fibres->k1_pa = 800.0; }},
+      {"parenchyma.fracture_toughness_j_per_m2",
+       [](Scenario& s) { s.parenchyma.fracture_toughness_j_per_m2 = 225.0; }},
       {"parenchyma.fibres.k2", [](Scenario& s) { s.parenchyma.fibres->k2 = 0.7; }},
       {"parenchyma.fibres.direction",
        [](Scenario& s) {
@@ -109,6 +113,8 @@ TEST(ScenarioFile, EveryFieldSurvivesASaveAndALoad) {
        [](Scenario& s) { s.lesions[0].youngs_modulus_pa = 8000.0; }},
       {"lesions[0].yield_limit_pa", [](Scenario& s) { s.lesions[0].yield_limit_pa.reset(); }},
       {"lesions[0].viscosity_pa_s", [](Scenario& s) { s.lesions[0].viscosity_pa_s.reset(); }},
+      {"lesions[0].fracture_toughness_j_per_m2",
+       [](Scenario& s) { s.lesions[0].fracture_toughness_j_per_m2.reset(); }},
       {"lesions[0].hidden", [](Scenario& s) { s.lesions[0].hidden = false; }},
       {"effects.near_incompressibility",
        [](Scenario& s) { s.effects.near_incompressibility = true; }},
@@ -337,6 +343,64 @@ TEST(ScenarioFile, AVersionOneFileReadsWithGravityOff) {
   EXPECT_EQ(round_trip(*reading.scenario), *reading.scenario);
 }
 
+// Version 3 added the fracture toughness; a version-2 file reads with the liver's, for the
+// parenchyma and for each lesion, and the scene's regions have it.
+TEST(ScenarioFile, AVersionTwoFileReadsWithTheLiversFractureToughness) {
+  const std::string text = R"({
+  "format": "liversim-scenario", "version": 2, "title": "Written by version 2",
+  "organ": {"geometry": "built-in-liver", "target_tet_count": 1500, "fix_ligament": true},
+  "parenchyma": {"youngs_modulus_pa": 3500, "poisson_ratio": 0.49, "density_kg_per_m3": 1060},
+  "effects": {"near_incompressibility": true, "viscoelastic": false, "viscoplastic": false,
+              "fibres": false, "gravity": false, "gravity_direction": [0, 0, -1],
+              "gravity_m_per_s2": 9.81},
+  "tools": ["probe"],
+  "task": {"kind": "palpate-lesion", "lesion": "t", "time_limit_s": 180},
+  "lesions": [{"name": "t", "centre_mm": [-50, 10, 40], "radii_mm": [12, 12, 12],
+               "youngs_modulus_pa": 17500}]
+})";
+  const ScenarioReading reading = read_scenario(text);
+  ASSERT_TRUE(reading.scenario) << (reading.errors.empty() ? "" : reading.errors[0].text());
+  EXPECT_EQ(reading.file_version, 2);
+  const Scenario& s = *reading.scenario;
+  EXPECT_EQ(s.parenchyma.fracture_toughness_j_per_m2, 200.0);
+  EXPECT_FALSE(s.lesions[0].fracture_toughness_j_per_m2);
+  const auto regions = region_materials(s);
+  ASSERT_EQ(regions.size(), 2u);
+  EXPECT_EQ(regions[0].fracture_toughness_j_per_m2, 200.0);
+  EXPECT_EQ(regions[1].fracture_toughness_j_per_m2, 200.0) << "a lesion takes the parenchyma's";
+
+  // Set, each region has its own; saved, the parenchyma's is written out.
+  Scenario tough = s;
+  tough.parenchyma.fracture_toughness_j_per_m2 = 150.0;
+  tough.lesions[0].fracture_toughness_j_per_m2 = 600.0;
+  const auto tough_regions = region_materials(tough);
+  EXPECT_EQ(tough_regions[0].fracture_toughness_j_per_m2, 150.0);
+  EXPECT_EQ(tough_regions[1].fracture_toughness_j_per_m2, 600.0);
+  const SceneSetup scene = build_scene(tough, ".");
+  EXPECT_EQ(build_model(scene.mesh, scene.model_options).regions[1].fracture_toughness_j_per_m2,
+            600.0);
+  const std::string saved = write_scenario(s);
+  EXPECT_NE(saved.find("\"fracture_toughness_j_per_m2\": 200"), std::string::npos) << saved;
+
+  // Out of the documented range, or not a number, it is refused, naming the field.
+  tough.lesions[0].fracture_toughness_j_per_m2 = 1e5;
+  tough.parenchyma.fracture_toughness_j_per_m2 = std::nan("");
+  const auto errors = validate(tough);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].path, "parenchyma.fracture_toughness_j_per_m2");
+  EXPECT_EQ(errors[1].path, "lesions[0].fracture_toughness_j_per_m2");
+  EXPECT_NE(errors[1].message.find("expected fracture toughness J, 20 to 5000 J/m²"),
+            std::string::npos)
+      << errors[1].message;
+  std::string text_too_tough = text;
+  text_too_tough.replace(text_too_tough.find("\"density_kg_per_m3\": 1060"), 25,
+                         "\"density_kg_per_m3\": 1060, \"fracture_toughness_j_per_m2\": 0");
+  const ScenarioReading refused = read_scenario(text_too_tough);
+  EXPECT_FALSE(refused.scenario);
+  ASSERT_EQ(refused.errors.size(), 1u);
+  EXPECT_EQ(refused.errors[0].path, "parenchyma.fracture_toughness_j_per_m2");
+}
+
 // Gravity in the scene: its acceleration is g times the normalised direction when on, and the
 // model has no gravity at all when off (the direction and strength are kept for switching it on).
 TEST(ScenarioScene, GravityIsTheModelsAccelerationWhenOnAndAbsentWhenOff) {
@@ -411,6 +475,13 @@ TEST(ShippedScenario, EachBuildsTheModelItDescribes) {
       EXPECT_GT(volume_m3, 0.5 * volume_expected_m3) << name;
       EXPECT_LT(volume_m3, 1.5 * volume_expected_m3) << name;
       EXPECT_EQ(model.regions[region].tissue.youngs_modulus_pa, s.lesions[i].youngs_modulus_pa);
+      const double toughness = model.regions[region].fracture_toughness_j_per_m2;
+      EXPECT_EQ(toughness, s.lesions[i].fracture_toughness_j_per_m2.value_or(
+                               s.parenchyma.fracture_toughness_j_per_m2));
+      // A tumour to resect is harder to cut than the liver around it (issue 42).
+      if (s.task.kind == TaskKind::resect_lesion && s.task.lesion == s.lesions[i].name) {
+        EXPECT_GT(toughness, model.regions[0].fracture_toughness_j_per_m2) << name;
+      }
     }
   }
   EXPECT_GE(count, 4);

@@ -10,6 +10,7 @@
 #include <QFile>
 #include <QLabel>
 #include <QLineEdit>
+#include <QListWidget>
 #include <QMessageBox>
 #include <QPushButton>
 #include <QSettings>
@@ -296,6 +297,24 @@ TEST_F(ScenarioEditorTest, TheRubricTheLawsTheIntegratorAndTheGraspPointAreEdite
   EXPECT_EQ(t.viscoplastic->yield_limit_pa, 120.0);
   EXPECT_EQ(t.viscoelastic->e1_pa, 2500.0);
   EXPECT_DOUBLE_EQ(t.viscoelastic->e1_pa + t.viscoelastic->e2_pa, t.elastic.youngs_modulus_pa);
+
+  // How hard it is to cut: the parenchyma's toughness, and the lesion's own, which below its
+  // range reads "the parenchyma's" and is then none of its own.
+  field<QDoubleSpinBox>("parenchymaFractureToughness")->setValue(180.0);
+  EXPECT_EQ(scenario().parenchyma.fracture_toughness_j_per_m2, 180.0);
+  ASSERT_FALSE(scenario().lesions.empty());
+  field<QListWidget>("lesionList")->setCurrentRow(0);
+  auto* lesionToughness = field<QDoubleSpinBox>("lesionFractureToughness");
+  ASSERT_TRUE(lesionToughness->isEnabled());
+  EXPECT_EQ(lesionToughness->text(), "the parenchyma's");
+  lesionToughness->setValue(600.0);
+  EXPECT_EQ(scenario().lesions[0].fracture_toughness_j_per_m2, 600.0);
+  trigger("undoAction");
+  EXPECT_FALSE(scenario().lesions[0].fracture_toughness_j_per_m2);
+  EXPECT_EQ(lesionToughness->text(), "the parenchyma's");  // the panel follows
+  trigger("redoAction");
+  EXPECT_EQ(scenario().lesions[0].fracture_toughness_j_per_m2, 600.0);
+  EXPECT_EQ(lesionToughness->value(), 600.0);
 
   // The integrator, through the same panel as the workstation's.
   auto* accuracy = field<QWidget>("accuracyPanel");

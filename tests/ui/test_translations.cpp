@@ -101,16 +101,16 @@ std::vector<ShownText> shownTexts(const MainWindow& window) {
 }
 
 // What may stay in Latin letters in a Chinese interface: names (of the product, devices,
-// methods, file formats), units, the symbols of the tissue's parameters (E, n, k1...) and of
+// methods, file formats), units, the symbols of the tissue's parameters (E, n, k1, J...) and of
 // gravity's acceleration (g), key names
 // and shortcuts "（Ctrl+O）", mnemonics "(&F)", file names in docs/, numbers.
 QString withoutNamesAndUnits(QString text) {
   static const QRegularExpression allowed(QStringLiteral(
       R"(\(&[A-Z]\)|LiverSim|Phantom Omni|Geomagic Touch|OpenHaptics|libHD\.so|SQLite|JSON|)"
       R"(CSV|PDF|RK4|BDF2|Dormand|Prince|Gmsh|English|Shift|Ctrl|p99|)"
-      R"(（((Ctrl|Shift|Alt)\+)*[A-Z]）|docs/[\w.-]+\.md|kg/m³|m/s²|)"
+      R"(（((Ctrl|Shift|Alt)\+)*[A-Z]）|docs/[\w.-]+\.md|kg/m³|m/s²|J/m²|)"
       R"([-+]?\d+(\.\d+)?(e[-+]?\d+)?|)"
-      R"(\b(N|mm|m|s|ms|µm|nm|pm|mL|Pa|kPa|Hz|x|y|z|E|E1|E2|n|k1|k2|g)\b)"));
+      R"(\b(N|mm|m|s|ms|µm|nm|pm|mL|Pa|kPa|Hz|x|y|z|E|E1|E2|n|k1|k2|g|J)\b)"));
   return text.remove(allowed);
 }
 

@@ -213,6 +213,17 @@ TEST(Workstation, TheMaterialPanelChangesTheRunningLiversTissue) {
   ASSERT_TRUE(QTest::qWaitFor([&] { return finished.size() == 2; }, kTimeoutMs));
   EXPECT_EQ(window->simulation().model().regions[0].tissue.density_kg_per_m3, 1000.0);
   EXPECT_FALSE(window->changingTissue());
+
+  // The fracture toughness, entered in the panel: what the scalpel will be held back by.
+  finished.clear();
+  auto* toughness = window->findChild<QDoubleSpinBox*>("materialFractureToughness");
+  ASSERT_NE(toughness, nullptr);
+  EXPECT_EQ(toughness->value(), 200.0);
+  toughness->setValue(450.0);
+  ASSERT_TRUE(finished.wait(kTimeoutMs));
+  ASSERT_TRUE(finished.first().first().toBool());
+  EXPECT_EQ(window->simulation().model().regions[0].fracture_toughness_j_per_m2, 450.0);
+  EXPECT_EQ(window->materialPanel()->tissueInUse().fracture_toughness_j_per_m2, 450.0);
 }
 
 // Gravity is free practice's to choose, for a trainee too: switched on, the liver carries its

@@ -26,6 +26,10 @@ void validate_regions(const std::vector<RegionMaterial>& regions) {
     if (regions[r].fibres)
       if (auto problem = validate(*regions[r].fibres))
         throw std::invalid_argument(region_name(r) + ": " + *problem);
+    if (const double j = regions[r].fracture_toughness_j_per_m2; !std::isfinite(j) || j < 0.0)
+      throw std::invalid_argument(
+          region_name(r) + ": " +
+          out_of_range_message("fracture toughness (J/m²)", j, "a finite value >= 0"));
     if (regions[r].viscoplastic && !regions[r].viscoelastic)
       throw std::invalid_argument(region_name(r) +
                                   ": viscoplasticity needs the viscoelastic parameters (E1, E2, "

@@ -58,6 +58,10 @@ constexpr std::array kRanges{
     ParameterRange{p::lesion_stiffness_ratio, "lesion stiffness / parenchyma", "", 1.0, 100.0, true,
                    "tumours are 1.5-10× the parenchyma by elastography; 100× (calcified lesions) "
                    "is the stiffest the suite tests (case 5)"},
+    ParameterRange{p::fracture_toughness, "fracture toughness J", "J/m²", 20.0, 5000.0, true,
+                   "liver 76-225 J/m² (porcine, by scalpel and needle; bovine 164); none is "
+                   "published for liver tumours or cirrhosis: up to fibrous tissue (muscle "
+                   "550-8000), down to a tenth of liver"},
 };
 
 }  // namespace

@@ -20,6 +20,7 @@ SurfaceBvh::SurfaceBvh(const BoundarySurface& surface, const NodeArray& position
     triangles_.push_back({surface.nodes[static_cast<std::size_t>(t[0])],
                           surface.nodes[static_cast<std::size_t>(t[1])],
                           surface.nodes[static_cast<std::size_t>(t[2])]});
+  if (surface.triangle_tet.size() == surface.triangles.size()) triangle_tet_ = surface.triangle_tet;
   if (triangles_.empty()) return;
   std::vector<Eigen::Vector3d> centroid(triangles_.size());
   for (std::size_t i = 0; i < triangles_.size(); ++i)

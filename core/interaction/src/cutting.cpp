@@ -26,13 +26,6 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
   };
   if (!std::isfinite(settings.cutting_stress_pa) || settings.cutting_stress_pa < 0.0)
     return out_of_range("cutting stress (Pa)", settings.cutting_stress_pa, "a finite value >= 0");
-  if (!std::isfinite(settings.fracture_toughness_j_per_m2) ||
-      settings.fracture_toughness_j_per_m2 < 0.0)
-    return out_of_range("fracture toughness (J/m²)", settings.fracture_toughness_j_per_m2,
-                        "a finite value >= 0");
-  for (double toughness : settings.region_fracture_toughness_j_per_m2)
-    if (!std::isfinite(toughness) || toughness < 0.0)
-      return out_of_range("region fracture toughness (J/m²)", toughness, "a finite value >= 0");
   if (!(settings.full_resistance_speed_m_per_s > 0.0) ||
       !std::isfinite(settings.full_resistance_speed_m_per_s))
     return out_of_range("full resistance speed (m/s)", settings.full_resistance_speed_m_per_s,
@@ -733,15 +726,8 @@ double blade_edge_in_contact_m(const PartContact& blade, const ToolGeometry& geo
          2.0 * geometry.blade_half_thickness_m;
 }
 
-double fracture_toughness_j_per_m2(const CuttingSettings& settings, std::size_t region) {
-  return region < settings.region_fracture_toughness_j_per_m2.size()
-             ? settings.region_fracture_toughness_j_per_m2[region]
-             : settings.fracture_toughness_j_per_m2;
-}
-
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
-                            const std::array<Eigen::Vector3d, 2>& edge_m,
-                            const CuttingSettings& settings, double margin_m) {
+                            const std::array<Eigen::Vector3d, 2>& edge_m, double margin_m) {
   // Each element's stretch of the edge, its faces pushed out by the margin so that an edge lying
   // along faces (its own cut, faces snapped onto it) is in; overlaps counted once.
   struct Stretch {
@@ -758,7 +744,9 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
     if (!box.overlaps(edge_box)) continue;
     const auto [t_in, t_out] = edge_within_element(p, edge_m, margin_m);
     if (t_in < t_out)
-      stretches[count++] = {t_in, t_out, fracture_toughness_j_per_m2(settings, model.region[e])};
+      stretches[count++] = {
+          t_in, t_out,
+          model.regions[static_cast<std::size_t>(model.region[e])].fracture_toughness_j_per_m2};
   }
   std::sort(stretches.begin(), stretches.begin() + static_cast<std::ptrdiff_t>(count),
             [](const Stretch& a, const Stretch& b) { return a.from < b.from; });

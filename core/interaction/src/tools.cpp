@@ -238,6 +238,11 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
           if (per_part.empty() || free_weight == 0.0) return;
           PartContact& met = per_part[p];
           met.force_on_part_n -= free_weight * stiffness * push;
+          if (const double pushed_n = free_weight * stiffness * push.norm();
+              pushed_n > met.hardest_push_n && t < bvh.triangle_tet().size()) {
+            met.hardest_push_n = pushed_n;
+            met.region = model.region[static_cast<std::size_t>(bvh.triangle_tet()[t])];
+          }
           const Eigen::Vector3d axis = part.b_m - part.a_m;
           const double length_sq = axis.squaredNorm();
           const double s =

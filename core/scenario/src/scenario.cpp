@@ -357,7 +357,7 @@ TissueSpec read_tissue(const Json& value, std::vector<ScenarioError>& errors) {
   TissueSpec tissue;
   Fields f(value, "parenchyma", errors,
            {"youngs_modulus_pa", "poisson_ratio", "density_kg_per_m3", "mooney_rivlin_fraction",
-            "viscoelastic", "viscoplastic", "fibres"});
+            "fracture_toughness_j_per_m2", "viscoelastic", "viscoplastic", "fibres"});
   if (!f.is_object()) return tissue;
   TissueMaterial& m = tissue.elastic;
   m.youngs_modulus_pa = f.parameter("youngs_modulus_pa", p::youngs_modulus, true).value_or(0.0);
@@ -365,6 +365,9 @@ TissueSpec read_tissue(const Json& value, std::vector<ScenarioError>& errors) {
   m.density_kg_per_m3 = f.parameter("density_kg_per_m3", p::density, true).value_or(0.0);
   m.mooney_rivlin_fraction =
       f.parameter("mooney_rivlin_fraction", p::mooney_rivlin_fraction, false).value_or(0.0);
+  tissue.fracture_toughness_j_per_m2 =
+      f.parameter("fracture_toughness_j_per_m2", p::fracture_toughness, false)
+          .value_or(tissue.fracture_toughness_j_per_m2);
   if (const Json* v = f.get("viscoelastic")) {
     Fields g(*v, f.at("viscoelastic"), errors, {"e1_pa", "e2_pa", "eta1_pa_s"});
     if (g.is_object())
@@ -418,7 +421,7 @@ std::vector<LesionSpec> read_lesions(const Json& value, std::vector<ScenarioErro
   return read_object_list<LesionSpec>(
       value, "lesions", "lesions",
       {"name", "centre_mm", "radii_mm", "youngs_modulus_pa", "yield_limit_pa", "viscosity_pa_s",
-       "hidden"},
+       "fracture_toughness_j_per_m2", "hidden"},
       errors, [](Fields& f) {
         LesionSpec lesion;
         lesion.name = f.text("name", true, true).value_or("");
@@ -430,6 +433,8 @@ std::vector<LesionSpec> read_lesions(const Json& value, std::vector<ScenarioErro
                 .value_or(lesion.youngs_modulus_pa);
         lesion.yield_limit_pa = f.parameter("yield_limit_pa", p::yield_limit, false);
         lesion.viscosity_pa_s = f.parameter("viscosity_pa_s", p::eta1, false);
+        lesion.fracture_toughness_j_per_m2 =
+            f.parameter("fracture_toughness_j_per_m2", p::fracture_toughness, false);
         lesion.hidden = f.boolean("hidden", false).value_or(false);
         return lesion;
       });
@@ -568,9 +573,10 @@ std::vector<RubricCriterion> read_rubric(const Json& value, std::vector<Scenario
 }
 
 // Older format versions, step by step up to the current one. Version 2 added effects.gravity and
-// its direction and strength; a version-1 file has none, which reads as gravity off, so there is
-// nothing to rewrite. A later version adds its step here (and a test with a file of the one
-// before).
+// its direction and strength; a version-1 file has none, which reads as gravity off. Version 3
+// added the fracture toughness of the parenchyma and of each lesion; an older file has none,
+// which reads as the default (liver's) toughness. So there is nothing to rewrite. A later version
+// adds its step here (and a test with a file of the one before).
 void migrate(Json& /*document*/, int /*from_version*/) {}
 
 // Thresholds of relative agreement.
@@ -626,7 +632,8 @@ bool TissueSpec::operator==(const TissueSpec& o) const {
                                                      a->creep_index_n == b->creep_index_n));
   };
   return same_elastic(elastic, o.elastic) && same_viscoelastic(viscoelastic, o.viscoelastic) &&
-         same_viscoplastic(viscoplastic, o.viscoplastic) && fibres == o.fibres;
+         same_viscoplastic(viscoplastic, o.viscoplastic) && fibres == o.fibres &&
+         fracture_toughness_j_per_m2 == o.fracture_toughness_j_per_m2;
 }
 
 bool Scenario::operator==(const Scenario& o) const {
@@ -645,6 +652,14 @@ std::vector<ScenarioError> validate(const Scenario& s) {
   if (s.title.empty()) fail("title", "missing: expected a non-empty text");
   const TissueSpec& t = s.parenchyma;
   if (const auto message = validate(t.elastic)) fail("parenchyma", *message);
+  const ParameterRange& toughness = parameter_range(p::fracture_toughness);
+  auto check_toughness = [&](const std::string& path, double value) {
+    if (!toughness.contains(value))
+      fail(path, format_number(value) + " J/m² is invalid: expected " +
+                     std::string(toughness.label) + ", " + format_number(toughness.min) + " to " +
+                     format_number(toughness.max) + " J/m²");
+  };
+  check_toughness("parenchyma.fracture_toughness_j_per_m2", t.fracture_toughness_j_per_m2);
 
   // Each effect that is on needs its law; viscoplasticity sits in series with viscoelasticity.
   if (s.effects.viscoelastic && !t.viscoelastic)
@@ -728,6 +743,8 @@ std::vector<ScenarioError> validate(const Scenario& s) {
                format_number(ratio.min) + " to " + format_number(ratio.max) +
                " times the parenchyma's " + format_number(t.elastic.youngs_modulus_pa) + " Pa (" +
                std::string(ratio.why) + ")");
+    if (lesion.fracture_toughness_j_per_m2)
+      check_toughness(at + ".fracture_toughness_j_per_m2", *lesion.fracture_toughness_j_per_m2);
     if (built_in && !(liver.value(to_metres(lesion.centre_mm)) < 0.0))
       fail(at + ".centre_mm", "(" + format_number(lesion.centre_mm[0]) + ", " +
                                   format_number(lesion.centre_mm[1]) + ", " +
@@ -910,6 +927,7 @@ std::string write_scenario(const Scenario& s) {
   tissue["density_kg_per_m3"] = t.elastic.density_kg_per_m3;
   if (t.elastic.mooney_rivlin_fraction != 0.0)
     tissue["mooney_rivlin_fraction"] = t.elastic.mooney_rivlin_fraction;
+  tissue["fracture_toughness_j_per_m2"] = t.fracture_toughness_j_per_m2;
   if (t.viscoelastic)
     tissue["viscoelastic"] = {{"e1_pa", t.viscoelastic->e1_pa},
                               {"e2_pa", t.viscoelastic->e2_pa},
@@ -933,6 +951,8 @@ std::string write_scenario(const Scenario& s) {
     lesion["youngs_modulus_pa"] = l.youngs_modulus_pa;
     if (l.yield_limit_pa) lesion["yield_limit_pa"] = *l.yield_limit_pa;
     if (l.viscosity_pa_s) lesion["viscosity_pa_s"] = *l.viscosity_pa_s;
+    if (l.fracture_toughness_j_per_m2)
+      lesion["fracture_toughness_j_per_m2"] = *l.fracture_toughness_j_per_m2;
     lesion["hidden"] = l.hidden;
     lesions.push_back(lesion);
   }
@@ -1020,6 +1040,7 @@ std::vector<RegionMaterial> region_materials(const Scenario& s) {
   const TissueSpec& t = s.parenchyma;
   RegionMaterial parenchyma;
   parenchyma.tissue = t.elastic;
+  parenchyma.fracture_toughness_j_per_m2 = t.fracture_toughness_j_per_m2;
   if (s.effects.viscoelastic) parenchyma.viscoelastic = t.viscoelastic;
   if (s.effects.viscoplastic) parenchyma.viscoplastic = t.viscoplastic;
   if (s.effects.fibres) parenchyma.fibres = FibreParameters{t.fibres->k1_pa, t.fibres->k2};
@@ -1030,6 +1051,8 @@ std::vector<RegionMaterial> region_materials(const Scenario& s) {
     RegionMaterial material;
     material.tissue = t.elastic;
     material.tissue.youngs_modulus_pa = lesion.youngs_modulus_pa;
+    material.fracture_toughness_j_per_m2 =
+        lesion.fracture_toughness_j_per_m2.value_or(t.fracture_toughness_j_per_m2);
     const double ratio = lesion.youngs_modulus_pa / t.elastic.youngs_modulus_pa;
     if (parenchyma.viscoelastic) {
       ViscoelasticParameters law = *parenchyma.viscoelastic;

@@ -121,16 +121,19 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   const auto edge = blade_edge_m(scalpel);
   if (!blade_in_tissue_) {
     if (!scalpel.blade_armed) return;
-    // Breaks in once the force on the blade reaches the tissue's toughness times the length of
-    // its edge in contact: the tissue would give way at that load (CuttingSettings). An element's
+    // Breaks in once the force on the blade reaches the toughness of the tissue it presses on
+    // times the length of its edge in contact: the tissue would give way at that load
+    // (CuttingSettings). An element's
     // average stress under a thin blade depends on the element's size, not the blade's load. An
     // edge already through the surface (put in deep, or pressed through faster than the tissue
     // gave way) has made its way in: it is in.
     const PartContact& blade = tools_->part_contact(kScalpelBlade);
     if (!blade.touched()) return;
+    const RegionMaterial& pressed =
+        model_->regions[static_cast<std::size_t>(std::max(0, blade.region))];
     if (!blade.pierced &&
-        blade.force_on_part_n.norm() < cutting_->fracture_toughness_j_per_m2 *
-                                           blade_edge_in_contact_m(blade, scalpel.geometry))
+        blade.force_on_part_n.norm() <
+            pressed.fracture_toughness_j_per_m2 * blade_edge_in_contact_m(blade, scalpel.geometry))
       return;
     blade_in_tissue_ = true;
     stroke_.edges_m.assign(1, edge);
@@ -264,7 +267,7 @@ void RealtimeSimulation::resist_cutting(const std::array<Eigen::Vector3d, 2>& ed
     cutting_force_n_.setZero();
     return;
   }
-  const EdgeInTissue in = edge_in_tissue(*model_, state_.position_m, edge, *cutting_);
+  const EdgeInTissue in = edge_in_tissue(*model_, state_.position_m, edge);
   cutting_force_n_ = -in.resistance_n *
                      std::min(1.0, speed / cutting_->full_resistance_speed_m_per_s) * across /
                      speed;

@@ -28,6 +28,10 @@ struct RegionMaterial {
   std::optional<ViscoelasticParameters> viscoelastic;
   // Seed Eq. 4, in series; needs `viscoelastic`.
   std::optional<ViscoplasticParameters> viscoplastic;
+  // The energy to make new cut surface in it (J/m², ≥ 0): what a blade's edge is held back by per
+  // metre of it in the region, and what breaks a blade in (interaction/cutting.h). Porcine liver
+  // cut by a scalpel: 187–225 J/m² (Chanthasopeephan, Desai & Lau 2006).
+  double fracture_toughness_j_per_m2 = 200.0;
 };
 
 // Reference fibre directions (normalised when the model is built): empty for no family, one vector

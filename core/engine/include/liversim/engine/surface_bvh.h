@@ -60,6 +60,8 @@ class SurfaceBvh {
   void for_each_triangle_overlapping(const Aabb& box, Visit&& visit) const;
 
   const std::vector<Triangle>& triangles() const { return triangles_; }
+  // The element each triangle bounds; empty when the surface did not say.
+  const std::vector<TetIndex>& triangle_tet() const { return triangle_tet_; }
   // The box around the whole surface (empty for an empty surface).
   Aabb bounds() const { return nodes_.empty() ? Aabb{} : nodes_.front().box; }
   bool empty() const { return triangles_.empty(); }
@@ -78,6 +80,7 @@ class SurfaceBvh {
   static constexpr int kMaxDepth = 64;
 
   std::vector<Triangle> triangles_;
+  std::vector<TetIndex> triangle_tet_;
   std::vector<Aabb> triangle_box_;   // per triangle, at the last refit
   std::vector<std::int32_t> order_;  // triangle indices, grouped by leaf
   std::vector<TreeNode> nodes_;

@@ -39,15 +39,11 @@ struct CuttingSettings {
   // which cut_tissue separates it; 0: the edge cuts whatever it sweeps through (as a broken-in
   // blade does in the real-time loop).
   double cutting_stress_pa = 1500.0;
-  // The energy to make new cut surface (J/m²): a blade pressed on the tissue breaks in once the
-  // force on it reaches this times the length of its edge in contact (a tip: the blade's
-  // thickness), the work per unit advance of a crack that long (Mahvash & Hayward 2001, haptic
-  // rendering of cutting). Porcine liver cut by a scalpel: 187–225 J/m² (Chanthasopeephan, Desai
-  // & Lau 2006); 0: it breaks in at a touch.
-  double fracture_toughness_j_per_m2 = 200.0;
-  // Per region (the model's region indices), when the regions differ (a lesion harder to cut
-  // than parenchyma); empty: every region has the toughness above.
-  std::vector<double> region_fracture_toughness_j_per_m2;
+  // A blade breaks in once the force on it reaches the fracture toughness of the tissue it
+  // touches (RegionMaterial::fracture_toughness_j_per_m2, per region of the model) times the
+  // length of its edge in contact (a tip: the blade's thickness), the work per unit advance of a
+  // crack that long (Mahvash & Hayward 2001, haptic rendering of cutting).
+  //
   // A cutting blade is held back by the toughness times its edge in the tissue, against its
   // motion across the edge; below this speed the resistance grows from zero with the speed (a
   // still blade is not pushed back, and the force does not flip with the hand's tremor).
@@ -84,14 +80,11 @@ struct EdgeInTissue {
   double resistance_n = 0.0;
 };
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
-                            const std::array<Eigen::Vector3d, 2>& edge_m,
-                            const CuttingSettings& settings, double margin_m = 1e-6);
+                            const std::array<Eigen::Vector3d, 2>& edge_m, double margin_m = 1e-6);
 // The length of the scalpel's edge in contact that `blade` (its part's contact) reports: the
 // stretch of its axis that touched the tissue and the blade's thickness (a tip's crack is that
 // wide). Times the toughness, the force at which it breaks in.
 double blade_edge_in_contact_m(const PartContact& blade, const ToolGeometry& geometry);
-// The toughness (J/m²) of `region` under `settings`.
-double fracture_toughness_j_per_m2(const CuttingSettings& settings, std::size_t region);
 
 // Whether the edge (heel, tip) passes through any element of the model in `position`, or within
 // about `reach_m` of one (each element's faces pushed out by that much).

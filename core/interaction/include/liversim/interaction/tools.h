@@ -128,6 +128,10 @@ struct PartContact {
   Eigen::Vector3d force_on_part_n = Eigen::Vector3d::Zero();
   double touched_from = 1.0, touched_to = 0.0;  // from > to: it touched nothing
   bool pierced = false;  // its axis passes through a face: it is through the surface
+  // The region (SimModel::regions) of the element whose face pushed it hardest, and that push
+  // (N); -1 when the surface does not say which element a face bounds.
+  std::int32_t region = -1;
+  double hardest_push_n = 0.0;
   bool touched() const { return touched_from <= touched_to; }
 };
 

@@ -20,7 +20,7 @@
 namespace liversim {
 
 // The version this build writes and the newest it reads; older files are migrated on reading.
-inline constexpr int kScenarioFormatVersion = 2;
+inline constexpr int kScenarioFormatVersion = 3;
 inline constexpr std::string_view kScenarioFormatName = "liversim-scenario";
 
 using Millimetres3 =
@@ -71,6 +71,9 @@ struct TissueSpec {
   std::optional<ViscoelasticParameters> viscoelastic;  // E = E1 + E2 must equal elastic's E
   std::optional<ViscoplasticParameters> viscoplastic;
   std::optional<FibreSpec> fibres;
+  // The energy to make new cut surface (J/m²): what holds a scalpel back as it cuts and what it
+  // takes to break in (RegionMaterial; docs/cutting.md). Porcine liver: 187–225 J/m².
+  double fracture_toughness_j_per_m2 = RegionMaterial{}.fracture_toughness_j_per_m2;
   bool operator==(const TissueSpec&) const;
 };
 
@@ -82,7 +85,8 @@ struct LesionSpec {
   double youngs_modulus_pa = 17500.0;    // instantaneous, with viscoelasticity
   std::optional<double> yield_limit_pa;  // with viscoplasticity (default: the parenchyma's)
   std::optional<double> viscosity_pa_s;  // η1 with viscoelasticity (default: the parenchyma's)
-  bool hidden = false;                   // not drawn for the trainee (palpation tasks)
+  std::optional<double> fracture_toughness_j_per_m2;  // J/m² (default: the parenchyma's)
+  bool hidden = false;                                // not drawn for the trainee (palpation tasks)
   bool operator==(const LesionSpec&) const = default;
 };
 
