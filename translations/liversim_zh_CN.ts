@@ -2695,10 +2695,6 @@ Simulated: %2.
         <translation>探针(&amp;P)</translation>
     </message>
     <message>
-        <source>Press the left mouse button on the liver to put the probe&apos;s ball on it, drag to push; Shift+wheel pushes it in or draws it back</source>
-        <translation>在肝脏上按下鼠标左键，将探针的球头放到该处，拖动以按压；Shift+滚轮可将其推入或退回</translation>
-    </message>
-    <message>
         <source>&amp;Forceps</source>
         <translation>抓钳(&amp;F)</translation>
     </message>
@@ -2711,16 +2707,36 @@ Simulated: %2.
         <translation>手术刀(&amp;S)</translation>
     </message>
     <message>
-        <source>Press the left mouse button on the liver to put the blade on it and drag: it breaks in once pressed hard enough to part the tissue and cuts along its path</source>
-        <translation>在肝脏上按下鼠标左键放下刀片并拖动：用力压到足以分开组织时刀片切入，并沿拖动路径切割</translation>
-    </message>
-    <message>
         <source>Force on the tool: %1 N (holding tissue)</source>
         <translation>器械受力：%1 N（正在夹持组织）</translation>
     </message>
     <message>
         <source>Force on the tool: %1 N</source>
         <translation>器械受力：%1 N</translation>
+    </message>
+    <message>
+        <source>Press the left mouse button on the liver to put the probe&apos;s ball on it, drag to move it; while the button is down, the wheel (or Shift+drag) pushes it in or draws it back</source>
+        <translation>在肝脏上按下鼠标左键放上探针的球头，拖动以移动它；按住按键时，滚轮（或 Shift+拖动）将其推入或拉回</translation>
+    </message>
+    <message>
+        <source>Press the left mouse button on the liver to put the blade in and drag: it cuts along its path. While the button is down, the wheel (or Shift+drag) pushes it deeper or draws it back; the panel shows how deep it is. Pressed on from outside, it breaks in once pressed hard enough to part the tissue</source>
+        <translation>在肝脏上按下鼠标左键将刀刃插入并拖动：它沿路径切割。按住按键时，滚轮（或 Shift+拖动）将其推深或拉回；面板显示其深度。从外部按压时，压力足以分开组织时刀刃才切入</translation>
+    </message>
+    <message>
+        <source>How much of the scalpel&apos;s edge is inside the tissue: its depth along the edge</source>
+        <translation>手术刀刃在组织内的长度：沿刀刃的深度</translation>
+    </message>
+    <message>
+        <source>Blade: not in the tissue</source>
+        <translation>刀刃：不在组织内</translation>
+    </message>
+    <message>
+        <source>Blade: %1 mm in the tissue, cutting</source>
+        <translation>刀刃：%1 mm 在组织内，正在切割</translation>
+    </message>
+    <message>
+        <source>Blade: %1 mm in the tissue</source>
+        <translation>刀刃：%1 mm 在组织内</translation>
     </message>
 </context>
 <context>

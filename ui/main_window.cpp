@@ -85,6 +85,10 @@ MainWindow::MainWindow(SceneSetup setup, std::optional<OpenedScenario> scenario,
       [this](QPoint pos, Qt::MouseButton button, Qt::KeyboardModifiers modifiers) {
         return mouseControl_->press(pos, button, modifiers, toolPanel_->tool());
       });
+  // While the mouse holds a tool, the wheel pushes it in along its shaft or draws it back.
+  viewport_->setWheelFilter([this](int notches) {
+    return mouseControl_->pushIn(notches * MouseToolControl::kWheelPushM);
+  });
   connect(viewport_, &VtkViewport::mouseMovedTo, this, [this](QPoint pos, Qt::MouseButtons) {
     mouseControl_->move(pos, QGuiApplication::keyboardModifiers());
   });
@@ -829,6 +833,9 @@ void MainWindow::showNewestSnapshot() {
     toolPanel_->showForce(snapshot.time_s, *pull, true);
   else
     toolPanel_->showForce(snapshot.time_s, Eigen::Vector3d::Zero(), false);
+  const bool scalpel = snapshot.tool && snapshot.tool->kind == ToolKind::scalpel;
+  toolPanel_->showBlade(scalpel ? std::optional(snapshot.blade_edge_in_tissue_m) : std::nullopt,
+                        snapshot.blade_cutting);
   viewport_->scheduleRender();
 }
 

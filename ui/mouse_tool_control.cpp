@@ -55,6 +55,15 @@ void MouseToolControl::move(QPoint pos, Qt::KeyboardModifiers modifiers) {
   }
 }
 
+bool MouseToolControl::pushIn(double in_m) {
+  if (!tool_ || !station_.mouse()) return false;
+  const Eigen::Vector3d shaft = tool_->pose.orientation * Eigen::Vector3d::UnitZ();  // outward
+  tool_->pose.origin_m -= in_m * shaft;
+  toolPoint_m_ -= in_m * shaft;
+  station_.mouse()->set(tool_->pose.origin_m * 1e3, Workstation::kMouseActionButton);
+  return true;
+}
+
 void MouseToolControl::release(Qt::MouseButton button) {
   if (button != Qt::LeftButton) return;
   if (grab_) endGrab();

@@ -33,6 +33,9 @@ class MouseToolControl {
   bool press(QPoint display, Qt::MouseButton button, Qt::KeyboardModifiers modifiers,
              std::optional<ToolKind> tool);
   void move(QPoint display, Qt::KeyboardModifiers modifiers);
+  // Pushes the tool the mouse holds in along its shaft by `in_m` (negative: draws it back); false
+  // when it holds none.
+  bool pushIn(double in_m);
   void release(Qt::MouseButton button);
   // Lets go of the grab and the tool (the scene is replaced, a device takes over, the tool
   // changed).
@@ -52,6 +55,8 @@ class MouseToolControl {
   static constexpr double kGrabRadiusM = 0.02;
   // A release lifts the tool this far up its shaft.
   static constexpr double kLiftM = 0.03;
+  // One notch of the wheel pushes a held tool in (or draws it back) this far.
+  static constexpr double kWheelPushM = 0.001;
 
  private:
   bool beginTool(ToolKind kind, QPoint display);

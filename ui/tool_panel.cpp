@@ -89,17 +89,26 @@ ToolPanel::ToolPanel(QWidget* parent) : QWidget(parent) {
       tr("Drag the liver with the left mouse button: the tissue under it follows the pointer"))
       ->setChecked(true);
   add(tr("&Probe"), "toolProbe", static_cast<int>(ToolKind::probe),
-      tr("Press the left mouse button on the liver to put the probe's ball on it, drag to push; "
-         "Shift+wheel pushes it in or draws it back"));
+      tr("Press the left mouse button on the liver to put the probe's ball on it, drag to move it; "
+         "while the button is down, the wheel (or Shift+drag) pushes it in or draws it back"));
   add(tr("&Forceps"), "toolForceps", static_cast<int>(ToolKind::forceps),
       tr("Press the left mouse button on the liver to close the jaws on it, drag to pull, release "
          "to let go"));
   add(tr("&Scalpel"), "toolScalpel", static_cast<int>(ToolKind::scalpel),
-      tr("Press the left mouse button on the liver to put the blade on it and drag: it breaks in "
-         "once pressed hard enough to part the tissue and cuts along its path"));
+      tr("Press the left mouse button on the liver to put the blade in and drag: it cuts along its "
+         "path. While the button is down, the wheel (or Shift+drag) pushes it deeper or draws it "
+         "back; the panel shows how deep it is. Pressed on from outside, it breaks in once pressed "
+         "hard enough to part the tissue"));
   force_ = new QLabel(this);
   force_->setObjectName("toolForce");
   layout->addWidget(force_);
+  blade_ = new QLabel(this);
+  blade_->setObjectName("toolBladeDepth");
+  blade_->setToolTip(
+      tr("How much of the scalpel's edge is inside the tissue: its depth along "
+         "the edge"));
+  blade_->hide();
+  layout->addWidget(blade_);
   trace_ = new ForceTrace(this);
   trace_->setObjectName("toolForceTrace");
   layout->addWidget(trace_);
@@ -142,6 +151,22 @@ void ToolPanel::showForce(double time_s, const Eigen::Vector3d& force_n, bool ho
 
 QString ToolPanel::forceText() const {
   return force_->text();
+}
+
+void ToolPanel::showBlade(std::optional<double> edge_in_tissue_m, bool cutting) {
+  blade_->setVisible(edge_in_tissue_m.has_value());
+  if (!edge_in_tissue_m) return;
+  const double mm = *edge_in_tissue_m * 1e3;
+  if (mm < 0.05)
+    blade_->setText(tr("Blade: not in the tissue"));
+  else if (cutting)
+    blade_->setText(tr("Blade: %1 mm in the tissue, cutting").arg(mm, 0, 'f', 1));
+  else
+    blade_->setText(tr("Blade: %1 mm in the tissue").arg(mm, 0, 'f', 1));
+}
+
+QString ToolPanel::bladeText() const {
+  return blade_->isHidden() ? QString() : blade_->text();
 }
 
 }  // namespace liversim

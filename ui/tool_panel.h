@@ -1,7 +1,7 @@
 #pragma once
 // The tool in the trainee's hand: the hand (a plain mouse grab), the probe, the forceps or the
-// scalpel, and the force the tissue puts on it, live as a number and as a trace of the last
-// seconds.
+// scalpel, the force the tissue puts on it, live as a number and as a trace of the last seconds,
+// and the scalpel's depth in the tissue.
 
 #include "liversim/interaction/tools.h"
 
@@ -52,6 +52,10 @@ class ToolPanel : public QWidget {
   // The tissue's force on the tool at simulated time t (N); the label shows its magnitude.
   void showForce(double time_s, const Eigen::Vector3d& force_n, bool holding);
   QString forceText() const;
+  // How much of the scalpel's edge is in the tissue (m) and whether it cuts; none: no scalpel in
+  // the scene (the line is hidden).
+  void showBlade(std::optional<double> edge_in_tissue_m, bool cutting);
+  QString bladeText() const;
   ForceTrace* trace() const { return trace_; }
 
  signals:
@@ -60,6 +64,7 @@ class ToolPanel : public QWidget {
  private:
   QButtonGroup* tools_ = nullptr;
   QLabel* force_ = nullptr;
+  QLabel* blade_ = nullptr;  // the scalpel's depth in the tissue
   ForceTrace* trace_ = nullptr;
 };
 

@@ -218,6 +218,10 @@ void VtkViewport::setPressFilter(PressFilter filter) {
   pressFilter_ = std::move(filter);
 }
 
+void VtkViewport::setWheelFilter(WheelFilter filter) {
+  wheelFilter_ = std::move(filter);
+}
+
 QImage VtkViewport::grabRendering() {
   renderPending_ = true;
   return grabFramebuffer();
@@ -414,6 +418,12 @@ void VtkViewport::wheelEvent(QWheelEvent* event) {
 
   // Touchpads send many small deltas: zoom once per accumulated notch.
   accumulatedWheelDelta_ += event->angleDelta().y();
+  if (const int notches = accumulatedWheelDelta_ / kWheelNotch;
+      notches != 0 && wheelFilter_ && wheelFilter_(notches)) {
+    accumulatedWheelDelta_ -= notches * kWheelNotch;
+    event->accept();
+    return;
+  }
   if (accumulatedWheelDelta_ >= kWheelNotch) {
     interactor_->InvokeEvent(vtkCommand::MouseWheelForwardEvent, event);
     accumulatedWheelDelta_ = 0;

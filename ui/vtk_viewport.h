@@ -35,6 +35,9 @@ class VtkViewport : public QOpenGLWidget {
   // the moves that follow and the matching release away from VTK.
   using PressFilter =
       std::function<bool(QPoint vtkDisplayPos, Qt::MouseButton, Qt::KeyboardModifiers)>;
+  // Decides, for each whole notch the wheel turns (positive: away from the user), whether the
+  // owner takes it; the camera zooms by the notches it does not take.
+  using WheelFilter = std::function<bool(int notches)>;
 
   explicit VtkViewport(QWidget* parent = nullptr);
   ~VtkViewport() override;
@@ -52,6 +55,7 @@ class VtkViewport : public QOpenGLWidget {
   bool isInteractionEnabled() const { return interactionEnabled_; }
 
   void setPressFilter(PressFilter filter);
+  void setWheelFilter(WheelFilter filter);
 
   // Renders the current scene and returns the picture the widget shows.
   QImage grabRendering();
@@ -99,6 +103,7 @@ class VtkViewport : public QOpenGLWidget {
 
   bool interactionEnabled_ = true;
   PressFilter pressFilter_;
+  WheelFilter wheelFilter_;
   Qt::MouseButtons ownerDragButtons_;
   Qt::MouseButtons vtkDragButtons_;
   int accumulatedWheelDelta_ = 0;

@@ -201,6 +201,7 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
     add_cycle(inputs, scalpel, steps);
   }
   std::vector<Eigen::Vector3d> steady;  // the force on the blade from 1 cm of travel on
+  std::vector<double> depths_m;         // and how much of its edge is in the tissue
   double top_shift_m = 0.0;             // how far the top near the blade moved, up or down
   int cycle = 0;
   simulation.replay(inputs, [&](const StepReport&, bool) {
@@ -209,6 +210,7 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
     if (cycle++ * kCycleS * kSpeedMPerS < 0.01) return;
     ASSERT_TRUE(seen.blade_cutting) << "the blade is not cutting at cycle " << cycle;
     steady.push_back(seen.cutting_force_n);
+    depths_m.push_back(seen.blade_edge_in_tissue_m);
     const Eigen::Vector3d edge_heel = seen.tool->pose.origin_m;
     const SimModel& now = *seen.model;
     for (std::size_t n = 0; n < now.node_count; ++n) {
@@ -228,6 +230,11 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
     EXPECT_LT(force.tail<2>().norm(), 1e-9 * force.norm()) << "not along the motion";
     EXPECT_GE(force.norm(), expected_n - below_n);
     EXPECT_LE(force.norm(), expected_n + above_n);
+  }
+  // The depth the trainee is shown: the edge's 15 mm in the tissue, as far as the top moved.
+  for (const double depth_m : depths_m) {
+    EXPECT_GE(depth_m, kDepthM - top_shift_m);
+    EXPECT_LE(depth_m, kDepthM + 1e-5 + top_shift_m);
   }
 }
 

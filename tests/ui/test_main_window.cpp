@@ -473,6 +473,51 @@ TEST_F(MainWindowTest, TheScalpelDrawnAcrossTheLiverCutsIt) {
   EXPECT_GT(countDifferentPixels(before, cutting), 100) << "neither the scalpel nor the cut shows";
 }
 
+// With the mouse the scalpel's depth is set by the wheel while the button is down (issue 42, item
+// 3), and the Tool panel shows how much of its edge is in the tissue; the wheel does not zoom
+// then. Put in where pressed, the 2 cm blade is about 16 mm in; six notches back draw it 6 mm out
+// along its shaft, tilted 35° from the view, so its edge leaves at least 3 mm (the tissue it
+// dragged may follow it some way).
+TEST_F(MainWindowTest, TheWheelSetsTheHeldScalpelsDepthAndThePanelShowsIt) {
+  const std::optional<QPoint> start = pointOnTheLiver();
+  ASSERT_TRUE(start);
+  window_->toolPanel()->findChild<QRadioButton*>("toolScalpel")->click();
+  auto* blade = window_->toolPanel()->findChild<QLabel*>("toolBladeDepth");
+  ASSERT_NE(blade, nullptr);
+  sendMouse(QEvent::MouseButtonPress, *start, Qt::LeftButton, Qt::LeftButton);
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] { return window_->simulation().snapshot().blade_edge_in_tissue_m > 0.005; },
+      kSimulatedTimeTimeoutMs))
+      << "the blade put in where pressed is not in the tissue";
+  ASSERT_TRUE(waitSimulated(0.1));
+  const double inBefore_m = window_->simulation().snapshot().blade_edge_in_tissue_m;
+  ASSERT_TRUE(QTest::qWaitFor([&] { return blade->isVisible(); }, 5'000));
+  EXPECT_TRUE(blade->text().contains(QStringLiteral("mm in the tissue")))
+      << blade->text().toStdString();
+  const auto camera = cameraPosition();
+
+  send_wheel(*window_->viewport(), *start, -6, Qt::LeftButton);
+  ASSERT_TRUE(waitSimulated(0.2));
+  const double inAfter_m = window_->simulation().snapshot().blade_edge_in_tissue_m;
+  std::cout << "the blade's edge in the tissue: " << inBefore_m * 1e3
+            << " mm, drawn back 6 mm: " << inAfter_m * 1e3 << " mm\n";
+  EXPECT_LT(inAfter_m, inBefore_m - 0.003) << "the wheel did not draw the blade back";
+  EXPECT_EQ(cameraPosition(), camera) << "the wheel zoomed while the blade was held";
+  // The panel shows the depth now (to its tenth of a millimetre, a snapshot or two later).
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        return blade->text().contains(
+            QString::number(window_->simulation().snapshot().blade_edge_in_tissue_m * 1e3, 'f', 1));
+      },
+      5'000))
+      << blade->text().toStdString();
+
+  release(*start);
+  // Released, the wheel zooms again.
+  send_wheel(*window_->viewport(), *start, 1, Qt::NoButton);
+  EXPECT_NE(cameraPosition(), camera);
+}
+
 TEST_F(MainWindowTest, DraggingTheBackgroundTurnsTheCameraAndGrabsNothing) {
   const QPoint corner(20, 20);
   ASSERT_FALSE(pickAt(corner)) << "the liver covers the corner of the viewport";

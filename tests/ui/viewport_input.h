@@ -1,7 +1,7 @@
 #pragma once
 // What the GUI tests do to a VtkViewport as a user would: VTK display coordinates (device
 // pixels, origin bottom-left, y up) ↔ the widget's, the same mapping as VtkViewport's, and mouse
-// events sent to it.
+// and wheel events sent to it.
 
 #include "vtk_viewport.h"
 
@@ -10,6 +10,7 @@
 #include <QCoreApplication>
 #include <QMouseEvent>
 #include <QPoint>
+#include <QWheelEvent>
 
 #include <cmath>
 
@@ -36,6 +37,13 @@ inline void send_mouse(VtkViewport& viewport, QEvent::Type type, QPoint pos, Qt:
                        Qt::MouseButtons buttons, Qt::KeyboardModifiers modifiers = Qt::NoModifier) {
   QMouseEvent event(type, QPointF(pos), QPointF(viewport.mapToGlobal(pos)), button, buttons,
                     modifiers);
+  QCoreApplication::sendEvent(&viewport, &event);
+}
+
+// `notches` turns of the wheel at `pos` (positive: away from the user) with `buttons` held.
+inline void send_wheel(VtkViewport& viewport, QPoint pos, int notches, Qt::MouseButtons buttons) {
+  QWheelEvent event(QPointF(pos), QPointF(viewport.mapToGlobal(pos)), QPoint(),
+                    QPoint(0, 120 * notches), buttons, Qt::NoModifier, Qt::NoScrollPhase, false);
   QCoreApplication::sendEvent(&viewport, &event);
 }
 

@@ -756,6 +756,7 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
   for (std::size_t i = 0; i < count; ++i) {
     const double new_m =
         std::max(0.0, stretches[i].to - std::max(stretches[i].from, covered_to)) * edge_length_m;
+    in.length_m += new_m;
     in.resistance_n += stretches[i].toughness * new_m;
     covered_to = std::max(covered_to, stretches[i].to);
   }

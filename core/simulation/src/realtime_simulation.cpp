@@ -119,6 +119,10 @@ void RealtimeSimulation::enable_cutting(CuttingSettings settings) {
 
 void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   const auto edge = blade_edge_m(scalpel);
+  // How deep the blade is, shown to the trainee (with the mouse it sets the depth); and, while it
+  // cuts, what holds it back.
+  const EdgeInTissue in = edge_in_tissue(*model_, state_.position_m, edge);
+  blade_edge_in_tissue_m_ = in.length_m;
   if (!blade_in_tissue_) {
     if (!scalpel.blade_armed) return;
     // Breaks in once the force on the blade reaches the toughness of the tissue it presses on
@@ -139,7 +143,7 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     stroke_.edges_m.assign(1, edge);
     return;
   }
-  resist_cutting(edge);
+  resist_cutting(edge, in);
   // A new instant of the stroke once the edge has moved a tenth of a millimetre (a broken-in
   // blade's stroke starts where it broke in).
   const auto& last = stroke_.edges_m.back();
@@ -249,7 +253,8 @@ void RealtimeSimulation::observe_outcome() {
   outcome_->model = model_;
 }
 
-void RealtimeSimulation::resist_cutting(const std::array<Eigen::Vector3d, 2>& edge) {
+void RealtimeSimulation::resist_cutting(const std::array<Eigen::Vector3d, 2>& edge,
+                                        const EdgeInTissue& in) {
   // The edge's velocity across itself, from its midpoint cycle to cycle in simulated time,
   // smoothed over 10 ms (a device's frames come at the servo's rate, cycles at the loop's).
   constexpr double kSmoothingS = 0.01;
@@ -267,7 +272,6 @@ void RealtimeSimulation::resist_cutting(const std::array<Eigen::Vector3d, 2>& ed
     cutting_force_n_.setZero();
     return;
   }
-  const EdgeInTissue in = edge_in_tissue(*model_, state_.position_m, edge);
   cutting_force_n_ = -in.resistance_n *
                      std::min(1.0, speed / cutting_->full_resistance_speed_m_per_s) * across /
                      speed;
@@ -529,6 +533,9 @@ void RealtimeSimulation::publish_cycle() {
   out.tool_grasping = tool_acts && tools_->grasping();
   out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
   out.blade_cutting = tool_acts && blade_in_tissue_;
+  out.blade_edge_in_tissue_m = tool_acts && cutting_ && active_tool_->kind == ToolKind::scalpel
+                                   ? blade_edge_in_tissue_m_
+                                   : 0.0;
   out.tool = tool_acts ? active_tool_ : std::nullopt;
   out.device_sample = device_sample_;
   if (haptic_servo_) haptic_servo_->publish(force_model);

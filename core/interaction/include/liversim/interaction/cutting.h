@@ -72,11 +72,13 @@ struct BladeStroke {
 // The scalpel's edge (heel, tip) in the scene.
 std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel);
 
-// The blade's edge in the tissue: the force the crack front along it holds back, each stretch of
-// the edge within an element (its faces pushed out by `margin_m`, so that an edge along faces, as
-// in its own cut, is in; overlaps once) times the element's region's toughness (N): the work per
-// unit advance of the crack (Mahvash & Hayward 2001). Allocates nothing.
+// The blade's edge in the tissue: each stretch of the edge within an element (its faces pushed
+// out by `margin_m`, so that an edge along faces, as in its own cut, is in; overlaps once), their
+// length, and the force the crack front along them holds back, each stretch times its element's
+// region's toughness: the work per unit advance of the crack (Mahvash & Hayward 2001). Allocates
+// nothing.
 struct EdgeInTissue {
+  double length_m = 0.0;
   double resistance_n = 0.0;
 };
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,

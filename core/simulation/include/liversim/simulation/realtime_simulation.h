@@ -48,6 +48,9 @@ struct SimulationSnapshot {
   // Of tool_force_n, the tissue's resistance to the cutting blade (CuttingSettings): its
   // toughness times the edge in the tissue, against the blade's motion across its edge.
   Eigen::Vector3d cutting_force_n = Eigen::Vector3d::Zero();
+  // How much of the scalpel's edge is inside the tissue (m; with cutting enabled), cutting or not:
+  // how deep the blade is, along its edge.
+  double blade_edge_in_tissue_m = 0.0;
   // The tool acting in the last cycle (set_tool's, or the device's), for drawing.
   std::optional<Tool> tool;
   // The haptic device's newest frame (set_haptic_servo), which the device's tool follows.
@@ -295,6 +298,7 @@ class RealtimeSimulation {
   BladeStroke stroke_;            // simulation thread only
   bool blade_in_tissue_ = false;  // the scalpel broke in: its blade passes and cuts
   Eigen::Vector3d cutting_force_n_ = Eigen::Vector3d::Zero();  // on the blade, while it cuts
+  double blade_edge_in_tissue_m_ = 0.0;  // of the scalpel's edge, after the last cycle
   Eigen::Vector3d blade_velocity_m_per_s_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d blade_middle_m_ = Eigen::Vector3d::Zero();
   double blade_time_s_ = -1.0;  // when blade_middle_m_ was; < 0: not yet
@@ -304,8 +308,9 @@ class RealtimeSimulation {
   // Extends the stroke with the scalpel's edge, cuts, and swaps in the cut model and state.
   void cut_with_scalpel(const Tool& scalpel);
   void end_stroke();  // the blade is out: the next cut needs a new break-in
-  // While the blade cuts: the tissue's resistance to it (CuttingSettings), from its edge `edge`.
-  void resist_cutting(const std::array<Eigen::Vector3d, 2>& edge);
+  // While the blade cuts: the tissue's resistance to it (CuttingSettings), from its edge `edge`
+  // and that edge's stretch in the tissue.
+  void resist_cutting(const std::array<Eigen::Vector3d, 2>& edge, const EdgeInTissue& in);
   // Takes the inputs set from other threads (springs, tool, device tool) for the next cycle.
   void take_inputs();
   void change_tool(const std::optional<Tool>& tool);
