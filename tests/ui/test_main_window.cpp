@@ -36,6 +36,7 @@
 #include "liversim/meshing/default_scene.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "main_window.h"
+#include "mouse_tool_control.h"
 #include "render/liver_scene.h"
 #include "tool_panel.h"
 #include "viewport_input.h"
@@ -491,6 +492,8 @@ TEST_F(MainWindowTest, TheWheelSetsTheHeldScalpelsDepthAndThePanelShowsIt) {
       << "the blade put in where pressed is not in the tissue";
   ASSERT_TRUE(waitSimulated(0.1));
   const double inBefore_m = window_->simulation().snapshot().blade_edge_in_tissue_m;
+  ASSERT_TRUE(window_->simulation().snapshot().tool);
+  const Tool putOn = *window_->simulation().snapshot().tool;
   ASSERT_TRUE(QTest::qWaitFor([&] { return blade->isVisible(); }, 5'000));
   EXPECT_TRUE(blade->text().contains(QStringLiteral("mm in the tissue")))
       << blade->text().toStdString();
@@ -511,6 +514,15 @@ TEST_F(MainWindowTest, TheWheelSetsTheHeldScalpelsDepthAndThePanelShowsIt) {
       },
       5'000))
       << blade->text().toStdString();
+
+  // Pushed in twelve notches, it goes no deeper than its blade: 4 mm past where it was put on
+  // (its heel was 4 mm above the surface), not 6.
+  send_wheel(*window_->viewport(), *start, 12, Qt::LeftButton);
+  ASSERT_TRUE(waitSimulated(0.05));
+  const Tool pushed = *window_->simulation().snapshot().tool;
+  const Eigen::Vector3d shaft = putOn.pose.orientation * Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR((putOn.pose.origin_m - pushed.pose.origin_m).dot(shaft),
+              MouseToolControl::kScalpelHeelAboveM, 1e-9);
 
   release(*start);
   // Released, the wheel zooms again.
