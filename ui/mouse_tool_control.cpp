@@ -57,11 +57,6 @@ void MouseToolControl::move(QPoint pos, Qt::KeyboardModifiers modifiers) {
 
 bool MouseToolControl::pushIn(double in_m) {
   if (!tool_ || !station_.mouse()) return false;
-  // The scalpel is put on with its heel kScalpelHeelAboveM above the surface; deeper than its
-  // blade, its handle would be forced into the tissue (which the simulation does not part: the
-  // handle wedges the cut open and crushes the elements beside it, docs/cutting.md).
-  if (tool_->kind == ToolKind::scalpel) in_m = std::min(in_m, kScalpelHeelAboveM - pushedIn_m_);
-  pushedIn_m_ += in_m;
   const Eigen::Vector3d shaft = tool_->pose.orientation * Eigen::Vector3d::UnitZ();  // outward
   tool_->pose.origin_m -= in_m * shaft;
   toolPoint_m_ -= in_m * shaft;
@@ -114,7 +109,6 @@ bool MouseToolControl::beginTool(ToolKind kind, QPoint pos) {
   }
   tool_ = tool;
   toolPoint_m_ = hit->point_m;
-  pushedIn_m_ = 0.0;
   station_.mouse()->place(tool.pose.origin_m * 1e3, Workstation::kMouseActionButton);
   // After the placement, so that the frames of the tool's interval are all where it is put. A
   // session of the mouse begins when it first takes a tool to the liver (and restarts the

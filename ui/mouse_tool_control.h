@@ -34,10 +34,8 @@ class MouseToolControl {
              std::optional<ToolKind> tool);
   void move(QPoint display, Qt::KeyboardModifiers modifiers);
   // Pushes the tool the mouse holds in along its shaft by `in_m` (negative: draws it back); false
-  // when it holds none. The scalpel goes in no deeper than its blade from where it was put on.
+  // when it holds none.
   bool pushIn(double in_m);
-  // How far the held tool is in along its shaft from where it was put on (m).
-  double pushedIn_m() const { return pushedIn_m_; }
   void release(Qt::MouseButton button);
   // Lets go of the grab and the tool (the scene is replaced, a device takes over, the tool
   // changed).
@@ -73,7 +71,6 @@ class MouseToolControl {
   std::vector<NodeSpring> springs_;
   std::optional<Tool> tool_;
   Eigen::Vector3d toolPoint_m_ = Eigen::Vector3d::Zero();  // where the mouse holds the tool
-  double pushedIn_m_ = 0.0;                                // along the shaft since it was put on
 };
 
 }  // namespace liversim

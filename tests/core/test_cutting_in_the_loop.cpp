@@ -8,6 +8,7 @@
 #include "liversim/engine/model_building.h"
 #include "liversim/engine/state.h"
 #include "liversim/engine/surface.h"
+#include "liversim/haptics/haptics.h"
 #include "liversim/interaction/cutting.h"
 #include "liversim/meshing/default_scene.h"
 #include "liversim/scenario/scenario.h"
@@ -55,14 +56,17 @@ void add_cycle(std::vector<SimulationInput>& inputs, const Tool& tool, int steps
 // The scalpel held upright (its 2 cm blade down) over the middle of the liver's top: lowered in
 // 0.5 s from 5 mm above it until the blade's tip is `depth_m` under it, drawn 6 cm along x at
 // `speed_m_per_s` with the tip that deep under the sloping top, lifted out in 0.5 s, then left
-// out for 0.5 s. One tool input and one cycle (of `step_s` steps) per millisecond.
+// out for 0.5 s. One tool input and one cycle (of `step_s` steps) per millisecond. `tilted`: held
+// as the mouse holds it in the opening view (shaft toward the viewer, 35° up), its heel where the
+// upright blade's would be.
 std::vector<SimulationInput> stroke(const SimModel& model, double step_s, double depth_m,
-                                    double speed_m_per_s) {
+                                    double speed_m_per_s, bool tilted) {
   constexpr double kLengthM = 0.06;
   Eigen::AlignedBox3d box;
   for (std::size_t n = 0; n < model.node_count; ++n) box.extend(model.rest_position_m.at(n));
   Tool scalpel;
   scalpel.kind = ToolKind::scalpel;
+  if (tilted) scalpel.pose.orientation = tool_orientation_from_view(opening_view_device_axes());
   const double blade_m = scalpel.geometry.blade_length_m;
   const double x0 = box.center().x() - 0.5 * kLengthM, y0 = box.center().y();
   const double top0 = top_at(model, x0, y0), top1 = top_at(model, x0 + kLengthM, y0);
@@ -93,6 +97,7 @@ struct StrokeCase {
   const char* scene;  // "free practice" or a shipped scenario's file name
   double depth_m;
   double speed_m_per_s;
+  bool tilted = false;
 };
 
 std::string case_name(const ::testing::TestParamInfo<StrokeCase>& info) {
@@ -100,7 +105,7 @@ std::string case_name(const ::testing::TestParamInfo<StrokeCase>& info) {
   scene = scene.substr(0, scene.find_first_of(" -."));
   return scene + "_" + std::to_string(static_cast<int>(std::lround(info.param.depth_m * 1e3))) +
          "mm_" + std::to_string(static_cast<int>(std::lround(info.param.speed_m_per_s * 1e3))) +
-         "mm_per_s";
+         "mm_per_s" + (info.param.tilted ? "_tilted" : "");
 }
 
 class ScalpelInTheLoopTest : public ::testing::TestWithParam<StrokeCase> {};
@@ -122,7 +127,7 @@ TEST_P(ScalpelInTheLoopTest, AStrokePartsTheLiverAndTheExplicitStepStaysUp) {
   simulation.enable_tools(extract_surface(scene.mesh));
   simulation.enable_cutting();
   const std::vector<SimulationInput> inputs =
-      stroke(*model, realtime_step_s(*model), c.depth_m, c.speed_m_per_s);
+      stroke(*model, realtime_step_s(*model), c.depth_m, c.speed_m_per_s, c.tilted);
 
   int parts = 0, cycles = 0;
   bool broke_in = false;
@@ -149,15 +154,18 @@ TEST_P(ScalpelInTheLoopTest, AStrokePartsTheLiverAndTheExplicitStepStaysUp) {
   EXPECT_FALSE(simulation.stats().halted);
 }
 
-// Depths within the blade's 2 cm (deeper, the shaft pushes uncut tissue: see docs/cutting.md),
-// speeds from a slow 1 cm/s to a brisk 5 cm/s.
-INSTANTIATE_TEST_SUITE_P(Strokes, ScalpelInTheLoopTest,
-                         ::testing::Values(StrokeCase{"free practice", 0.008, 0.02},
-                                           StrokeCase{"free practice", 0.016, 0.01},
-                                           StrokeCase{"free practice", 0.016, 0.05},
-                                           StrokeCase{"wedge-resection-peripheral-tumour.json",
-                                                      0.016, 0.02}),
-                         case_name);
+// Depths within the blade's 2 cm and deeper (the handle follows it in: cutting_edge_m; pushing,
+// it had set the step to 0.054 ms at 25 mm, tilted), speeds from a slow 1 cm/s to a brisk 5 cm/s.
+INSTANTIATE_TEST_SUITE_P(
+    Strokes, ScalpelInTheLoopTest,
+    ::testing::Values(StrokeCase{"free practice", 0.008, 0.02},
+                      StrokeCase{"free practice", 0.016, 0.01},
+                      StrokeCase{"free practice", 0.016, 0.05},
+                      StrokeCase{"free practice", 0.025, 0.02, true},
+                      StrokeCase{"free practice", 0.045, 0.02, true},
+                      StrokeCase{"wedge-resection-peripheral-tumour.json", 0.016, 0.02},
+                      StrokeCase{"wedge-resection-peripheral-tumour.json", 0.045, 0.02, true}),
+    case_name);
 
 // A blade you feel (issue 42, item 4): drawn straight through a block, a cutting blade is held back
 // by the toughness times its edge in the tissue, against its motion. The block (6 × 5 × 4 cm,

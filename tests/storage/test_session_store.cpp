@@ -398,10 +398,11 @@ TEST(SessionReplay, ASessionRecordedBeforeTheStationStillReplaysToItsEndWithItsC
   EXPECT_GT(end.time_s, 2.4);
 }
 
-// A session recorded when the scalpel came to break in by the tissue's toughness (issue 42):
-// `liversim-cli record --tets 1500 --tool scalpel --duration 2.6 --trajectory
+// A session recorded when a broken-in scalpel came to cut with the whole tool (issue 42:
+// cutting_edge_m; the file recorded when it came to break in by the tissue's toughness went with
+// it): `liversim-cli record --tets 1500 --tool scalpel --duration 2.6 --trajectory
 // tests/data/trajectories/free-practice-three-strokes.txt`, two cuts
-// (tests/data/storage/session-v5-scalpel-cuts-toughness.sqlite). Replayed by today's engine, its
+// (tests/data/storage/session-v5-scalpel-cuts-whole-tool.sqlite). Replayed by today's engine, its
 // final positions and velocities are those its replay gave when it was recorded, to the last bit.
 // Bit for bit holds for one build of the engine, the one the digest was taken with: GCC's
 // optimised build with the AVX2+FMA element kernels. Other builds skip. A deliberate change of the
@@ -416,13 +417,13 @@ TEST(SessionReplay, ARecordedSessionReplaysToTheSameStateBitForBit) {
     GTEST_SKIP() << "the digest is of the AVX2+FMA element kernels; these are "
                  << element_kernel_instruction_set();
   const ReplayedEnd end = replay_to_the_end(
-      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cuts-toughness.sqlite",
-      "recorded-with-toughness");
+      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cuts-whole-tool.sqlite",
+      "recorded-cutting-with-the-whole-tool");
   EXPECT_EQ(end.cuts, 2u);
   EXPECT_EQ(end.nodes, 434u) << "the cuts made other nodes (copies along them, flaps merged)";
   EXPECT_EQ(end.steps, 4429u);
   EXPECT_EQ(end.time_s, 2.5990115343578988);
-  EXPECT_EQ(end.digest, 0xe3e3a01de634448cull);
+  EXPECT_EQ(end.digest, 0x0b1705f8775396fbull);
 }
 
 TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {

@@ -515,14 +515,17 @@ TEST_F(MainWindowTest, TheWheelSetsTheHeldScalpelsDepthAndThePanelShowsIt) {
       5'000))
       << blade->text().toStdString();
 
-  // Pushed in twelve notches, it goes no deeper than its blade: 4 mm past where it was put on
-  // (its heel was 4 mm above the surface), not 6.
-  send_wheel(*window_->viewport(), *start, 12, Qt::LeftButton);
-  ASSERT_TRUE(waitSimulated(0.05));
+  // Pushed in sixteen notches, 10 mm deeper than it was put on: deeper than its blade, so its
+  // handle goes into the tissue with it, and more of it is in.
+  send_wheel(*window_->viewport(), *start, 16, Qt::LeftButton);
+  ASSERT_TRUE(waitSimulated(0.2));
   const Tool pushed = *window_->simulation().snapshot().tool;
   const Eigen::Vector3d shaft = putOn.pose.orientation * Eigen::Vector3d::UnitZ();
-  EXPECT_NEAR((putOn.pose.origin_m - pushed.pose.origin_m).dot(shaft),
-              MouseToolControl::kScalpelHeelAboveM, 1e-9);
+  EXPECT_NEAR((putOn.pose.origin_m - pushed.pose.origin_m).dot(shaft), 0.010, 1e-9);
+  const double inDeep_m = window_->simulation().snapshot().blade_edge_in_tissue_m;
+  std::cout << "pushed 10 mm deeper than put on: " << inDeep_m * 1e3 << " mm in the tissue\n";
+  EXPECT_GT(inDeep_m, inBefore_m + 0.005);
+  EXPECT_FALSE(window_->simulation().stats().halted);
 
   release(*start);
   // Released, the wheel zooms again.

@@ -47,6 +47,11 @@ std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel) {
   return {edge.a_m, edge.b_m};
 }
 
+std::array<Eigen::Vector3d, 2> cutting_edge_m(const Tool& scalpel) {
+  return {scalpel.pose.to_scene({0.0, 0.0, scalpel.geometry.shaft_length_m}),
+          blade_edge_m(scalpel)[1]};
+}
+
 double element_cutting_stress_pa(const SimModel& model, const SimState& state, std::size_t e) {
   Eigen::Matrix3d F = deformation_gradient(model, state.position_m, e);
   if (model.effects.viscous && model.viscous_parameters[model.region[e]])

@@ -347,7 +347,9 @@ std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const Node
                           grasp_.stiffness_n_per_m[i], grasp_.damping_n_s_per_m[i]});
     count = 1;  // the shaft only (parts[0] of the forceps)
   }
-  if (blade_cuts && tool.kind == ToolKind::scalpel) count = 1;  // the blade passes: shaft only
+  // A cutting scalpel passes: its blade and, deeper than the blade, its shaft part the tissue
+  // instead (cutting_edge_m).
+  if (blade_cuts && tool.kind == ToolKind::scalpel) count = 0;
   contact_count_ =
       add_contact_springs(*model_, bvh_, position, std::span<const Capsule>(parts.data(), count),
                           contact_, contact_scratch_, springs_,

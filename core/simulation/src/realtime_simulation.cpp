@@ -118,7 +118,8 @@ void RealtimeSimulation::enable_cutting(CuttingSettings settings) {
 }
 
 void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
-  const auto edge = blade_edge_m(scalpel);
+  // Out, the blade; in, the whole tool cuts (cutting_edge_m).
+  const auto edge = blade_in_tissue_ ? cutting_edge_m(scalpel) : blade_edge_m(scalpel);
   // How deep the blade is, shown to the trainee (with the mouse it sets the depth); and, while it
   // cuts, what holds it back.
   const EdgeInTissue in = edge_in_tissue(*model_, state_.position_m, edge);
@@ -127,10 +128,9 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     if (!scalpel.blade_armed) return;
     // Breaks in once the force on the blade reaches the toughness of the tissue it presses on
     // times the length of its edge in contact: the tissue would give way at that load
-    // (CuttingSettings). An element's
-    // average stress under a thin blade depends on the element's size, not the blade's load. An
-    // edge already through the surface (put in deep, or pressed through faster than the tissue
-    // gave way) has made its way in: it is in.
+    // (CuttingSettings). An element's average stress under a thin blade depends on the element's
+    // size, not the blade's load. An edge already through the surface (put in deep, or pressed
+    // through faster than the tissue gave way) has made its way in: it is in.
     const PartContact& blade = tools_->part_contact(kScalpelBlade);
     if (!blade.touched()) return;
     const RegionMaterial& pressed =
@@ -140,7 +140,7 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
             pressed.fracture_toughness_j_per_m2 * blade_edge_in_contact_m(blade, scalpel.geometry))
       return;
     blade_in_tissue_ = true;
-    stroke_.edges_m.assign(1, edge);
+    stroke_.edges_m.assign(1, cutting_edge_m(scalpel));
     return;
   }
   resist_cutting(edge, in);

@@ -71,6 +71,12 @@ struct BladeStroke {
 
 // The scalpel's edge (heel, tip) in the scene.
 std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel);
+// What a scalpel that has broken in cuts with: from the end of its shaft to the blade's tip. Taken
+// deeper than its blade, the handle follows the blade into its incision and parts what it passes,
+// as a longer blade would. (Pushing, the 5 mm shaft wedged the cut open, crushed the elements
+// beside it and dragged light nodes that sprang back at metres per second: the explicit step fell
+// to 0.05 ms, issue 42.)
+std::array<Eigen::Vector3d, 2> cutting_edge_m(const Tool& scalpel);
 
 // The blade's edge in the tissue: each stretch of the edge within an element (its faces pushed
 // out by `margin_m`, so that an edge along faces, as in its own cut, is in; overlaps once), their

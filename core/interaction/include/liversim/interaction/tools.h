@@ -177,9 +177,9 @@ class ToolInteraction {
                   ContactSettings contact = {}, GraspSettings grasp = {});
 
   // The springs for the next interval at the tool's pose and the tissue's `position`. A scalpel
-  // whose blade is cutting (`blade_cuts`) pushes with its shaft only: the blade passes into the
-  // tissue it separates. Allocates nothing (every buffer is sized for the whole surface at
-  // construction).
+  // whose blade is cutting (`blade_cuts`) does not push: it passes into the tissue it separates,
+  // its shaft too when deeper than the blade (cutting_edge_m). Allocates nothing (every buffer is
+  // sized for the whole surface at construction).
   std::span<const NodeSpring> update(const Tool& tool, const NodeArray& position,
                                      bool blade_cuts = false);
   // The springs of the last update.

@@ -199,7 +199,8 @@ class RealtimeSimulation {
   // From then on a scalpel cuts (cutting.h). Its blade presses on the tissue like any tool until
   // the force on it reaches the tissue's toughness times its edge in contact
   // (RegionMaterial::fracture_toughness_j_per_m2); then the blade breaks in:
-  // it stops pushing (only the shaft still does), its edge at each cycle extends the stroke, and
+  // it stops pushing and cuts with the whole tool (cutting_edge_m), whose edge at each cycle
+  // extends the stroke, and
   // the tissue the stroke has passed through is separated. Taking the scalpel away or changing
   // the tool ends the stroke. A cut replaces the model and state (see SimulationSnapshot::model)
   // and drops the springs set by set_springs (their nodes may be gone). Call while stopped,
