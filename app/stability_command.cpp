@@ -122,9 +122,9 @@ int run_suite(const StabilityStudyOptions& o) {
   for (const ParameterRange& range : tissue_parameter_ranges())
     md << "| " << range.label << " | `" << range.name << "` | " << format(range.min, 4) << " | "
        << format(range.max, 4) << " | " << range.unit << " | "
-       << (range.name == parameter::fracture_toughness ? "no (no force of the sweep uses it)"
-           : range.log_scale                           ? "log-uniform"
-                                                       : "uniform")
+       << (!range.swept      ? "no (no force of the sweep uses it)"
+           : range.log_scale ? "log-uniform"
+                             : "uniform")
        << " | " << range.why << " |\n";
   if (const int written = write_report(o.output_dir / "stability-report.md", md.str()))
     return written;

@@ -165,8 +165,4 @@ void ToolPanel::showBlade(std::optional<double> edge_in_tissue_m, bool cutting) 
     blade_->setText(tr("Blade: %1 mm in the tissue").arg(mm, 0, 'f', 1));
 }
 
-QString ToolPanel::bladeText() const {
-  return blade_->isHidden() ? QString() : blade_->text();
-}
-
 }  // namespace liversim

@@ -55,7 +55,6 @@ class ToolPanel : public QWidget {
   // How much of the scalpel's edge is in the tissue (m) and whether it cuts; none: no scalpel in
   // the scene (the line is hidden).
   void showBlade(std::optional<double> edge_in_tissue_m, bool cutting);
-  QString bladeText() const;
   ForceTrace* trace() const { return trace_; }
 
  signals:

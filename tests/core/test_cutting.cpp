@@ -309,7 +309,7 @@ TEST(Cutting, ABladeEdgeIsInTheTissueWhereItPassesThroughAnElementOrComesWithinR
   const SimModel model = block_model();
   const SimState state = make_rest_state(model);
   auto in = [&](Eigen::Vector3d heel, Eigen::Vector3d tip, double reach_m = 0.0) {
-    return blade_edge_in_tissue(model, state.position_m, {heel, tip}, reach_m);
+    return edge_in_tissue(model, state.position_m, {heel, tip}, reach_m).within_reach;
   };
   // Down into the block's top, and wholly inside it.
   EXPECT_TRUE(in({0.031, 0.022, 0.06}, {0.031, 0.022, 0.035}));

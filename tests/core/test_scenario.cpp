@@ -13,6 +13,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <string_view>
 
 namespace liversim {
 namespace {
@@ -316,20 +317,29 @@ TEST(ScenarioFile, ANumberBeyondADoublesRangeIsAnErrorOfTheTextNotACrash) {
   }
 }
 
-// Version 2 added gravity; a version-1 file (every shipped scenario before it) reads as before,
-// with gravity off and its direction and strength at their defaults, and says it was migrated.
-TEST(ScenarioFile, AVersionOneFileReadsWithGravityOff) {
-  const std::string text = R"({
-  "format": "liversim-scenario", "version": 1, "title": "Written by version 1",
-  "organ": {"geometry": "built-in-liver", "target_tet_count": 3841, "fix_ligament": true},
+// A palpation scenario as an older format version wrote it, with that version's `effects`.
+std::string older_palpation_scenario(int version, std::string_view effects) {
+  return R"({
+  "format": "liversim-scenario", "version": )" +
+         std::to_string(version) + R"(, "title": "Written by an older version",
+  "organ": {"geometry": "built-in-liver", "target_tet_count": 1500, "fix_ligament": true},
   "parenchyma": {"youngs_modulus_pa": 3500, "poisson_ratio": 0.49, "density_kg_per_m3": 1060},
-  "effects": {"near_incompressibility": true, "viscoelastic": false, "viscoplastic": false,
-              "fibres": false},
+  "effects": )" +
+         std::string(effects) +
+         R"(,
   "tools": ["probe"],
   "task": {"kind": "palpate-lesion", "lesion": "t", "time_limit_s": 180},
   "lesions": [{"name": "t", "centre_mm": [-50, 10, 40], "radii_mm": [12, 12, 12],
                "youngs_modulus_pa": 17500}]
 })";
+}
+
+// Version 2 added gravity; a version-1 file (every shipped scenario before it) reads as before,
+// with gravity off and its direction and strength at their defaults, and says it was migrated.
+TEST(ScenarioFile, AVersionOneFileReadsWithGravityOff) {
+  const std::string text = older_palpation_scenario(
+      1, R"({"near_incompressibility": true, "viscoelastic": false, "viscoplastic": false,
+              "fibres": false})");
   const ScenarioReading reading = read_scenario(text);
   ASSERT_TRUE(reading.scenario) << (reading.errors.empty() ? "" : reading.errors[0].text());
   EXPECT_EQ(reading.file_version, 1);
@@ -346,18 +356,10 @@ TEST(ScenarioFile, AVersionOneFileReadsWithGravityOff) {
 // Version 3 added the fracture toughness; a version-2 file reads with the liver's, for the
 // parenchyma and for each lesion, and the scene's regions have it.
 TEST(ScenarioFile, AVersionTwoFileReadsWithTheLiversFractureToughness) {
-  const std::string text = R"({
-  "format": "liversim-scenario", "version": 2, "title": "Written by version 2",
-  "organ": {"geometry": "built-in-liver", "target_tet_count": 1500, "fix_ligament": true},
-  "parenchyma": {"youngs_modulus_pa": 3500, "poisson_ratio": 0.49, "density_kg_per_m3": 1060},
-  "effects": {"near_incompressibility": true, "viscoelastic": false, "viscoplastic": false,
+  const std::string text = older_palpation_scenario(
+      2, R"({"near_incompressibility": true, "viscoelastic": false, "viscoplastic": false,
               "fibres": false, "gravity": false, "gravity_direction": [0, 0, -1],
-              "gravity_m_per_s2": 9.81},
-  "tools": ["probe"],
-  "task": {"kind": "palpate-lesion", "lesion": "t", "time_limit_s": 180},
-  "lesions": [{"name": "t", "centre_mm": [-50, 10, 40], "radii_mm": [12, 12, 12],
-               "youngs_modulus_pa": 17500}]
-})";
+              "gravity_m_per_s2": 9.81})");
   const ScenarioReading reading = read_scenario(text);
   ASSERT_TRUE(reading.scenario) << (reading.errors.empty() ? "" : reading.errors[0].text());
   EXPECT_EQ(reading.file_version, 2);

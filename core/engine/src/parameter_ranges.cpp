@@ -61,7 +61,8 @@ constexpr std::array kRanges{
     ParameterRange{p::fracture_toughness, "fracture toughness J", "J/m²", 20.0, 5000.0, true,
                    "liver 76-225 J/m² (porcine, by scalpel and needle; bovine 164); none is "
                    "published for liver tumours or cirrhosis: up to fibrous tissue (muscle "
-                   "550-8000), down to a tenth of liver"},
+                   "550-8000), down to a tenth of liver",
+                   false},
 };
 
 }  // namespace

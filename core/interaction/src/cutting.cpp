@@ -712,27 +712,14 @@ std::pair<double, double> edge_within_element(const std::array<Eigen::Vector3d, 
 
 }  // namespace
 
-bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
-                          const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m) {
-  const Aabb edge_box = Aabb::around(edge_m[0], edge_m[1], reach_m);
-  for (std::size_t e = 0; e < model.tet_count; ++e) {
-    const auto p = corners_at(model, position_m, e);
-    Aabb box;
-    for (const auto& q : p) box.grow(q);
-    if (!box.overlaps(edge_box)) continue;
-    const auto [t_in, t_out] = edge_within_element(p, edge_m, reach_m);
-    if (t_in <= t_out) return true;
-  }
-  return false;
-}
-
 double blade_edge_in_contact_m(const PartContact& blade, const ToolGeometry& geometry) {
   return (blade.touched_to - blade.touched_from) * geometry.blade_length_m +
          2.0 * geometry.blade_half_thickness_m;
 }
 
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
-                            const std::array<Eigen::Vector3d, 2>& edge_m, double margin_m) {
+                            const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m,
+                            double margin_m) {
   // Each element's stretch of the edge, its faces pushed out by the margin so that an edge lying
   // along faces (its own cut, faces snapped onto it) is in; overlaps counted once.
   struct Stretch {
@@ -741,12 +728,17 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
   constexpr std::size_t kMostStretches = 128;  // elements along one edge: a few dozen at most
   std::array<Stretch, kMostStretches> stretches;
   std::size_t count = 0;
-  const Aabb edge_box = Aabb::around(edge_m[0], edge_m[1], margin_m);
+  EdgeInTissue in;
+  const Aabb edge_box = Aabb::around(edge_m[0], edge_m[1], std::max(reach_m, margin_m));
   for (std::size_t e = 0; e < model.tet_count && count < kMostStretches; ++e) {
     const auto p = corners_at(model, position_m, e);
     Aabb box;
     for (const auto& q : p) box.grow(q);
     if (!box.overlaps(edge_box)) continue;
+    if (!in.within_reach) {
+      const auto [t_in, t_out] = edge_within_element(p, edge_m, reach_m);
+      in.within_reach = t_in <= t_out;
+    }
     const auto [t_in, t_out] = edge_within_element(p, edge_m, margin_m);
     if (t_in < t_out)
       stretches[count++] = {
@@ -755,7 +747,6 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
   }
   std::sort(stretches.begin(), stretches.begin() + static_cast<std::ptrdiff_t>(count),
             [](const Stretch& a, const Stretch& b) { return a.from < b.from; });
-  EdgeInTissue in;
   const double edge_length_m = (edge_m[1] - edge_m[0]).norm();
   double covered_to = 0.0;
   for (std::size_t i = 0; i < count; ++i) {

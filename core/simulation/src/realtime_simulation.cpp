@@ -120,9 +120,15 @@ void RealtimeSimulation::enable_cutting(CuttingSettings settings) {
 void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   // Out, the blade; in, the whole tool cuts (cutting_edge_m).
   const auto edge = blade_in_tissue_ ? cutting_edge_m(scalpel) : blade_edge_m(scalpel);
-  // How deep the blade is, shown to the trainee (with the mouse it sets the depth); and, while it
-  // cuts, what holds it back.
-  const EdgeInTissue in = edge_in_tissue(*model_, state_.position_m, edge);
+  // How deep the blade is, shown to the trainee (with the mouse it sets the depth); while it cuts,
+  // what holds it back, and whether it is still in: within a few millimetres of tissue (in its own
+  // cut the edge may touch no element). Clear of the surface's box (refitted in this cycle's
+  // steps), the edge meets nothing: no walk over the elements.
+  constexpr double kBladeReachM = 0.003;
+  const EdgeInTissue in =
+      tools_->bvh().bounds().overlaps(Aabb::around(edge[0], edge[1], kBladeReachM))
+          ? edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)
+          : EdgeInTissue{};
   blade_edge_in_tissue_m_ = in.length_m;
   if (!blade_in_tissue_) {
     if (!scalpel.blade_armed) return;
@@ -148,10 +154,8 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   // blade's stroke starts where it broke in).
   const auto& last = stroke_.edges_m.back();
   if ((edge[0] - last[0]).norm() < 1e-4 && (edge[1] - last[1]).norm() < 1e-4) return;
-  // Drawn out of the tissue, the blade has to break in again. Within a few millimetres of tissue
-  // it is still in: in its own cut the edge may touch no element.
-  constexpr double kBladeReachM = 0.003;
-  if (!blade_edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)) return end_stroke();
+  // Drawn out of the tissue, the blade has to break in again.
+  if (!in.within_reach) return end_stroke();
   // Disarmed, the blade passes on without cutting; armed again, the stroke goes on from here.
   if (!scalpel.blade_armed) {
     stroke_.edges_m.assign(1, edge);

@@ -27,6 +27,9 @@ struct ParameterRange {
   // Spans decades: sample log-uniformly, step a spin box by factors. (min > 0 when set.)
   bool log_scale = false;
   std::string_view why;  // one line: where the limits come from
+  // Drawn by the stability suite's parameter sweep (case 12); not a parameter of the forces
+  // otherwise (the fracture toughness only holds the scalpel back).
+  bool swept = true;
 
   bool contains(double value) const { return value >= min && value <= max; }  // NaN: false
   // The value at `fraction` (0: min, 1: max) of the range, linearly or log-uniformly: a uniform

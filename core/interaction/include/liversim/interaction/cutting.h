@@ -81,23 +81,21 @@ std::array<Eigen::Vector3d, 2> cutting_edge_m(const Tool& scalpel);
 // The blade's edge in the tissue: each stretch of the edge within an element (its faces pushed
 // out by `margin_m`, so that an edge along faces, as in its own cut, is in; overlaps once), their
 // length, and the force the crack front along them holds back, each stretch times its element's
-// region's toughness: the work per unit advance of the crack (Mahvash & Hayward 2001). Allocates
-// nothing.
+// region's toughness: the work per unit advance of the crack (Mahvash & Hayward 2001); and
+// whether the edge passes through an element or within about `reach_m` of one (its faces pushed
+// out by that much). One walk over the elements; allocates nothing.
 struct EdgeInTissue {
   double length_m = 0.0;
   double resistance_n = 0.0;
+  bool within_reach = false;
 };
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
-                            const std::array<Eigen::Vector3d, 2>& edge_m, double margin_m = 1e-6);
+                            const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m = 0.0,
+                            double margin_m = 1e-6);
 // The length of the scalpel's edge in contact that `blade` (its part's contact) reports: the
 // stretch of its axis that touched the tissue and the blade's thickness (a tip's crack is that
 // wide). Times the toughness, the force at which it breaks in.
 double blade_edge_in_contact_m(const PartContact& blade, const ToolGeometry& geometry);
-
-// Whether the edge (heel, tip) passes through any element of the model in `position`, or within
-// about `reach_m` of one (each element's faces pushed out by that much).
-bool blade_edge_in_tissue(const SimModel& model, const NodeArray& position_m,
-                          const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m = 0.0);
 
 struct CutReport {
   std::size_t elements_swept = 0;           // elements the sweep touches
