@@ -594,6 +594,16 @@ TEST(ScenarioScene, ALiveTissueChangeIsRefusedWholeWhenAParameterIsBad) {
     EXPECT_NE(std::string(e.what()).find("Poisson"), std::string::npos) << e.what();
   }
   EXPECT_EQ(model.stable_time_step_s, step);
+  // A toughness that is no number is refused by the model too, not only by the scenario's reader.
+  std::vector<RegionMaterial> regions = region_materials(s);
+  regions[1].fracture_toughness_j_per_m2 = std::numeric_limits<double>::quiet_NaN();
+  try {
+    set_region_materials(model, regions);
+    FAIL() << "a NaN fracture toughness was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("region 1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fracture toughness"), std::string::npos) << e.what();
+  }
   // The lesion's region needs a material too.
   EXPECT_THROW(set_region_materials(model, {region_materials(s)[0]}), std::invalid_argument);
 }
