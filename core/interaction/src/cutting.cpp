@@ -35,6 +35,8 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
   if (!(settings.snap_min_shape_fraction > 0.0 && settings.snap_min_shape_fraction < 1.0))
     return out_of_range("snap shape fraction", settings.snap_min_shape_fraction,
                         "a value in (0, 1)");
+  if (!(settings.split_min_fraction > 0.0 && settings.split_min_fraction <= 0.5))
+    return out_of_range("split fraction", settings.split_min_fraction, "a value in (0, 0.5]");
   return std::nullopt;
 }
 
@@ -684,6 +686,250 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
 
 namespace {
 
+// Each per-element array of the model (its material, shape and fibres; not the face marks) for the
+// elements of the new model, each from its element `origin[i]` of the old.
+void take_element_data(SimModel& m, const std::vector<TetIndex>& origin) {
+  auto take = [&](auto& per_element) {
+    if (per_element.empty()) return;
+    std::remove_reference_t<decltype(per_element)> kept(origin.size());
+    for (std::size_t i = 0; i < origin.size(); ++i) kept[i] = per_element[origin[i]];
+    per_element = std::move(kept);
+  };
+  for (auto& entry : m.dm_inverse) take(entry);
+  take(m.rest_volume_m3);
+  take(m.shear_modulus_pa);
+  take(m.lame_lambda_pa);
+  take(m.mooney_rivlin_c2_pa);
+  take(m.region);
+  take(m.fibre_parameters);
+  for (auto& family : m.fibre_direction) take(family);
+}
+
+// Dm⁻¹ and rest volume of element i from its corners' rest positions.
+void reshape_element(SimModel& m, std::size_t i) {
+  const Eigen::Vector3d x0 = m.rest_position_m.at(m.corner[0][i]);
+  Eigen::Matrix3d dm;
+  for (int c = 1; c < 4; ++c) dm.col(c - 1) = m.rest_position_m.at(m.corner[c][i]) - x0;
+  const Eigen::Matrix3d inverse = dm.inverse();
+  for (int k = 0; k < 9; ++k) m.dm_inverse[k][i] = inverse(k / 3, k % 3);
+  m.rest_volume_m3[i] = dm.determinant() / 6.0;
+}
+
+// Lumped and inverse masses from the element masses, and the node incidence.
+void lump_masses(SimModel& m) {
+  m.lumped_mass_kg.assign(m.node_count, 0.0);
+  for (std::size_t i = 0; i < m.tet_count; ++i)
+    for (int c = 0; c < 4; ++c) m.lumped_mass_kg[m.corner[c][i]] += m.element_mass_kg[i] / 4.0;
+  m.inverse_mass_per_kg.resize(m.node_count);
+  for (std::size_t n = 0; n < m.node_count; ++n)
+    m.inverse_mass_per_kg[n] =
+        !m.is_fixed[n] && m.lumped_mass_kg[n] > 0.0 ? 1.0 / m.lumped_mass_kg[n] : 0.0;
+  build_node_incidence(m);
+}
+
+// The state on a cut's new model: these positions and velocities, each element's viscous history
+// from its origin, the old clock and step; the energy books open again.
+SimState carried_state(const SimModel& m, const SimState& old, NodeArray position_m,
+                       NodeArray velocity_m_per_s, const std::vector<TetIndex>& element_origin) {
+  SimState next = make_rest_state(m, old.force_scratch.workers);
+  next.position_m = std::move(position_m);
+  next.velocity_m_per_s = std::move(velocity_m_per_s);
+  if (m.effects.viscous)
+    for (std::size_t i = 0; i < m.tet_count; ++i)
+      next.viscous_history.copy_element(old.viscous_history,
+                                        static_cast<std::size_t>(element_origin[i]), i);
+  next.time_s = old.time_s;
+  next.step_count = old.step_count;
+  next.last_step_s = old.last_step_s;
+  next.max_speed_m_per_s = old.max_speed_m_per_s;
+  open_energy_books(m, next);
+  return next;
+}
+
+// A node made on the edge (a, b), a < b, at parameter s along it from a.
+struct EdgeSplit {
+  NodeIndex a = 0, b = 0;
+  double s = 0.0;
+  bool operator<(const EdgeSplit& other) const {
+    return std::tie(a, b) < std::tie(other.a, other.b);
+  }
+};
+
+// The children of an element with corners `parent` bisected on its edges `mine` (indices into
+// `splits`, ascending), one after another; a node made on split k is node old_nodes + k.
+void bisect(const std::array<NodeIndex, 4>& parent, const std::vector<EdgeSplit>& splits,
+            const std::vector<std::ptrdiff_t>& mine, std::size_t old_nodes,
+            std::vector<std::array<NodeIndex, 4>>& children) {
+  children.assign(1, parent);
+  for (const std::ptrdiff_t k : mine) {
+    const NodeIndex a = splits[k].a, b = splits[k].b;
+    const auto made = static_cast<NodeIndex>(old_nodes + static_cast<std::size_t>(k));
+    for (std::size_t i = 0, count = children.size(); i < count; ++i) {
+      const auto at_a = std::find(children[i].begin(), children[i].end(), a) - children[i].begin();
+      const auto at_b = std::find(children[i].begin(), children[i].end(), b) - children[i].begin();
+      if (at_a == 4 || at_b == 4) continue;
+      // The node made replaces one end in each half: both keep the parent's orientation.
+      std::array<NodeIndex, 4> other = children[i];
+      children[i][at_a] = made;
+      other[at_b] = made;
+      children.push_back(other);
+    }
+  }
+}
+
+// The split edges of element e (indices into `splits`, ascending).
+void splits_of(const SimModel& model, std::size_t e, const std::vector<EdgeSplit>& splits,
+               std::vector<std::ptrdiff_t>& mine) {
+  mine.clear();
+  for (const auto& edge : kEdge) {
+    const NodeIndex a = model.corner[edge[0]][e], b = model.corner[edge[1]][e];
+    const EdgeSplit key{std::min(a, b), std::max(a, b), 0.0};
+    const auto it = std::lower_bound(splits.begin(), splits.end(), key);
+    if (it != splits.end() && it->a == key.a && it->b == key.b) mine.push_back(it - splits.begin());
+  }
+  std::sort(mine.begin(), mine.end());
+}
+
+struct Refinement {
+  std::shared_ptr<SimModel> model;
+  SimState state;
+  std::vector<TetIndex> element_origin;
+};
+
+// The model and state with `geometry`'s snapped nodes and a node made on each edge of `splits`
+// (sorted): every element holding split edges is bisected on them one after another, in the order
+// of `splits` in every element, so two elements divide the face they share alike and the mesh
+// stays conforming. A node on an edge is the same material point in each element holding it, and
+// the children of a linear element have its deformation gradient: stress, forces and viscous
+// history are those of the parent, only where a cut can run has changed. The new nodes follow the
+// old ones (node_count of the old model on); each child keeps its parent's share of the mass by
+// its rest volume.
+Refinement split_edges(const SimModel& model, const SimState& state, const Geometry& geometry,
+                       const std::vector<std::uint8_t>& snapped,
+                       const std::vector<EdgeSplit>& splits) {
+  const std::size_t old_nodes = model.node_count, tets = model.tet_count;
+
+  // The children of each element, with the corners of its own each of their nodes lies between
+  // (a bit per corner), to tell which of its faces a child's face lies on.
+  Refinement refined;
+  std::vector<std::array<NodeIndex, 4>> child_corners;
+  std::vector<std::array<std::uint8_t, 4>> child_support;
+  std::vector<std::uint8_t> split_parent(tets, 0);
+  std::vector<std::array<NodeIndex, 4>> work;
+  std::vector<std::ptrdiff_t> mine;
+  for (std::size_t e = 0; e < tets; ++e) {
+    std::array<NodeIndex, 4> parent;
+    for (int c = 0; c < 4; ++c) parent[c] = model.corner[c][e];
+    splits_of(model, e, splits, mine);
+    bisect(parent, splits, mine, old_nodes, work);
+    split_parent[e] = !mine.empty();
+    for (const auto& child : work) {
+      std::array<std::uint8_t, 4> support{};
+      for (int c = 0; c < 4; ++c) {
+        const NodeIndex n = child[c];
+        for (int k = 0; k < 4; ++k) {
+          const bool on_end =
+              n < static_cast<NodeIndex>(old_nodes)
+                  ? parent[k] == n
+                  : parent[k] == splits[n - old_nodes].a || parent[k] == splits[n - old_nodes].b;
+          if (on_end) support[c] |= std::uint8_t(1u << k);
+        }
+      }
+      child_corners.push_back(child);
+      child_support.push_back(support);
+      refined.element_origin.push_back(static_cast<TetIndex>(e));
+    }
+  }
+
+  auto next = std::make_shared<SimModel>(model);
+  SimModel& m = *next;
+  m.node_count = old_nodes + splits.size();
+  m.tet_count = child_corners.size();
+  const std::vector<TetIndex>& origin = refined.element_origin;
+  take_element_data(m, origin);
+  // A child's face on a face of its parent is what that face was (surface, cut); the others are
+  // inside the parent.
+  for (auto* mask : {&m.cut_face_mask, &m.boundary_face_mask}) {
+    if (mask->empty()) continue;
+    std::vector<std::uint8_t> kept(origin.size(), 0);
+    for (std::size_t i = 0; i < origin.size(); ++i)
+      for (int f = 0; f < 4; ++f) {
+        std::uint8_t on = 0;
+        for (int k = 0; k < 3; ++k) on |= child_support[i][kTetFace[f][k]];
+        for (int g = 0; g < 4; ++g)
+          if (on == (0xF & ~(1u << g)) && ((*mask)[origin[i]] >> g & 1u))
+            kept[i] |= std::uint8_t(1u << f);
+      }
+    *mask = std::move(kept);
+  }
+  for (int c = 0; c < 4; ++c) {
+    m.corner[c].resize(m.tet_count);
+    for (std::size_t i = 0; i < m.tet_count; ++i) m.corner[c][i] = child_corners[i][c];
+  }
+  m.rest_position_m.resize(m.node_count);
+  m.is_fixed.resize(m.node_count);
+  NodeArray position, velocity;
+  position.resize(m.node_count);
+  velocity.resize(m.node_count);
+  for (std::size_t n = 0; n < old_nodes; ++n) {
+    m.rest_position_m.set(n, geometry.rest_m.at(n));
+    position.set(n, geometry.position_m.at(n));
+    velocity.set(n, geometry.velocity_m_per_s.at(n));
+  }
+  auto between = [](const NodeArray& x, const EdgeSplit& split) {
+    return Eigen::Vector3d(x.at(split.a) + split.s * (x.at(split.b) - x.at(split.a)));
+  };
+  for (std::size_t k = 0; k < splits.size(); ++k) {
+    const std::size_t n = old_nodes + k;
+    m.rest_position_m.set(n, between(geometry.rest_m, splits[k]));
+    position.set(n, between(geometry.position_m, splits[k]));
+    velocity.set(n, between(geometry.velocity_m_per_s, splits[k]));
+    m.is_fixed[n] = model.is_fixed[splits[k].a] && model.is_fixed[splits[k].b];
+  }
+
+  // Shapes of the children and of the elements a snap moved; masses by rest volume.
+  std::vector<double> parent_volume(tets, 0.0);
+  std::vector<std::uint8_t> reshaped(m.tet_count, 0);
+  for (std::size_t i = 0; i < m.tet_count; ++i) {
+    const std::size_t e = origin[i];
+    bool moved = split_parent[e] != 0;
+    for (int c = 0; c < 4 && !moved; ++c) moved = snapped[model.corner[c][e]] != 0;
+    reshaped[i] = moved;
+    if (!moved) continue;
+    reshape_element(m, i);
+    parent_volume[e] += m.rest_volume_m3[i];
+  }
+  m.element_mass_kg.resize(m.tet_count);
+  for (std::size_t i = 0; i < m.tet_count; ++i) {
+    const std::size_t e = origin[i];
+    m.element_mass_kg[i] =
+        split_parent[e] ? geometry.element_mass_kg[e] * m.rest_volume_m3[i] / parent_volume[e]
+                        : geometry.element_mass_kg[e];
+  }
+  lump_masses(m);
+
+  // The smaller children raise the mesh's frequency around them.
+  std::vector<NodeIndex> around;
+  for (std::size_t i = 0; i < m.tet_count; ++i) {
+    if (!reshaped[i]) continue;
+    std::array<Eigen::Vector3d, 4> p;
+    for (int c = 0; c < 4; ++c) {
+      around.push_back(m.corner[c][i]);
+      p[c] = m.rest_position_m.at(m.corner[c][i]);
+    }
+    m.min_element_height_m = std::min(m.min_element_height_m, shape_of(p).min_height_m);
+  }
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
+  m.max_frequency_rad_per_s =
+      std::max(m.max_frequency_rad_per_s, local_max_frequency_rad_per_s(m, around));
+  m.stable_time_step_s = stable_time_step_s(m, StepInputs{});
+
+  refined.state = carried_state(m, state, std::move(position), std::move(velocity), origin);
+  refined.model = std::move(next);
+  return refined;
+}
+
 // The stretch [t_in, t_out] of the segment heel + t·(tip − heel), t in [0, 1], inside element e
 // with its faces pushed out by `reach_m` (in by −reach_m), by Cyrus–Beck clipping; empty when
 // t_in > t_out.
@@ -759,20 +1005,16 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
   return in;
 }
 
-CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
-                     const CuttingSettings& settings) {
-  if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
-  for (const auto& edge : stroke.edges_m)
-    if (!edge[0].allFinite() || !edge[1].allFinite())
-      throw std::invalid_argument("the blade's stroke is not finite");
+namespace {
 
+// cut_tissue on a sweep. `may_split`: nodes may be made on edges (once: the cut then runs on the
+// model with them); `on_cut`: nodes already on the cut (empty, or a flag per node).
+CutResult cut_along(const SimModel& model, const SimState& state, const SweepSurface& surface,
+                    const CuttingSettings& settings, bool may_split,
+                    const std::vector<std::uint8_t>& on_cut) {
   CutResult result;
   CutReport& report = result.report;
   FaceNeighbours neighbours(model);
-
-  // A blade that did not move sweeps nothing.
-  const SweepSurface surface = sweep_surface(stroke);
-  if (surface.size() == 0) return result;
 
   // 1. The elements the sweep touches, and those of them stressed past the threshold.
   Aabb sweep_box;
@@ -811,6 +1053,10 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     double s;           // along the edge from node to other
     double distance_m;  // the move
   };
+  // Where the edge (a, b) crosses the sweep, as the parameter from a.
+  auto crossing_of = [&](NodeIndex a, NodeIndex b) {
+    return surface.crossing(geometry.position_m.at(a), geometry.position_m.at(b));
+  };
   std::vector<Crossing> crossings;
   std::vector<std::array<NodeIndex, 2>> edges;
   for (std::size_t e : zone)
@@ -822,7 +1068,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   for (const auto& [a, b] : edges) {
-    const auto s = surface.crossing(geometry.position_m.at(a), geometry.position_m.at(b));
+    const auto s = crossing_of(a, b);
     if (!s) continue;
     const double length = (geometry.position_m.at(b) - geometry.position_m.at(a)).norm();
     if (*s <= settings.snap_fraction) crossings.push_back({a, b, *s, *s * length});
@@ -837,8 +1083,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   for (const Crossing& crossing : crossings) {
     if (snapped[crossing.node] || model.is_fixed[crossing.node]) continue;
     // An earlier snap may have moved either end: take the crossing as it is now.
-    const auto s = surface.crossing(geometry.position_m.at(crossing.node),
-                                    geometry.position_m.at(crossing.other));
+    const auto s = crossing_of(crossing.node, crossing.other);
     if (!s || *s > settings.snap_fraction) continue;
     if (try_snap(model, neighbours, geometry, crossing.node, crossing.other, *s,
                  settings.snap_min_shape_fraction)) {
@@ -847,9 +1092,9 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     }
   }
 
-  // Elements around a snapped node now touch the sweep too.
+  // Elements around a snapped node (or one already on the cut) now touch the sweep too.
   for (NodeIndex n = 0; n < static_cast<NodeIndex>(model.node_count); ++n) {
-    if (!snapped[n]) continue;
+    if (!snapped[n] && (on_cut.empty() || !on_cut[n])) continue;
     for_each_element_of(model, n, [&](std::size_t e) {
       if (swept[e]) return;
       swept[e] = 1;
@@ -858,10 +1103,8 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     });
   }
 
-  // 3. Sides. A node on the sweep is on neither; an element lies on the side of its nodes off
-  // the sweep, or, when the sweep still passes through it, on the side of its centroid. An
-  // element the sweep enters but does not pass all the way through (the blade ends inside it)
-  // is not cut: the cut stops at its faces.
+  // Which side of the sweep each node is on: 0 on it, else the side of the nearest triangle's
+  // plane.
   std::vector<std::int8_t> node_label(model.node_count, 2);  // 2: not yet known
   auto label_of = [&](NodeIndex n) {
     if (node_label[n] == 2) {
@@ -873,6 +1116,107 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     }
     return node_label[n];
   };
+
+  // 2b. Where the sweep passes all the way through an element and still crosses an edge of it
+  // away from both ends (no node could be moved there), a node is made on that edge, and the cut
+  // runs on the model with those nodes: its elements then lie each on one side, none goes whole
+  // to the side of its centroid (which left islands of elements joined to nothing on their side).
+  if (may_split) {
+    std::vector<EdgeSplit> splits, crossed;
+    for (std::size_t e : zone) {
+      if (!over_threshold[e]) continue;
+      crossed.clear();
+      bool through = true;
+      for (const auto& edge : kEdge) {
+        const NodeIndex a = model.corner[edge[0]][e], b = model.corner[edge[1]][e];
+        if (label_of(a) * label_of(b) >= 0) continue;
+        const auto s = crossing_of(a, b);
+        if (!s) {
+          through = false;
+          break;
+        }
+        crossed.push_back(a < b ? EdgeSplit{a, b, *s} : EdgeSplit{b, a, 1.0 - *s});
+      }
+      if (!through) continue;
+      for (const EdgeSplit& split : crossed)
+        if (split.s >= settings.split_min_fraction && split.s <= 1.0 - settings.split_min_fraction)
+          splits.push_back(split);
+    }
+    std::sort(splits.begin(), splits.end());
+    splits.erase(std::unique(splits.begin(), splits.end(),
+                             [](const EdgeSplit& l, const EdgeSplit& r) {
+                               return l.a == r.a && l.b == r.b;
+                             }),
+                 splits.end());
+    // No part may be thinner than the smallest element of the mesh (the explicit step would fall)
+    // or than split_min_fraction of its element: the edges of an element that would have one are
+    // not split, until none would.
+    std::vector<std::ptrdiff_t> mine;
+    std::vector<std::array<NodeIndex, 4>> parts;
+    std::vector<std::array<NodeIndex, 2>> refused;
+    for (bool refusing = !splits.empty(); refusing && !splits.empty();) {
+      refusing = false;
+      std::vector<std::size_t> affected;
+      for (const EdgeSplit& split : splits)
+        for_each_element_of(model, split.a, [&](std::size_t e) {
+          if (element_has_node(model, e, split.b)) affected.push_back(e);
+        });
+      std::sort(affected.begin(), affected.end());
+      affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
+      auto rest_at = [&](NodeIndex n) -> Eigen::Vector3d {
+        if (n < static_cast<NodeIndex>(model.node_count)) return geometry.rest_m.at(n);
+        const EdgeSplit& split = splits[n - static_cast<NodeIndex>(model.node_count)];
+        return geometry.rest_m.at(split.a) +
+               split.s * (geometry.rest_m.at(split.b) - geometry.rest_m.at(split.a));
+      };
+      refused.clear();
+      for (std::size_t e : affected) {
+        std::array<NodeIndex, 4> parent;
+        for (int c = 0; c < 4; ++c) parent[c] = model.corner[c][e];
+        const double parent_height_m = shape_of(corners_at(model, geometry.rest_m, e)).min_height_m;
+        splits_of(model, e, splits, mine);
+        bisect(parent, splits, mine, model.node_count, parts);
+        bool thin = false;
+        for (const auto& part : parts) {
+          std::array<Eigen::Vector3d, 4> p;
+          for (int c = 0; c < 4; ++c) p[c] = rest_at(part[c]);
+          const double height_m = shape_of(p).min_height_m;
+          thin |= height_m < settings.split_min_fraction * parent_height_m ||
+                  height_m < model.min_element_height_m;
+        }
+        if (!thin) continue;
+        for (std::ptrdiff_t k : mine) refused.push_back({splits[k].a, splits[k].b});
+      }
+      if (refused.empty()) break;
+      refusing = true;
+      std::sort(refused.begin(), refused.end());
+      std::erase_if(splits, [&](const EdgeSplit& split) {
+        return std::binary_search(refused.begin(), refused.end(),
+                                  std::array<NodeIndex, 2>{split.a, split.b});
+      });
+    }
+    if (!splits.empty()) {
+      const Refinement refined = split_edges(model, state, geometry, snapped, splits);
+      std::vector<std::uint8_t> now_on_cut(refined.model->node_count, 1);
+      for (std::size_t n = 0; n < model.node_count; ++n)
+        now_on_cut[n] = snapped[n] || (!on_cut.empty() && on_cut[n]);
+      CutResult cut =
+          cut_along(*refined.model, refined.state, surface, settings, false, now_on_cut);
+      cut.report.snapped_nodes += report.snapped_nodes;
+      cut.report.nodes_made_on_edges = splits.size();
+      if (!cut.cut()) return cut;
+      // Origins in the model before the nodes were made: a node made is no old node's.
+      for (NodeIndex& n : cut.node_origin)
+        if (n >= static_cast<NodeIndex>(model.node_count)) n = -1;
+      for (TetIndex& e : cut.element_origin) e = refined.element_origin[e];
+      return cut;
+    }
+  }
+
+  // 3. Sides. A node on the sweep is on neither; an element lies on the side of its nodes off
+  // the sweep, or, when the sweep still passes through it, on the side of its centroid. An
+  // element the sweep enters but does not pass all the way through (the blade ends inside it)
+  // is not cut: the cut stops at its faces.
   std::vector<std::int8_t> element_side(tets, 0);
   std::vector<std::uint8_t> cut_through(tets, 0);
   for (std::size_t e : zone) {
@@ -887,9 +1231,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     if (plus && minus)
       for (const auto& edge : kEdge) {
         const NodeIndex a = model.corner[edge[0]][e], b = model.corner[edge[1]][e];
-        if (label_of(a) * label_of(b) < 0)
-          through &=
-              surface.crossing(geometry.position_m.at(a), geometry.position_m.at(b)).has_value();
+        if (label_of(a) * label_of(b) < 0) through &= crossing_of(a, b).has_value();
       }
     cut_through[e] = through;
     element_side[e] =
@@ -1194,14 +1536,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     for (std::size_t i = 0; i < element_origin.size(); ++i)
       m.corner[c][i] = new_index[corner[c][element_origin[i]]];
   }
-  for (auto& entry : m.dm_inverse) take(entry);
-  take(m.rest_volume_m3);
-  take(m.shear_modulus_pa);
-  take(m.lame_lambda_pa);
-  take(m.mooney_rivlin_c2_pa);
-  take(m.region);
-  take(m.fibre_parameters);
-  for (auto& family : m.fibre_direction) take(family);
+  take_element_data(m, element_origin);
   if (m.cut_face_mask.empty()) m.cut_face_mask.assign(tets, 0);
   take(m.cut_face_mask);
   if (m.boundary_face_mask.empty()) {  // the first cut: the organ's surface
@@ -1225,15 +1560,15 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   }
 
   // Elements whose corners moved get their shape data again; the cut faces are marked.
-  std::vector<std::uint8_t> reshaped(m.tet_count, 0), on_cut(model.node_count, 0);
-  for (NodeIndex n : touched) on_cut[n] = 1;
+  std::vector<std::uint8_t> reshaped(m.tet_count, 0), touched_by_cut(model.node_count, 0);
+  for (NodeIndex n : touched) touched_by_cut[n] = 1;
   for (std::size_t i = 0; i < m.tet_count; ++i) {
     const std::size_t old = element_origin[i];
     bool moved = false;
     int corners_on_cut = 0;
     for (int c = 0; c < 4; ++c) {
       moved |= snapped[model.corner[c][old]] != 0;
-      corners_on_cut += on_cut[model.corner[c][old]];
+      corners_on_cut += touched_by_cut[model.corner[c][old]];
     }
     if (corners_on_cut >= 3)
       for (int f = 0; f < 4; ++f)
@@ -1245,21 +1580,9 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     m.boundary_face_mask[i] |= exposed[old];
     reshaped[i] = moved;
     if (!moved) continue;
-    const Eigen::Vector3d x0 = m.rest_position_m.at(m.corner[0][i]);
-    Eigen::Matrix3d dm;
-    for (int c = 1; c < 4; ++c) dm.col(c - 1) = m.rest_position_m.at(m.corner[c][i]) - x0;
-    const Eigen::Matrix3d inverse = dm.inverse();
-    for (int k = 0; k < 9; ++k) m.dm_inverse[k][i] = inverse(k / 3, k % 3);
-    m.rest_volume_m3[i] = dm.determinant() / 6.0;
+    reshape_element(m, i);
   }
-  m.lumped_mass_kg.assign(m.node_count, 0.0);
-  for (std::size_t i = 0; i < m.tet_count; ++i)
-    for (int c = 0; c < 4; ++c) m.lumped_mass_kg[m.corner[c][i]] += m.element_mass_kg[i] / 4.0;
-  m.inverse_mass_per_kg.resize(m.node_count);
-  for (std::size_t n = 0; n < m.node_count; ++n)
-    m.inverse_mass_per_kg[n] =
-        !m.is_fixed[n] && m.lumped_mass_kg[n] > 0.0 ? 1.0 / m.lumped_mass_kg[n] : 0.0;
-  build_node_incidence(m);
+  lump_masses(m);
 
   // The stable step: the mesh's largest frequency is the old one or one of the modes around the
   // cut (see local_max_frequency_rad_per_s); the smallest height may only shrink.
@@ -1270,7 +1593,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   // reshaped.
   std::vector<NodeIndex> around_cut;
   for (std::size_t n = 0; n < m.node_count; ++n)
-    if (on_cut[origin[n]]) around_cut.push_back(static_cast<NodeIndex>(n));
+    if (touched_by_cut[origin[n]]) around_cut.push_back(static_cast<NodeIndex>(n));
   for (std::size_t i = 0; i < m.tet_count; ++i) {
     if (!reshaped[i]) continue;
     std::array<Eigen::Vector3d, 4> p;
@@ -1286,26 +1609,29 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
 
   // 8. The state carried over: positions and velocities of each node's origin, the history of
   // each element; the energy books open again on the new model.
-  SimState next_state = make_rest_state(m, state.force_scratch.workers);
-  for (std::size_t n = 0; n < m.node_count; ++n) {
-    next_state.position_m.set(n, position.at(n));
-    next_state.velocity_m_per_s.set(n, geometry.velocity_m_per_s.at(origin[n]));
-  }
-  if (m.effects.viscous)
-    for (std::size_t i = 0; i < m.tet_count; ++i)
-      next_state.viscous_history.copy_element(state.viscous_history,
-                                              static_cast<std::size_t>(element_origin[i]), i);
-  next_state.time_s = state.time_s;
-  next_state.step_count = state.step_count;
-  next_state.last_step_s = state.last_step_s;
-  next_state.max_speed_m_per_s = state.max_speed_m_per_s;
-  open_energy_books(m, next_state);
-
+  NodeArray velocity;
+  velocity.resize(m.node_count);
+  for (std::size_t n = 0; n < m.node_count; ++n)
+    velocity.set(n, geometry.velocity_m_per_s.at(origin[n]));
+  result.state = carried_state(m, state, std::move(position), std::move(velocity), element_origin);
   result.model = std::move(next);
-  result.state = std::move(next_state);
   result.node_origin = std::move(origin);
   result.element_origin = std::move(element_origin);
   return result;
+}
+
+}  // namespace
+
+CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
+                     const CuttingSettings& settings) {
+  if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
+  for (const auto& edge : stroke.edges_m)
+    if (!edge[0].allFinite() || !edge[1].allFinite())
+      throw std::invalid_argument("the blade's stroke is not finite");
+  // A blade that did not move sweeps nothing.
+  const SweepSurface surface = sweep_surface(stroke);
+  if (surface.size() == 0) return {};
+  return cut_along(model, state, surface, settings, true, {});
 }
 
 }  // namespace liversim

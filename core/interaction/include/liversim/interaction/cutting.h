@@ -8,13 +8,16 @@
 // Stappen 2001): the nearer node of each edge the surface crosses is moved onto the surface when
 // every element it belongs to keeps its shape (and a node of the organ's surface moves only along
 // it); the faces the surface then runs along are separated, and each node on them gets one copy
-// per side. Where a node cannot be moved, the elements the surface still passes through go whole
-// to the side of their centroid. A node whose parted surroundings would not be one manifold fan
+// per side. A snap shares the mass of the elements around the node by their new volumes, so no mass
+// is lost. Where no node can be moved (a node of the surface off it, a neighbour that would
+// flatten), a node is made where the surface crosses the edge, away from both ends, and the
+// elements holding the edge are bisected on it (Mor & Kanade 2000 subdivide the elements a blade
+// passes through likewise): a linear element's parts have its deformation gradient, so they carry
+// its region, fibres, stress and viscous history exactly, and no part may be thinner than the
+// mesh's smallest element. Only where neither works does an element the surface passes through go
+// whole to the side of its centroid. A node whose parted surroundings would not be one manifold fan
 // keeps its faces joined (a small bridge the next stroke cuts), so the surface stays manifold.
-// No element is made or split, so the region, fibres and viscous history of every element carry
-// over and none can be a sliver; a snap shares the mass of the elements around the node by their
-// new volumes, so no mass is lost. Pieces that come free are taken out and their volume counted
-// as resected.
+// Pieces that come free are taken out and their volume counted as resected.
 //
 // The model stays constant between cuts: a cut makes a new model and state from the old ones.
 
@@ -53,6 +56,10 @@ struct CuttingSettings {
   // `snap_min_shape_fraction` of its smallest height and of its volume, at rest and deformed.
   double snap_fraction = 0.5;
   double snap_min_shape_fraction = 0.25;
+  // Where no node could be moved, a node is made on an edge the cut crosses at least this fraction
+  // of its length from either end (nearer, the element is left whole: a child that thin would set
+  // the explicit step).
+  double split_min_fraction = 0.25;
 };
 
 // The problem with the settings, if any (a message naming the setting, its value and what is
@@ -101,6 +108,7 @@ struct CutReport {
   std::size_t elements_swept = 0;           // elements the sweep touches
   std::size_t elements_over_threshold = 0;  // of those, stressed past the cutting threshold
   std::size_t snapped_nodes = 0;
+  std::size_t nodes_made_on_edges = 0;  // where no node could be moved (elements split on them)
   std::size_t separated_faces = 0;
   std::size_t duplicated_nodes = 0;  // node copies made
   std::size_t removed_elements = 0;  // in pieces that came free
@@ -117,7 +125,8 @@ struct CutResult {
   // Null when the sweep separated nothing (the old model and state stand).
   std::shared_ptr<const SimModel> model;
   SimState state;
-  // For each node and element of the new model, the one of the old model it came from.
+  // For each node and element of the new model, the one of the old model it came from (an
+  // element split: each part; a node made on an edge: -1).
   std::vector<NodeIndex> node_origin;
   std::vector<TetIndex> element_origin;
   CutReport report;
