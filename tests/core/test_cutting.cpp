@@ -709,3 +709,63 @@ TEST(Cutting, WhereNoNodeCanBeMovedOntoTheCutAnElementIsSplitAndNoneIsLost) {
 
 }  // namespace
 }  // namespace liversim
+
+namespace liversim {
+namespace {
+
+// A cut deepened stroke after stroke in its own groove (issue 42, item 3): a stroke 15 mm deep,
+// then one down to 25 mm in the same plane, cut what one stroke 25 mm deep cuts. The plane is
+// 0.2 of a cube off a grid plane, so the nodes snap onto it and the cut is exact: its area is
+// both lips, 5 cm wide, from the top down to the last row of nodes the blade passed (z = 0.02).
+TEST(Cutting, ACutDeepenedInItsOwnGrooveCutsWhatOneDeepStrokeCuts) {
+  const SimModel model = block_model();
+  const double x = 0.032;
+  const CutResult first =
+      cut_tissue(model, make_rest_state(model), vertical_cut(x, 0.025), cut_anything());
+  ASSERT_TRUE(first.cut());
+  EXPECT_NEAR(cut_area_m2(*first.model), 2 * 0.05 * 0.01, 1e-12);  // down to z = 0.03
+  const CutResult again =
+      cut_tissue(*first.model, first.state, vertical_cut(x, 0.015), cut_anything());
+  ASSERT_TRUE(again.cut()) << "the deeper stroke cut nothing more";
+  const CutResult once =
+      cut_tissue(model, make_rest_state(model), vertical_cut(x, 0.015), cut_anything());
+  ASSERT_TRUE(once.cut());
+  EXPECT_NEAR(cut_area_m2(*again.model), 2 * 0.05 * 0.02, 1e-12);
+  EXPECT_NEAR(cut_area_m2(*again.model), cut_area_m2(*once.model), 1e-12);
+  EXPECT_EQ(again.model->node_count, once.model->node_count);
+  EXPECT_EQ(piece_count(*again.model), 1u);
+  EXPECT_TRUE(boundary_is_manifold(*again.model));
+  EXPECT_TRUE(elements_are_sound(*again.model, again.state));
+}
+
+// A blade under the surface cuts (issue 42, item 3): a sweep wholly inside the block, 4 cm across
+// and 3 cm tall, its edges inside cubes, opens a crack inside it. The nodes of the grid plane
+// x = 0.03 it crosses (y = 0.01 … 0.04, z = 0.01 … 0.03) snap onto it; the two off the crack's
+// front (z = 0.02, y = 0.02 and 0.03) get a copy each. Nothing comes free, and the organ's
+// surface is untouched.
+TEST(Cutting, ABladeUnderTheSurfaceOpensACrackInside) {
+  const SimModel model = block_model();
+  const double x = 0.032;
+  const CutResult cut =
+      cut_tissue(model, make_rest_state(model),
+                 sweep_of({x, 0.005, 0.035}, {x, 0.005, 0.005}, {0.0, 0.04, 0.0}), cut_anything());
+  ASSERT_TRUE(cut.cut()) << "a sweep under the surface cut nothing";
+  const SimModel& after = *cut.model;
+  EXPECT_EQ(cut.report.removed_elements, 0u);
+  EXPECT_EQ(piece_count(after), 1u);
+  EXPECT_EQ(cut.report.duplicated_nodes, 2u);
+  for (const auto& face : cut_faces_at_rest(after))
+    for (const Eigen::Vector3d& p : face) {
+      EXPECT_NEAR(p.x(), x, 1e-12);
+      EXPECT_GT(p.z(), 0.005);
+      EXPECT_LT(p.z(), 0.04 - 1e-9) << "the crack reached the top";
+    }
+  EXPECT_TRUE(boundary_is_manifold(after));
+  EXPECT_TRUE(elements_are_sound(after, cut.state));
+  // Both lips, within the patch of snapped nodes (3 × 2 cm).
+  EXPECT_GT(cut_area_m2(after), 0.0);
+  EXPECT_LE(cut_area_m2(after), 2 * 0.03 * 0.02 + 1e-12);
+}
+
+}  // namespace
+}  // namespace liversim
