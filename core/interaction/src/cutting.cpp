@@ -728,9 +728,11 @@ void lump_masses(SimModel& m) {
 }
 
 // The state on a cut's new model: these positions and velocities, each element's viscous history
-// from its origin, the old clock and step; the energy books open again.
+// from its origin, the old clock and step; the energy books open again when `open_books` (a whole
+// pass over the elements: not for the model a cut only runs on).
 SimState carried_state(const SimModel& m, const SimState& old, NodeArray position_m,
-                       NodeArray velocity_m_per_s, const std::vector<TetIndex>& element_origin) {
+                       NodeArray velocity_m_per_s, const std::vector<TetIndex>& element_origin,
+                       bool open_books) {
   SimState next = make_rest_state(m, old.force_scratch.workers);
   next.position_m = std::move(position_m);
   next.velocity_m_per_s = std::move(velocity_m_per_s);
@@ -742,7 +744,7 @@ SimState carried_state(const SimModel& m, const SimState& old, NodeArray positio
   next.step_count = old.step_count;
   next.last_step_s = old.last_step_s;
   next.max_speed_m_per_s = old.max_speed_m_per_s;
-  open_energy_books(m, next);
+  if (open_books) open_energy_books(m, next);
   return next;
 }
 
@@ -794,6 +796,9 @@ struct Refinement {
   std::shared_ptr<SimModel> model;
   SimState state;
   std::vector<TetIndex> element_origin;
+  // Per node: a corner of a split element's part or of an element a snap moved, around which the
+  // mesh's frequency may have risen (its estimate is left to the cut that runs on this model).
+  std::vector<std::uint8_t> reshaped_around;
 };
 
 // The model and state with `geometry`'s snapped nodes and a node made on each edge of `splits`
@@ -908,24 +913,20 @@ Refinement split_edges(const SimModel& model, const SimState& state, const Geome
   }
   lump_masses(m);
 
-  // The smaller children raise the mesh's frequency around them.
-  std::vector<NodeIndex> around;
+  // The smaller parts raise the mesh's frequency around them: the cut that runs on this model
+  // estimates it with its own (one estimate, and none when it parts nothing).
+  refined.reshaped_around.assign(m.node_count, 0);
   for (std::size_t i = 0; i < m.tet_count; ++i) {
     if (!reshaped[i]) continue;
     std::array<Eigen::Vector3d, 4> p;
     for (int c = 0; c < 4; ++c) {
-      around.push_back(m.corner[c][i]);
+      refined.reshaped_around[m.corner[c][i]] = 1;
       p[c] = m.rest_position_m.at(m.corner[c][i]);
     }
     m.min_element_height_m = std::min(m.min_element_height_m, shape_of(p).min_height_m);
   }
-  std::sort(around.begin(), around.end());
-  around.erase(std::unique(around.begin(), around.end()), around.end());
-  m.max_frequency_rad_per_s =
-      std::max(m.max_frequency_rad_per_s, local_max_frequency_rad_per_s(m, around));
-  m.stable_time_step_s = stable_time_step_s(m, StepInputs{});
 
-  refined.state = carried_state(m, state, std::move(position), std::move(velocity), origin);
+  refined.state = carried_state(m, state, std::move(position), std::move(velocity), origin, false);
   refined.model = std::move(next);
   return refined;
 }
@@ -1007,11 +1008,20 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
 
 namespace {
 
-// cut_tissue on a sweep. `may_split`: nodes may be made on edges (once: the cut then runs on the
-// model with them); `on_cut`: nodes already on the cut (empty, or a flag per node).
+// What a cut on the model with the nodes made on edges knows from the cut before them.
+struct AfterSplitting {
+  std::vector<std::uint8_t> on_cut;           // per node: moved or made onto the sweep
+  std::vector<std::uint8_t> may_touch;        // per element: part of one the sweep touched
+  std::vector<std::uint8_t> reshaped_around;  // per node: Refinement's
+};
+
+// cut_tissue on a sweep. Without `after` nodes may be made on edges, and the cut then runs again
+// on the model with them, given what this one found.
 CutResult cut_along(const SimModel& model, const SimState& state, const SweepSurface& surface,
-                    const CuttingSettings& settings, bool may_split,
-                    const std::vector<std::uint8_t>& on_cut) {
+                    const CuttingSettings& settings, const AfterSplitting* after) {
+  const bool may_split = after == nullptr;
+  static const std::vector<std::uint8_t> kNone;
+  const std::vector<std::uint8_t>& on_cut = after ? after->on_cut : kNone;
   CutResult result;
   CutReport& report = result.report;
   FaceNeighbours neighbours(model);
@@ -1027,6 +1037,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
            element_cutting_stress_pa(model, state, e) >= settings.cutting_stress_pa;
   };
   for (std::size_t e = 0; e < tets; ++e) {
+    if (after && !after->may_touch[e]) continue;
     const auto p = corners_at(model, state.position_m, e);
     Aabb box;
     for (const auto& q : p) box.grow(q);
@@ -1197,11 +1208,16 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
     }
     if (!splits.empty()) {
       const Refinement refined = split_edges(model, state, geometry, snapped, splits);
-      std::vector<std::uint8_t> now_on_cut(refined.model->node_count, 1);
-      for (std::size_t n = 0; n < model.node_count; ++n)
-        now_on_cut[n] = snapped[n] || (!on_cut.empty() && on_cut[n]);
-      CutResult cut =
-          cut_along(*refined.model, refined.state, surface, settings, false, now_on_cut);
+      // The parts of elements the sweep did not touch do not touch it either (an edge it crosses
+      // is in every element holding it, all touched).
+      AfterSplitting known;
+      known.on_cut.assign(refined.model->node_count, 1);
+      for (std::size_t n = 0; n < model.node_count; ++n) known.on_cut[n] = snapped[n];
+      known.reshaped_around = refined.reshaped_around;
+      known.may_touch.resize(refined.model->tet_count);
+      for (std::size_t i = 0; i < known.may_touch.size(); ++i)
+        known.may_touch[i] = swept[refined.element_origin[i]];
+      CutResult cut = cut_along(*refined.model, refined.state, surface, settings, &known);
       cut.report.snapped_nodes += report.snapped_nodes;
       cut.report.nodes_made_on_edges = splits.size();
       if (!cut.cut()) return cut;
@@ -1593,7 +1609,8 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   // reshaped.
   std::vector<NodeIndex> around_cut;
   for (std::size_t n = 0; n < m.node_count; ++n)
-    if (touched_by_cut[origin[n]]) around_cut.push_back(static_cast<NodeIndex>(n));
+    if (touched_by_cut[origin[n]] || (after && after->reshaped_around[origin[n]]))
+      around_cut.push_back(static_cast<NodeIndex>(n));
   for (std::size_t i = 0; i < m.tet_count; ++i) {
     if (!reshaped[i]) continue;
     std::array<Eigen::Vector3d, 4> p;
@@ -1613,7 +1630,8 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   velocity.resize(m.node_count);
   for (std::size_t n = 0; n < m.node_count; ++n)
     velocity.set(n, geometry.velocity_m_per_s.at(origin[n]));
-  result.state = carried_state(m, state, std::move(position), std::move(velocity), element_origin);
+  result.state =
+      carried_state(m, state, std::move(position), std::move(velocity), element_origin, true);
   result.model = std::move(next);
   result.node_origin = std::move(origin);
   result.element_origin = std::move(element_origin);
@@ -1631,7 +1649,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   // A blade that did not move sweeps nothing.
   const SweepSurface surface = sweep_surface(stroke);
   if (surface.size() == 0) return {};
-  return cut_along(model, state, surface, settings, true, {});
+  return cut_along(model, state, surface, settings, nullptr);
 }
 
 }  // namespace liversim
