@@ -266,8 +266,11 @@ void SessionReplayWindow::tick() {
   QElapsedTimer budget;
   budget.start();
   bool arrived = false;
+  // The end is the last cycle's own time: t0 + (end − t0) can fall an ulp short of it, and the
+  // last cycle would then not be taken (the replay stopped a cycle short, now and then).
+  const double target_s = targetS_ >= durationS() ? replay_->end_s() : t0_s_ + targetS_;
   do {
-    arrived = replay_->advance_to(t0_s_ + targetS_, kCyclesPerCall);
+    arrived = replay_->advance_to(target_s, kCyclesPerCall);
   } while (!arrived && budget.elapsed() < kTickBudgetMs);
   if (arrived) seekPending_ = false;
   // Playing slower than the session ran, the replay shows every cycle rather than skipping on.
