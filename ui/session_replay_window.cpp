@@ -165,8 +165,8 @@ SessionReplayWindow::SessionReplayWindow(SessionStore* openStore, const QString&
       std::shared_ptr<SessionReplay> replay;
       QString error;
       try {
-        replay =
-            std::make_shared<SessionReplay>(replay_scene(setup, scenario_text), std::move(inputs));
+        replay = std::make_shared<SessionReplay>(replay_scene(setup, scenario_text),
+                                                 std::move(inputs), setup.loop_step_s);
       } catch (const std::exception& e) {
         error = QString::fromUtf8(e.what());
       }

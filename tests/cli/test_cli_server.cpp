@@ -3,6 +3,7 @@
 // an instructor lists and exports them from the server and publishes a scenario that workstations
 // pull; a bad URL, a wrong password, a server that is down or not set up each fail with the reason
 // and the server named. Passwords go in on standard input, as a script would give them.
+#include "liversim/storage/postgres_session_store.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "recorded_session.h"
 #include "storage_test_support.h"
@@ -101,7 +102,10 @@ class CliServer : public ::testing::Test {
         std::string(ThrowawayPostgres::kAdministratorPassword) + "\n";
     CliRun r = run_cli(folder_, {"server", "set-up", "--server", admin}, admin_password);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_NE(r.out.find("LiverSim schema version 2"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("LiverSim schema version " +
+                         std::to_string(PostgresSessionStore::kSchemaVersion)),
+              std::string::npos)
+        << r.out;
     r = run_cli(folder_, {"server", "add-login", "--server", admin, "ws01", "--workstation"},
                 admin_password + kWorkstationPassword + "\n");
     ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -167,6 +167,34 @@ INSTANTIATE_TEST_SUITE_P(
                       StrokeCase{"wedge-resection-peripheral-tumour.json", 0.045, 0.02, true}),
     case_name);
 
+// A cutting scalpel costs one force evaluation per loop step. Once in, it pushes nothing, and the
+// step's limit is the mesh's, give or take a little stiffening; with the loop's step at that limit
+// a dip of a fraction of a per cent split each step in two, twice the work while it cut (2 per
+// loop step in this stroke). The loop's step sits under it (kLoopStepFraction). The stroke of
+// Strokes/ScalpelInTheLoopTest, 16 mm deep at 2 cm/s, on free practice's liver.
+TEST(LoopStep, ACuttingScalpelTakesOneForceEvaluationPerLoopStep) {
+  const SceneSetup scene = default_scene(kShippedTets);
+  const auto model = std::make_shared<const SimModel>(build_model(scene.mesh, scene.model_options));
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(scene.mesh));
+  simulation.enable_cutting();
+  const double step_s = realtime_step_s(*model);
+  const int steps = std::max(1, static_cast<int>(std::lround(kCycleS / step_s)));
+  const std::vector<SimulationInput> inputs = stroke(*model, step_s, 0.016, 0.02, false);
+  long loop_steps = 0, evaluations = 0;
+  simulation.replay(inputs, [&](const StepReport& report, bool) {
+    simulation.update_snapshot();
+    if (!simulation.snapshot().blade_cutting) return;
+    loop_steps += steps;
+    evaluations += report.force_evaluations;
+  });
+  std::cout << "while the scalpel cut: " << evaluations << " force evaluations over " << loop_steps
+            << " loop steps of " << step_s * 1e3 << " ms\n";
+  ASSERT_GT(loop_steps, 1000) << "the scalpel hardly cut";
+  // A few steps around the break-in and the cuts, where the stiffening rises, may still split.
+  EXPECT_LE(evaluations, loop_steps + loop_steps / 20);
+}
+
 // A blade you feel (issue 42, item 4): drawn straight through a block, a cutting blade is held back
 // by the toughness times its edge in the tissue, against its motion. The block (6 × 5 × 4 cm,
 // fixed at its base) is two layers: the top centimetre of toughness 400 J/m², the rest 200 J/m²

@@ -253,7 +253,7 @@ TEST_F(SessionReplayTest, TheRunCutTheLiverAndEveryCycleIsOnTheServoClock) {
 }
 
 TEST_F(SessionReplayTest, ReplayedToTheEndItIsTheRunToTheLastBit) {
-  SessionReplay replay(*scene_, *log_);
+  SessionReplay replay(*scene_, *log_, live_->step_s());
   EXPECT_EQ(replay.time_s(), replay.begin_s());
   EXPECT_TRUE(replay.advance_to(replay.end_s()));
   EXPECT_TRUE(replay.at_end());
@@ -262,7 +262,7 @@ TEST_F(SessionReplayTest, ReplayedToTheEndItIsTheRunToTheLastBit) {
 }
 
 TEST_F(SessionReplayTest, ReplayedAFewCyclesAtATimeItArrivesAtTheSameState) {
-  SessionReplay replay(*scene_, *log_);
+  SessionReplay replay(*scene_, *log_, live_->step_s());
   int calls = 0;
   double last = replay.time_s();
   while (!replay.advance_to(replay.end_s(), 3)) {
@@ -276,7 +276,7 @@ TEST_F(SessionReplayTest, ReplayedAFewCyclesAtATimeItArrivesAtTheSameState) {
 }
 
 TEST_F(SessionReplayTest, ASeekBackStartsFromRestAndASeekOnGoesOnFromThere) {
-  SessionReplay replay(*scene_, *log_);
+  SessionReplay replay(*scene_, *log_, live_->step_s());
   const double middle = 0.5 * (replay.begin_s() + replay.end_s());
   replay.advance_to(middle);
   EXPECT_LE(replay.time_s(), middle);
@@ -301,7 +301,7 @@ TEST_F(SessionReplayTest, ALogOfAnotherModelOrWithoutTimedCyclesIsRefused) {
   far.kind = SimulationInput::Kind::springs;
   far.springs.push_back({static_cast<NodeIndex>(scene_->mesh.node_count() + 5), {0, 0, 0}, 1.0});
   const SimulationInput cycle{SimulationInput::Kind::cycle, std::nullopt, {}, 1, false, 1.0};
-  SessionReplay replay(*scene_, {far, cycle});
+  SessionReplay replay(*scene_, {far, cycle}, live_->step_s());
   try {
     replay.advance_to(2.0);
     ADD_FAILURE() << "a spring on a node the model does not have was taken";
@@ -311,7 +311,7 @@ TEST_F(SessionReplayTest, ALogOfAnotherModelOrWithoutTimedCyclesIsRefused) {
         << e.what();
   }
   const SimulationInput untimed{SimulationInput::Kind::cycle, std::nullopt, {}, 1, false};
-  EXPECT_THROW(SessionReplay(*scene_, {untimed}), std::invalid_argument);
+  EXPECT_THROW(SessionReplay(*scene_, {untimed}, live_->step_s()), std::invalid_argument);
 }
 
 TEST(SessionReplayScene, FreePracticeIsTheBuiltInLiverAtItsCountWithTheSessionsIntegrator) {

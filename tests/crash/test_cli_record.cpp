@@ -102,8 +102,11 @@ TEST(CliRecord, RecordsACompleteSessionWithEveryServoFrameItsInputLogAndItsMetri
   const std::optional<ReplaySetup> replay_setup = store.replay_setup(session.id);
   ASSERT_TRUE(replay_setup.has_value());
   EXPECT_EQ(replay_setup->built_in_liver_tets, 1000);
+  // Its loop's step is kept with it, a cycle being a count of those steps.
+  ASSERT_TRUE(replay_setup->loop_step_s.has_value());
   SessionReplay replay(replay_scene(*replay_setup, store.scenario_text(session.id)),
-                       store.inputs(session.id));
+                       store.inputs(session.id), replay_setup->loop_step_s);
+  EXPECT_EQ(replay.simulation().step_s(), *replay_setup->loop_step_s);
   EXPECT_TRUE(replay.advance_to(replay.end_s()));
   EXPECT_GE(replay.end_s() - replay.begin_s(), kDurationS - 0.1) << "the whole session replays";
   const std::vector<SessionEvent> events = store.events(session.id);

@@ -254,11 +254,12 @@ int user_version(const fs::path& file) {
 }
 
 // A file of every earlier version, written by that version's code (the writer child, then a
-// metric, an event and a grade added in SQL; the v2 file's mapping too): everything in it survives
+// metric, an event and a grade added in SQL; the mapping of the v2 file and after too): everything
+// in it survives
 // the migration to the current version, and a session added after has everything the current
 // version stores.
 TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
-  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 5) << "add a file of the version before";
+  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 6) << "add a file of the version before";
   struct Earlier {
     int version;
     double peak_force_n;
@@ -269,7 +270,8 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
   for (const Earlier& earlier : {Earlier{1, 0.75, "probe", "v1 grade", std::nullopt},
                                  Earlier{2, 0.5, "scalpel", "v2 grade", 2.0},
                                  Earlier{3, 0.25, "forceps", "v3 grade", 3.0, 201},
-                                 Earlier{4, 0.125, "scalpel", "v4 grade", 4.0}}) {
+                                 Earlier{4, 0.125, "scalpel", "v4 grade", 4.0},
+                                 Earlier{5, 0.0625, "probe", "v5 grade", 5.0}}) {
     const std::string name = "sessions-v" + std::to_string(earlier.version) + ".sqlite";
     SCOPED_TRACE(name);
     const fs::path file = fresh_database("migrated-from-v" + std::to_string(earlier.version));
@@ -288,6 +290,7 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     replay.built_in_liver_tets = 2500;
     replay.integrator.kind = IntegratorKind::dopri5;
     replay.integrator.tolerance_m = 2e-7;
+    replay.loop_step_s = 6.75e-4;
     const SimulationInput cycle{SimulationInput::Kind::cycle, std::nullopt, {}, 3, true, 0.25};
     std::int64_t added = 0;
     {
@@ -340,6 +343,7 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     EXPECT_EQ(read->built_in_liver_tets, 2500);
     EXPECT_EQ(read->integrator.kind, IntegratorKind::dopri5);
     EXPECT_EQ(read->integrator.tolerance_m, 2e-7);
+    EXPECT_EQ(read->loop_step_s, 6.75e-4);
     ASSERT_EQ(store.inputs(added).size(), 1u);
     EXPECT_EQ(store.inputs(added)[0].servo_time_s, 0.25);
   }
@@ -359,11 +363,13 @@ struct ReplayedEnd {
 ReplayedEnd replay_to_the_end(const fs::path& recorded, const std::string& name) {
   const fs::path file = fresh_database(name);
   fs::copy_file(recorded, file);
+  { SqliteSessionStore migrated(file); }  // a file of an earlier version: migrated first
   SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
   const std::optional<ReplaySetup> setup = store.replay_setup(1);
   EXPECT_TRUE(setup);
   if (!setup) return {};
-  SessionReplay replay(replay_scene(*setup, store.scenario_text(1)), store.inputs(1));
+  SessionReplay replay(replay_scene(*setup, store.scenario_text(1)), store.inputs(1),
+                       setup->loop_step_s);
   EXPECT_TRUE(replay.advance_to(std::numeric_limits<double>::infinity()));
   const SimState& state = replay.simulation().state();
   ReplayedEnd end{state.position_m.size(), state.step_count, state.time_s};
@@ -382,6 +388,19 @@ ReplayedEnd replay_to_the_end(const fs::path& recorded, const std::string& name)
     fold(array->z);
   }
   return end;
+}
+
+// Why this build cannot reproduce a recorded digest, if it cannot: bit for bit holds for the build
+// the digests were taken with, GCC's optimised build with the AVX2+FMA element kernels.
+std::optional<std::string> other_build_than_the_digests() {
+#if !defined(__GNUC__) || defined(__clang__) || !defined(__OPTIMIZE__) || \
+    defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  return "the digest is of GCC's optimised build without sanitizers";
+#endif
+  if (element_kernel_instruction_set() != "avx2+fma")
+    return std::string("the digest is of the AVX2+FMA element kernels; these are ") +
+           std::string(element_kernel_instruction_set());
+  return std::nullopt;
 }
 
 // A session recorded by `liversim-cli record` before the station existed (commit 0c1087a: 2.5 s
@@ -403,19 +422,15 @@ TEST(SessionReplay, ASessionRecordedBeforeTheStationStillReplaysToItsEndWithItsC
 // it): `liversim-cli record --tets 1500 --tool scalpel --duration 2.6 --trajectory
 // tests/data/trajectories/free-practice-three-strokes.txt`, two cuts
 // (tests/data/storage/session-v5-scalpel-cuts-whole-tool.sqlite). Replayed by today's engine, its
-// final positions and velocities are those its replay gave when it was recorded, to the last bit.
+// final positions and velocities are those its replay gave when it was recorded, to the last bit:
+// recorded before the loop's step was kept with a session, it replays with the step its loop took
+// then (legacy_loop_step_s).
 // Bit for bit holds for one build of the engine, the one the digest was taken with: GCC's
 // optimised build with the AVX2+FMA element kernels. Other builds skip. A deliberate change of the
 // engine's numerics fails it: old sessions then no longer replay as recorded, which is for that
 // change to say (and to record a new file and digest).
 TEST(SessionReplay, ARecordedSessionReplaysToTheSameStateBitForBit) {
-#if !defined(__GNUC__) || defined(__clang__) || !defined(__OPTIMIZE__) || \
-    defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "the digest is of GCC's optimised build without sanitizers";
-#endif
-  if (element_kernel_instruction_set() != "avx2+fma")
-    GTEST_SKIP() << "the digest is of the AVX2+FMA element kernels; these are "
-                 << element_kernel_instruction_set();
+  if (const auto why = other_build_than_the_digests()) GTEST_SKIP() << *why;
   const ReplayedEnd end = replay_to_the_end(
       fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cuts-whole-tool.sqlite",
       "recorded-cutting-with-the-whole-tool");
@@ -424,6 +439,24 @@ TEST(SessionReplay, ARecordedSessionReplaysToTheSameStateBitForBit) {
   EXPECT_EQ(end.steps, 4429u);
   EXPECT_EQ(end.time_s, 2.5990115343578988);
   EXPECT_EQ(end.digest, 0x0b1705f8775396fbull);
+}
+
+// A session recorded once the loop's step was kept with it (issue 42: the loop steps at 0.9 of
+// the stable step, schema 6), by the same command as above
+// (tests/data/storage/session-v6-scalpel-cuts-loop-step.sqlite): it replays with its own step, to
+// the state its replay gave when it was recorded, to the last bit (the same builds as above).
+TEST(SessionReplay, ASessionRecordedWithItsLoopStepReplaysToTheSameStateBitForBit) {
+  if (const auto why = other_build_than_the_digests()) GTEST_SKIP() << *why;
+  const ReplayedEnd end = replay_to_the_end(
+      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v6-scalpel-cuts-loop-step.sqlite",
+      "recorded-with-its-loop-step");
+  EXPECT_EQ(end.cuts, 2u);
+  EXPECT_EQ(end.nodes, 434u);
+  // The same strokes as the session above in 3196 steps instead of 4429: the loop's step is no
+  // longer split in two while the scalpel cuts.
+  EXPECT_EQ(end.steps, 3196u);
+  EXPECT_EQ(end.time_s, 2.5995903787974228);
+  EXPECT_EQ(end.digest, 0x708845dae5fe1d95ull);
 }
 
 TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {

@@ -11,9 +11,13 @@
 namespace liversim {
 
 std::unique_ptr<RealtimeSimulation> make_scene_simulation(std::shared_ptr<const SimModel> model,
-                                                          const BoundarySurface& surface) {
+                                                          const BoundarySurface& surface,
+                                                          double loop_step_s) {
   SimState rest = make_rest_state(*model, shared_worker_pool());
-  auto simulation = std::make_unique<RealtimeSimulation>(std::move(model), std::move(rest));
+  RealtimeSimulation::Options options;
+  options.loop_step_s = loop_step_s;
+  auto simulation =
+      std::make_unique<RealtimeSimulation>(std::move(model), std::move(rest), options);
   simulation->enable_tools(surface);
   simulation->enable_cutting();
   return simulation;
@@ -43,7 +47,8 @@ SceneSetup replay_scene(const ReplaySetup& setup, const std::string& scenario_te
   return scene;
 }
 
-SessionReplay::SessionReplay(SceneSetup scene, std::vector<SimulationInput> inputs)
+SessionReplay::SessionReplay(SceneSetup scene, std::vector<SimulationInput> inputs,
+                             std::optional<double> loop_step_s)
     : scene_(std::move(scene)), inputs_(std::move(inputs)) {
   bool any_cycle = false;
   for (const SimulationInput& input : inputs_) {
@@ -54,11 +59,15 @@ SessionReplay::SessionReplay(SceneSetup scene, std::vector<SimulationInput> inpu
   }
   if (!any_cycle) throw std::invalid_argument("the session's input log holds no timed cycle");
   model_ = std::make_shared<const SimModel>(build_model(scene_.mesh, scene_.model_options));
+  loop_step_s_ = loop_step_s ? *loop_step_s : legacy_loop_step_s(*model_);
+  if (!(loop_step_s_ > 0.0) || !std::isfinite(loop_step_s_))
+    throw std::invalid_argument("the session's loop step (" + std::to_string(loop_step_s_) +
+                                " s) is no step");
   restart();
 }
 
 void SessionReplay::restart() {
-  simulation_ = make_scene_simulation(model_, scene_.visual.surface);
+  simulation_ = make_scene_simulation(model_, scene_.visual.surface, loop_step_s_);
   next_ = 0;
   time_s_ = begin_s_;
 }

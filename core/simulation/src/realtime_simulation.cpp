@@ -58,6 +58,11 @@ StepAccumulator::Due StepAccumulator::add(double elapsed_s) {
 }
 
 double realtime_step_s(const SimModel& model) {
+  return model.integrator.step_s > 0.0 ? model.integrator.step_s
+                                       : kLoopStepFraction * model.stable_time_step_s;
+}
+
+double legacy_loop_step_s(const SimModel& model) {
   return model.integrator.step_s > 0.0 ? model.integrator.step_s : model.stable_time_step_s;
 }
 
@@ -70,7 +75,7 @@ RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
     : model_(std::move(model)),
       state_(std::move(initial_state)),
       options_(options),
-      step_s_(realtime_step_s(*model_)),
+      step_s_(options.loop_step_s > 0.0 ? options.loop_step_s : realtime_step_s(*model_)),
       max_steps_per_cycle_(options.max_steps_per_cycle > 0
                                ? options.max_steps_per_cycle
                                : steps_per_cycle(options.cycle_s, step_s_)),

@@ -660,6 +660,7 @@ bool Workstation::begin_recording() {
   start.trainee = listener_.trainee ? listener_.trainee() : default_trainee_name();
   ReplaySetup replay;
   replay.integrator = setup_.model_options.integrator;
+  replay.loop_step_s = simulation_->step_s();
   if (scenario_) {
     start.scenario_title = scenario_->scenario.title;
     start.scenario_text = scenario_->text;

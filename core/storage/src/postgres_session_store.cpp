@@ -236,11 +236,18 @@ CREATE POLICY republished_in_ones_own_name ON published_scenarios FOR UPDATE
   TO liversim_instructor USING (true) WITH CHECK (published_by = session_user);
 )sql";
 
+// Version 3: the real-time loop's step a session was recorded with (sqlite_session_store.cpp's
+// version 6).
+constexpr const char* kServerSchemaV3 = R"sql(
+ALTER TABLE session_replays ADD COLUMN loop_step_s double precision;
+)sql";
+
 struct Migration {
   std::array<const char*, 2> steps;
 };
-constexpr std::array<Migration, 2> kServerMigrations = {
-    Migration{{kServerSchemaV1, kServerSchemaV1Parts}}, Migration{{kServerSchemaV2, nullptr}}};
+constexpr std::array<Migration, 3> kServerMigrations = {
+    Migration{{kServerSchemaV1, kServerSchemaV1Parts}}, Migration{{kServerSchemaV2, nullptr}},
+    Migration{{kServerSchemaV3, nullptr}}};
 static_assert(kServerMigrations.size() == PostgresSessionStore::kSchemaVersion);
 
 // Type OIDs of the parameters and columns (pg_type.h: server headers, not libpq's).
@@ -644,8 +651,8 @@ void store_replay(Connection& c, std::int64_t session, const ReplaySetup& replay
   if (replay.built_in_liver_tets) tets = *replay.built_in_liver_tets;
   c.run(
       "INSERT INTO session_replays (session_id, built_in_liver_tets, scenario_folder, "
-      "integrator, step_s, tolerance_m, newton_tolerance_m, max_newton_iterations) "
-      "VALUES ($1, $2, $3, $4, $5, $6, $7, $8)",
+      "integrator, step_s, tolerance_m, newton_tolerance_m, max_newton_iterations, loop_step_s) "
+      "VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9)",
       Params()
           .add(session)
           .add(tets)
@@ -654,7 +661,8 @@ void store_replay(Connection& c, std::int64_t session, const ReplaySetup& replay
           .add(i.step_s)
           .add(i.tolerance_m)
           .add(i.newton_tolerance_m)
-          .add(std::int64_t{i.max_newton_iterations}),
+          .add(std::int64_t{i.max_newton_iterations})
+          .add(replay.loop_step_s),
       "storing how to replay the session");
 }
 
@@ -1227,7 +1235,8 @@ std::string PostgresSessionStore::scenario_text(std::int64_t session) {
 std::optional<ReplaySetup> PostgresSessionStore::replay_setup(std::int64_t session) {
   Result row = connection_->run(
       "SELECT built_in_liver_tets, scenario_folder, integrator, step_s, tolerance_m, "
-      "newton_tolerance_m, max_newton_iterations FROM session_replays WHERE session_id = $1",
+      "newton_tolerance_m, max_newton_iterations, loop_step_s FROM session_replays "
+      "WHERE session_id = $1",
       Params().add(session), "reading how to replay the session");
   if (row.rows() != 1) return std::nullopt;
   ReplaySetup setup;
@@ -1244,6 +1253,7 @@ std::optional<ReplaySetup> PostgresSessionStore::replay_setup(std::int64_t sessi
   setup.integrator.tolerance_m = row.real(0, 4);
   setup.integrator.newton_tolerance_m = row.real(0, 5);
   setup.integrator.max_newton_iterations = static_cast<int>(row.integer(0, 6));
+  if (!row.is_null(0, 7)) setup.loop_step_s = row.real(0, 7);
   return setup;
 }
 

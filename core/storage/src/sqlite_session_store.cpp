@@ -167,8 +167,12 @@ constexpr const char* kSchemaV5 =
     ") WITHOUT ROWID;";
 #undef LIVERSIM_SQL_UUID
 
-constexpr std::array<const char*, 5> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3, kSchemaV4,
-                                                    kSchemaV5};
+// Version 6: the real-time loop's step a session was recorded with (a cycle of its input log is a
+// count of them); NULL for the sessions before, which replay with the model's stable step.
+constexpr const char* kSchemaV6 = "ALTER TABLE session_replays ADD COLUMN loop_step_s REAL;";
+
+constexpr std::array<const char*, 6> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3,
+                                                    kSchemaV4, kSchemaV5, kSchemaV6};
 static_assert(kMigrations.size() == SqliteSessionStore::kSchemaVersion);
 
 enum StatementId {
@@ -583,13 +587,17 @@ std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
     Statement& add_replay =
         prepared(kAddReplay,
                  "INSERT INTO session_replays (session_id, built_in_liver_tets, scenario_folder, "
-                 "integrator, step_s, tolerance_m, newton_tolerance_m, max_newton_iterations) "
-                 "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+                 "integrator, step_s, tolerance_m, newton_tolerance_m, max_newton_iterations, "
+                 "loop_step_s) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)");
     add_replay.bind(1, session);
     if (replay->built_in_liver_tets)
       add_replay.bind(2, std::int64_t{*replay->built_in_liver_tets});
     else
       add_replay.bind_null(2);
+    if (replay->loop_step_s)
+      add_replay.bind(9, *replay->loop_step_s);
+    else
+      add_replay.bind_null(9);
     const IntegratorSettings& i = replay->integrator;
     add_replay.bind(3, std::string_view(replay->scenario_folder))
         .bind(4, integrator_name(i.kind))
@@ -666,10 +674,11 @@ void SqliteSessionStore::append_inputs(std::int64_t session,
 }
 
 std::optional<ReplaySetup> SqliteSessionStore::replay_setup(std::int64_t session) {
-  Statement& row = prepared(
-      kReplay,
-      "SELECT built_in_liver_tets, scenario_folder, integrator, step_s, tolerance_m, "
-      "newton_tolerance_m, max_newton_iterations FROM session_replays WHERE session_id = ?1");
+  Statement& row =
+      prepared(kReplay,
+               "SELECT built_in_liver_tets, scenario_folder, integrator, step_s, tolerance_m, "
+               "newton_tolerance_m, max_newton_iterations, loop_step_s FROM session_replays "
+               "WHERE session_id = ?1");
   row.bind(1, session);
   if (!row.step("reading how to replay the session")) {
     row.reset();
@@ -684,6 +693,7 @@ std::optional<ReplaySetup> SqliteSessionStore::replay_setup(std::int64_t session
   setup.integrator.tolerance_m = row.real(4);
   setup.integrator.newton_tolerance_m = row.real(5);
   setup.integrator.max_newton_iterations = static_cast<int>(row.integer(6));
+  if (!row.is_null(7)) setup.loop_step_s = row.real(7);
   row.reset();
   if (!kind)
     throw error("session " + std::to_string(session) + " was run with the integrator \"" +

@@ -36,6 +36,10 @@ struct ReplaySetup {
   std::optional<int> built_in_liver_tets;  // free practice; none: the session's scenario
   std::string scenario_folder;
   IntegratorSettings integrator;
+  // The real-time loop's step the session was recorded with (a cycle of the input log is a count
+  // of these); none for a session recorded before it was kept, whose loop stepped by the model's
+  // integrator step, or else its stable step (legacy_loop_step_s).
+  std::optional<double> loop_step_s;
 };
 
 }  // namespace liversim

@@ -16,9 +16,11 @@
 namespace liversim {
 
 // The simulation of a workstation scene: from rest, tools on `surface` (the model's boundary)
-// with the default contact and grasp, cutting on. The workstation and a replay both start here.
+// with the default contact and grasp, cutting on, stepping by `loop_step_s` (0: realtime_step_s).
+// The workstation and a replay both start here.
 std::unique_ptr<RealtimeSimulation> make_scene_simulation(std::shared_ptr<const SimModel> model,
-                                                          const BoundarySurface& surface);
+                                                          const BoundarySurface& surface,
+                                                          double loop_step_s = 0.0);
 
 // The scene of a recorded session, built again: free practice's built-in liver, or the stored
 // scenario (its organ file looked for in the setup's folder), with the integrator of the
@@ -28,9 +30,11 @@ SceneSetup replay_scene(const ReplaySetup& setup, const std::string& scenario_te
 
 class SessionReplay {
  public:
-  // Builds the model (seconds on a large mesh). Throws std::invalid_argument when the log holds
-  // no cycle.
-  SessionReplay(SceneSetup scene, std::vector<SimulationInput> inputs);
+  // Builds the model (seconds on a large mesh); its loop steps by `loop_step_s`, the one the
+  // session was recorded with (ReplaySetup::loop_step_s; none: legacy_loop_step_s). Throws
+  // std::invalid_argument when the log holds no cycle.
+  SessionReplay(SceneSetup scene, std::vector<SimulationInput> inputs,
+                std::optional<double> loop_step_s);
 
   const SceneSetup& scene() const { return scene_; }
   std::span<const SimulationInput> inputs() const { return inputs_; }
@@ -57,6 +61,7 @@ class SessionReplay {
   std::shared_ptr<const SimModel> model_;
   std::vector<SimulationInput> inputs_;
   std::unique_ptr<RealtimeSimulation> simulation_;
+  double loop_step_s_ = 0.0;
   std::size_t next_ = 0;  // the next input to take
   double begin_s_ = 0.0, end_s_ = 0.0, time_s_ = 0.0;
 };

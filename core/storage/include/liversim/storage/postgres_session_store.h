@@ -36,7 +36,7 @@ enum class ServerLoginKind { workstation, instructor };
 class PostgresSessionStore final : public SessionStore {
  public:
   // The schema version this build reads and writes (table liversim_schema on the server).
-  static constexpr int kSchemaVersion = 2;
+  static constexpr int kSchemaVersion = 3;
 
   // Connects as settings.user with this password (empty: libpq finds one in ~/.pgpass or uses a
   // client certificate). Throws StorageError naming the server: unreachable (no answer, TLS

@@ -19,7 +19,7 @@ class SqliteSessionStore final : public SessionStore {
   enum class Access { read_write, read_only };
 
   // The schema version this build writes; files at older versions are migrated on opening.
-  static constexpr int kSchemaVersion = 5;
+  static constexpr int kSchemaVersion = 6;
 
   // Opens the file, creating it (read_write) if it does not exist. Throws StorageError naming the
   // file when it cannot be opened, is not a LiverSim database, is damaged, is read-only while
