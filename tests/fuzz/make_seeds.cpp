@@ -134,7 +134,7 @@ void session_seeds(const fs::path& out, const fs::path& data, const fs::path& sc
     start.device = "mouse";
     start.started_unix_ms = 1700000000000;
     start.mapping = WorkspaceMapping{};
-    start.replay = ReplaySetup{std::nullopt, "/scenarios", {}};
+    start.replay = ReplaySetup{std::nullopt, "/scenarios", {}, 6.75e-4};
     const std::int64_t complete = store.begin_session(start);
     store.append_frames(complete, std::vector<ServoFrame>{frame(0.0, 0), frame(0.001, 1)});
     store.append_frames(complete, std::vector<ServoFrame>{frame(0.002, 1)});
@@ -168,10 +168,12 @@ void session_seeds(const fs::path& out, const fs::path& data, const fs::path& sc
   write_bytes(
       out / ("sessions-v" + std::to_string(SqliteSessionStore::kSchemaVersion) + "-written.sqlite"),
       shrunk(file));
-  // Every earlier schema version, as written by that version (tests/data/storage), migrated on
-  // opening.
+  // Every earlier schema version, as written by that version (tests/data/storage/sessions-vN),
+  // migrated on opening; not the recorded sessions there (hundreds of kilobytes each).
   for (const auto& entry : fs::directory_iterator(data / "storage")) {
-    if (entry.path().extension() != ".sqlite") continue;
+    if (entry.path().extension() != ".sqlite" ||
+        !entry.path().filename().string().starts_with("sessions-v"))
+      continue;
     fs::copy_file(entry.path(), file, fs::copy_options::overwrite_existing);
     write_bytes(out / entry.path().filename(), shrunk(file));
   }
