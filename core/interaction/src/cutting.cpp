@@ -792,6 +792,58 @@ void splits_of(const SimModel& model, std::size_t e, const std::vector<EdgeSplit
   std::sort(mine.begin(), mine.end());
 }
 
+// Leaves out of `splits` the edges of every element that would have a part thinner than the
+// mesh's smallest element (the explicit step would fall) or than `min_fraction` of its own
+// smallest height at rest, until none would.
+void refuse_thin_parts(const SimModel& model, const NodeArray& rest_m, double min_fraction,
+                       std::vector<EdgeSplit>& splits) {
+  auto rest_at = [&](NodeIndex n) -> Eigen::Vector3d {
+    if (n < static_cast<NodeIndex>(model.node_count)) return rest_m.at(n);
+    const EdgeSplit& split = splits[n - static_cast<NodeIndex>(model.node_count)];
+    return rest_m.at(split.a) + split.s * (rest_m.at(split.b) - rest_m.at(split.a));
+  };
+  auto has_thin_part = [&](std::size_t e, const std::vector<std::ptrdiff_t>& mine,
+                           std::vector<std::array<NodeIndex, 4>>& parts) {
+    std::array<NodeIndex, 4> parent;
+    for (int c = 0; c < 4; ++c) parent[c] = model.corner[c][e];
+    const double parent_height_m = shape_of(corners_at(model, rest_m, e)).min_height_m;
+    bisect(parent, splits, mine, model.node_count, parts);
+    for (const auto& part : parts) {
+      std::array<Eigen::Vector3d, 4> p;
+      for (int c = 0; c < 4; ++c) p[c] = rest_at(part[c]);
+      const double height_m = shape_of(p).min_height_m;
+      if (height_m < min_fraction * parent_height_m || height_m < model.min_element_height_m)
+        return true;
+    }
+    return false;
+  };
+  std::vector<std::ptrdiff_t> mine;
+  std::vector<std::array<NodeIndex, 4>> parts;
+  std::vector<std::array<NodeIndex, 2>> refused;
+  std::vector<std::size_t> affected;
+  while (!splits.empty()) {
+    affected.clear();
+    for (const EdgeSplit& split : splits)
+      for_each_element_of(model, split.a, [&](std::size_t e) {
+        if (element_has_node(model, e, split.b)) affected.push_back(e);
+      });
+    std::sort(affected.begin(), affected.end());
+    affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
+    refused.clear();
+    for (std::size_t e : affected) {
+      splits_of(model, e, splits, mine);
+      if (has_thin_part(e, mine, parts))
+        for (std::ptrdiff_t k : mine) refused.push_back({splits[k].a, splits[k].b});
+    }
+    if (refused.empty()) return;
+    std::sort(refused.begin(), refused.end());
+    std::erase_if(splits, [&](const EdgeSplit& split) {
+      return std::binary_search(refused.begin(), refused.end(),
+                                std::array<NodeIndex, 2>{split.a, split.b});
+    });
+  }
+}
+
 struct Refinement {
   std::shared_ptr<SimModel> model;
   SimState state;
@@ -1010,7 +1062,6 @@ namespace {
 
 // What a cut on the model with the nodes made on edges knows from the cut before them.
 struct AfterSplitting {
-  std::vector<std::uint8_t> on_cut;           // per node: moved or made onto the sweep
   std::vector<std::uint8_t> may_touch;        // per element: part of one the sweep touched
   std::vector<std::uint8_t> reshaped_around;  // per node: Refinement's
 };
@@ -1019,9 +1070,6 @@ struct AfterSplitting {
 // on the model with them, given what this one found.
 CutResult cut_along(const SimModel& model, const SimState& state, const SweepSurface& surface,
                     const CuttingSettings& settings, const AfterSplitting* after) {
-  const bool may_split = after == nullptr;
-  static const std::vector<std::uint8_t> kNone;
-  const std::vector<std::uint8_t>& on_cut = after ? after->on_cut : kNone;
   CutResult result;
   CutReport& report = result.report;
   FaceNeighbours neighbours(model);
@@ -1103,9 +1151,9 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
     }
   }
 
-  // Elements around a snapped node (or one already on the cut) now touch the sweep too.
+  // Elements around a snapped node now touch the sweep too.
   for (NodeIndex n = 0; n < static_cast<NodeIndex>(model.node_count); ++n) {
-    if (!snapped[n] && (on_cut.empty() || !on_cut[n])) continue;
+    if (!snapped[n]) continue;
     for_each_element_of(model, n, [&](std::size_t e) {
       if (swept[e]) return;
       swept[e] = 1;
@@ -1132,7 +1180,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   // away from both ends (no node could be moved there), a node is made on that edge, and the cut
   // runs on the model with those nodes: its elements then lie each on one side, none goes whole
   // to the side of its centroid (which left islands of elements joined to nothing on their side).
-  if (may_split) {
+  if (!after) {
     std::vector<EdgeSplit> splits, crossed;
     for (std::size_t e : zone) {
       if (!over_threshold[e]) continue;
@@ -1159,60 +1207,13 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
                                return l.a == r.a && l.b == r.b;
                              }),
                  splits.end());
-    // No part may be thinner than the smallest element of the mesh (the explicit step would fall)
-    // or than split_min_fraction of its element: the edges of an element that would have one are
-    // not split, until none would.
-    std::vector<std::ptrdiff_t> mine;
-    std::vector<std::array<NodeIndex, 4>> parts;
-    std::vector<std::array<NodeIndex, 2>> refused;
-    for (bool refusing = !splits.empty(); refusing && !splits.empty();) {
-      refusing = false;
-      std::vector<std::size_t> affected;
-      for (const EdgeSplit& split : splits)
-        for_each_element_of(model, split.a, [&](std::size_t e) {
-          if (element_has_node(model, e, split.b)) affected.push_back(e);
-        });
-      std::sort(affected.begin(), affected.end());
-      affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
-      auto rest_at = [&](NodeIndex n) -> Eigen::Vector3d {
-        if (n < static_cast<NodeIndex>(model.node_count)) return geometry.rest_m.at(n);
-        const EdgeSplit& split = splits[n - static_cast<NodeIndex>(model.node_count)];
-        return geometry.rest_m.at(split.a) +
-               split.s * (geometry.rest_m.at(split.b) - geometry.rest_m.at(split.a));
-      };
-      refused.clear();
-      for (std::size_t e : affected) {
-        std::array<NodeIndex, 4> parent;
-        for (int c = 0; c < 4; ++c) parent[c] = model.corner[c][e];
-        const double parent_height_m = shape_of(corners_at(model, geometry.rest_m, e)).min_height_m;
-        splits_of(model, e, splits, mine);
-        bisect(parent, splits, mine, model.node_count, parts);
-        bool thin = false;
-        for (const auto& part : parts) {
-          std::array<Eigen::Vector3d, 4> p;
-          for (int c = 0; c < 4; ++c) p[c] = rest_at(part[c]);
-          const double height_m = shape_of(p).min_height_m;
-          thin |= height_m < settings.split_min_fraction * parent_height_m ||
-                  height_m < model.min_element_height_m;
-        }
-        if (!thin) continue;
-        for (std::ptrdiff_t k : mine) refused.push_back({splits[k].a, splits[k].b});
-      }
-      if (refused.empty()) break;
-      refusing = true;
-      std::sort(refused.begin(), refused.end());
-      std::erase_if(splits, [&](const EdgeSplit& split) {
-        return std::binary_search(refused.begin(), refused.end(),
-                                  std::array<NodeIndex, 2>{split.a, split.b});
-      });
-    }
+    refuse_thin_parts(model, geometry.rest_m, settings.split_min_fraction, splits);
     if (!splits.empty()) {
       const Refinement refined = split_edges(model, state, geometry, snapped, splits);
       // The parts of elements the sweep did not touch do not touch it either (an edge it crosses
-      // is in every element holding it, all touched).
+      // is in every element holding it, all touched); the nodes moved or made onto it are on it,
+      // and their elements touch it.
       AfterSplitting known;
-      known.on_cut.assign(refined.model->node_count, 1);
-      for (std::size_t n = 0; n < model.node_count; ++n) known.on_cut[n] = snapped[n];
       known.reshaped_around = refined.reshaped_around;
       known.may_touch.resize(refined.model->tet_count);
       for (std::size_t i = 0; i < known.may_touch.size(); ++i)
