@@ -459,6 +459,32 @@ TEST(SessionReplay, ASessionRecordedWithItsLoopStepReplaysToTheSameStateBitForBi
   EXPECT_EQ(end.digest, 0x708845dae5fe1d95ull);
 }
 
+// A session whose stored loop step is no step (a damaged or hand-edited file: negative, zero, or
+// text where a number belongs) is refused by its replay, naming the loop step, and the file keeps
+// everything else.
+TEST(SessionReplay, AStoredLoopStepThatIsNoStepIsRefusedByName) {
+  for (const char* bad : {"-0.001", "0", "'fast'"}) {
+    SCOPED_TRACE(bad);
+    const fs::path file = fresh_database("bad-loop-step");
+    fs::copy_file(
+        fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v6-scalpel-cuts-loop-step.sqlite",
+        file);
+    run_sql(file, (std::string("UPDATE session_replays SET loop_step_s = ") + bad).c_str());
+    SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
+    const std::optional<ReplaySetup> setup = store.replay_setup(1);
+    ASSERT_TRUE(setup);
+    try {
+      SessionReplay replay(replay_scene(*setup, store.scenario_text(1)), store.inputs(1),
+                           setup->loop_step_s);
+      ADD_FAILURE() << "a loop step of " << bad << " was replayed";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("loop step"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(store.frames(1).size(), 2603u);
+    EXPECT_EQ(store.integrity_check(), "ok");
+  }
+}
+
 TEST(SessionStore, TheInputLogAndTheReplaySetupReadBackExactly) {
   const fs::path file = fresh_database("inputs");
   std::int64_t session = 0;

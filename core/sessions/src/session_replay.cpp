@@ -61,8 +61,9 @@ SessionReplay::SessionReplay(SceneSetup scene, std::vector<SimulationInput> inpu
   model_ = std::make_shared<const SimModel>(build_model(scene_.mesh, scene_.model_options));
   loop_step_s_ = loop_step_s ? *loop_step_s : legacy_loop_step_s(*model_);
   if (!(loop_step_s_ > 0.0) || !std::isfinite(loop_step_s_))
-    throw std::invalid_argument("the session's loop step (" + std::to_string(loop_step_s_) +
-                                " s) is no step");
+    throw std::invalid_argument("the session's stored loop step is " +
+                                std::to_string(loop_step_s_) +
+                                " s: it cannot be replayed (a step is a positive time)");
   restart();
 }
 
