@@ -125,9 +125,15 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   station->stop();
   for (LoopRecord record; trace.pop(record);) records.push_back(record);
   station->finish_metrics();
-  const std::size_t end_tets = station->simulation().snapshot().model
-                                   ? station->simulation().snapshot().model->tet_count
-                                   : start_tets;
+  const std::shared_ptr<const SimModel> end_model = station->simulation().snapshot().model;
+  const std::size_t end_tets = end_model ? end_model->tet_count : start_tets;
+  // The mass the cuts added to keep the step (selective mass scaling), against the tissue's.
+  double added_mass_kg = 0.0, tissue_mass_kg = 0.0;
+  if (end_model) {
+    added_mass_kg = end_model->added_mass_kg;
+    for (double m : end_model->lumped_mass_kg) tissue_mass_kg += m;
+    tissue_mass_kg -= added_mass_kg;
+  }
   station.reset();
   fs::remove(database);
   if (!fault.empty()) return fail("the scripted device stopped: " + fault);
@@ -219,7 +225,13 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << "); smallest step " << ms_text(smallest_step_s) << " ms (target " << kLeastStepMs
       << " ms: " << (smallest_step_s * 1e3 >= kLeastStepMs ? "met" : "**not met**")
       << "); slowest cut update " << std::setprecision(2) << slowest_ms << " ms (target "
-      << kFrameMs << " ms: " << (slowest_ms <= kFrameMs ? "met" : "**not met**") << ").\n";
+      << kFrameMs << " ms: " << (slowest_ms <= kFrameMs ? "met" : "**not met**") << "). Mass the "
+      << "cuts added so that their small parts keep the step: " << std::setprecision(2)
+      << added_mass_kg * 1e3 << " g, " << std::setprecision(3)
+      << (tissue_mass_kg > 0.0 ? 100.0 * added_mass_kg / tissue_mass_kg : 0.0)
+      << " % of the tissue's " << std::setprecision(0) << tissue_mass_kg * 1e3
+      << " g (bound: " << std::setprecision(1) << 100.0 * CuttingSettings{}.max_added_mass_fraction
+      << " %).\n";
   if (trace.dropped() > 0)
     doc << "\n" << trace.dropped() << " records of the loop were dropped (the ring was full).\n";
 

@@ -147,9 +147,9 @@ TEST_F(RealtimeSteppingFixture, TheFixedStepIsTheIntegratorStepOrElseJustUnderTh
   EXPECT_EQ(realtime_step_s(*stable), kLoopStepFraction * stable->stable_time_step_s);
   const RealtimeSimulation by_cycle(stable, make_rest_state(*stable));
   EXPECT_EQ(by_cycle.step_s(), kLoopStepFraction * stable->stable_time_step_s);
-  // The default cap covers one publish cycle (1/120 s) of simulated time.
+  // The default cap covers a display frame (1/60 s) of simulated time.
   EXPECT_EQ(by_cycle.max_steps_per_cycle(),
-            static_cast<int>(std::ceil((1.0 / 120.0) / by_cycle.step_s())));
+            static_cast<int>(std::ceil((1.0 / 60.0) / by_cycle.step_s())));
 
   IntegratorSettings implicit;
   implicit.kind = IntegratorKind::backward_euler;

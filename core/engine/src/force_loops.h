@@ -208,7 +208,8 @@ void average_nodal_volume_ratios(const SimModel& model, const detail::ElasticKer
       [&](std::size_t begin, std::size_t end, std::size_t) { volume_ratio(data, begin, end); });
   for_each_chunk(
       scratch, model.node_count, kNodesPerChunk,
-      [&](std::size_t begin, std::size_t end, std::size_t) {
+      [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+        double min_j = std::numeric_limits<double>::infinity();
         for (std::size_t n = begin; n < end; ++n) {
           double weighted = 0.0, volume = 0.0, lambda_volume = 0.0;
           for (auto s = model.node_slot_begin[n]; s < model.node_slot_begin[n + 1]; ++s) {
@@ -218,22 +219,29 @@ void average_nodal_volume_ratios(const SimModel& model, const detail::ElasticKer
             volume += model.rest_volume_m3[e];
             lambda_volume += model.rest_volume_m3[e] * model.lame_lambda_pa[e];
           }
+          if (volume > 0.0) min_j = std::min(min_j, weighted / volume);
           scratch.nodal_lambda_pressure_pa[n] =
               volume > 0.0 ? neo_hookean::lambda_pressure(weighted / volume, lambda_volume / volume)
                            : 0.0;
         }
+        scratch.chunk_min_nodal_volume_ratio[chunk] = min_j;
       });
+  scratch.min_nodal_volume_ratio = std::numeric_limits<double>::infinity();
+  for (double min_j : scratch.chunk_min_nodal_volume_ratio)
+    scratch.min_nodal_volume_ratio = std::min(scratch.min_nodal_volume_ratio, min_j);
 }
 
 ElasticEvaluation nothing_seen() {
-  return {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), 0.0};
+  return {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), 0.0,
+          std::numeric_limits<double>::infinity()};
 }
 detail::ElasticKernelSeen kernel_nothing_seen() {
   const ElasticEvaluation none = nothing_seen();
   return {none.min_volume_ratio, none.max_volume_ratio, none.max_fibre_modulus_pa};
 }
 ElasticEvaluation evaluation_of(const detail::ElasticKernelSeen& seen) {
-  return {seen.min_volume_ratio, seen.max_volume_ratio, seen.max_fibre_modulus_pa};
+  return {seen.min_volume_ratio, seen.max_volume_ratio, seen.max_fibre_modulus_pa,
+          std::numeric_limits<double>::infinity()};
 }
 
 // Fibre families present in the kernel data (kernel_data puts them first).
@@ -398,8 +406,8 @@ ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& positio
 
 // Picks the element loop compiled for the model's effect set and runs it over every element.
 template <bool kViscous>
-ElasticEvaluation element_forces_for_effects(const SimModel& model, const NodeArray& position,
-                                             ForceScratch& scratch, const ViscousContext& viscous) {
+ElasticEvaluation element_forces_of_effects(const SimModel& model, const NodeArray& position,
+                                            ForceScratch& scratch, const ViscousContext& viscous) {
   const EffectSet on = built(model);
   const detail::ElasticKernelData data = kernel_data(model, position, scratch);
   if constexpr (kViscous) {
@@ -453,6 +461,16 @@ ElasticEvaluation element_forces_for_effects(const SimModel& model, const NodeAr
   if constexpr (kBuiltFibres)
     if (on.fibres) return with_pressure(std::true_type{});
   return with_pressure(std::false_type{});
+}
+
+// The same, with the smallest nodal J when it averaged the pressure over nodes.
+template <bool kViscous>
+ElasticEvaluation element_forces_for_effects(const SimModel& model, const NodeArray& position,
+                                             ForceScratch& scratch, const ViscousContext& viscous) {
+  scratch.min_nodal_volume_ratio = std::numeric_limits<double>::infinity();
+  ElasticEvaluation seen = element_forces_of_effects<kViscous>(model, position, scratch, viscous);
+  seen.min_nodal_volume_ratio = scratch.min_nodal_volume_ratio;
+  return seen;
 }
 
 }  // namespace

@@ -208,11 +208,20 @@ ElasticEvaluation central_difference_step(const SimModel& model, SimState& state
 }
 
 double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& seen) {
+  // Where every element averages its λ pressure over nodes (no viscous region keeps its own), the
+  // λ part stiffens with the smallest nodal J, only the −μ/J part with the element's: a small
+  // element crushed under a blade barely stiffens its nodes, whose J averages it with their other
+  // elements' (the whole volumetric stiffening of the smallest J had set the step 4–8 times too
+  // small while a blade pressed on a cut's small parts).
+  const bool nodal = model.effects.average_nodal_pressure && !model.effects.viscous &&
+                     std::isfinite(seen.min_nodal_volume_ratio);
   double stiffening = 1.0;
   for (const RegionMaterial& region : model.regions) {
     const double mu = region.tissue.shear_modulus_pa(), lambda = region.tissue.lame_lambda_pa();
-    stiffening =
-        std::max(stiffening, neo_hookean::volumetric_stiffening(seen.min_volume_ratio, mu, lambda));
+    stiffening = std::max(
+        stiffening, nodal ? neo_hookean::split_volumetric_stiffening(
+                                seen.min_nodal_volume_ratio, seen.min_volume_ratio, mu, lambda)
+                          : neo_hookean::volumetric_stiffening(seen.min_volume_ratio, mu, lambda));
     stiffening = std::max(stiffening, 1.0 + seen.max_fibre_modulus_pa / (lambda + 2.0 * mu));
   }
   return stiffening;

@@ -132,6 +132,16 @@ double volumetric_stiffening(double J, double mu, double lambda) {
   return volumetric_stiffness(J, mu, lambda) / (lambda + mu);
 }
 
+double split_volumetric_stiffening(double nodal_J, double element_J, double mu, double lambda) {
+  // U'' = λ(1 − ln J)/J² + μ/J² above kMinVolumeRatio; below it each part's quadratic continuation
+  // keeps its curvature at kMinVolumeRatio.
+  const double j_lambda = std::max(nodal_J, kMinVolumeRatio);
+  const double j_mu = std::max(element_J, kMinVolumeRatio);
+  const double lambda_part = lambda * (1.0 - std::log(j_lambda)) / (j_lambda * j_lambda);
+  const double mu_part = mu / (j_mu * j_mu);
+  return (lambda_part + mu_part) / (lambda + mu);
+}
+
 double energy_density(const Eigen::Matrix3d& F, double mu, double lambda) {
   return 0.5 * mu * (F.squaredNorm() - 3.0) + volumetric_energy(F.determinant(), mu, lambda);
 }

@@ -155,6 +155,7 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
     model.is_fixed[n] = 1;
   }
   model.min_element_height_m = assess_quality(mesh).min_height_m;
+  model.reference_element_height_m = model.min_element_height_m;
   build_node_incidence(model);
   set_region_materials(model, options.regions);
   return model;
@@ -184,17 +185,12 @@ void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& re
 
   model.shear_modulus_pa.resize(tets);
   model.lame_lambda_pa.resize(tets);
-  model.lumped_mass_kg.assign(model.node_count, 0.0);
   for (std::size_t e = 0; e < tets; ++e) {
     const TissueMaterial& tissue = regions[model.region[e]].tissue;
     model.shear_modulus_pa[e] = (1.0 - tissue.mooney_rivlin_fraction) * tissue.shear_modulus_pa();
     model.lame_lambda_pa[e] = tissue.lame_lambda_pa();
-    const double corner_mass =
-        (model.element_mass_kg.empty() ? tissue.density_kg_per_m3 * model.rest_volume_m3[e]
-                                       : model.element_mass_kg[e]) /
-        4.0;
-    for (int c = 0; c < 4; ++c) model.lumped_mass_kg[model.corner[c][e]] += corner_mass;
   }
+  lump_node_masses(model);
 
   model.effects.fibres = fibres;
   model.fibre_parameters.clear();
@@ -229,14 +225,33 @@ void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& re
                     *region.viscoelastic, region.tissue.poisson_ratio, region.viscoplastic})
               : std::nullopt);
 
+  model.max_frequency_rad_per_s = estimate_max_frequency_rad_per_s(model, model.rest_position_m);
+  model.uncut_frequency_rad_per_s = model.max_frequency_rad_per_s;
+  set_gravity(model, model.gravity_m_per_s2, model.support);
+}
+
+void lump_node_masses(SimModel& model) {
+  model.lumped_mass_kg.assign(model.node_count, 0.0);
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const double corner_mass_kg =
+        (model.element_mass_kg.empty()
+             ? model.regions[model.region[e]].tissue.density_kg_per_m3 * model.rest_volume_m3[e]
+             : model.element_mass_kg[e]) /
+        4.0;
+    for (int c = 0; c < 4; ++c) model.lumped_mass_kg[model.corner[c][e]] += corner_mass_kg;
+  }
+  model.added_mass_kg = 0.0;
+  if (!model.node_added_mass_kg.empty())
+    for (std::size_t n = 0; n < model.node_count; ++n) {
+      model.lumped_mass_kg[n] += model.node_added_mass_kg[n];
+      model.added_mass_kg += model.node_added_mass_kg[n];
+    }
   model.inverse_mass_per_kg.resize(model.node_count);
   for (std::size_t n = 0; n < model.node_count; ++n) {
     // A node no element touches has no mass; keep it still rather than divide by zero.
     const bool free = !model.is_fixed[n] && model.lumped_mass_kg[n] > 0.0;
     model.inverse_mass_per_kg[n] = free ? 1.0 / model.lumped_mass_kg[n] : 0.0;
   }
-  model.max_frequency_rad_per_s = estimate_max_frequency_rad_per_s(model, model.rest_position_m);
-  set_gravity(model, model.gravity_m_per_s2, model.support);
 }
 
 void set_gravity(SimModel& model, const Eigen::Vector3d& gravity_m_per_s2,

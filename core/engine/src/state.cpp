@@ -20,6 +20,8 @@ ForceScratch make_force_scratch(const SimModel& model) {
   if (model.effects.average_nodal_pressure) {
     scratch.element_volume_ratio.resize(model.tet_count);
     scratch.nodal_lambda_pressure_pa.resize(model.node_count);
+    scratch.chunk_min_nodal_volume_ratio.resize((model.node_count + kNodesPerChunk - 1) /
+                                                kNodesPerChunk);
   }
   return scratch;
 }

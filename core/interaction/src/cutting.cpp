@@ -5,6 +5,7 @@
 #include "liversim/engine/forces.h"
 #include "liversim/engine/integrator.h"
 #include "liversim/engine/mesh_quality.h"
+#include "liversim/engine/model_building.h"
 
 #include <Eigen/Dense>
 
@@ -37,6 +38,14 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
                         "a value in (0, 1)");
   if (!(settings.split_min_fraction > 0.0 && settings.split_min_fraction <= 0.5))
     return out_of_range("split fraction", settings.split_min_fraction, "a value in (0, 0.5]");
+  if (!(settings.refine_edge_m >= 0.0) || !std::isfinite(settings.refine_edge_m))
+    return out_of_range("refinement edge (m)", settings.refine_edge_m, "a finite value >= 0");
+  if (!(settings.min_part_height_m > 0.0) || !std::isfinite(settings.min_part_height_m))
+    return out_of_range("smallest part height (m)", settings.min_part_height_m,
+                        "a finite value > 0");
+  if (!(settings.max_added_mass_fraction >= 0.0 && settings.max_added_mass_fraction <= 0.05))
+    return out_of_range("added mass fraction", settings.max_added_mass_fraction,
+                        "a value in [0, 0.05]");
   return std::nullopt;
 }
 
@@ -458,13 +467,40 @@ double density_kg_per_m3(const SimModel& model, std::size_t e) {
   return model.regions[model.region[e]].tissue.density_kg_per_m3;
 }
 
+// The model's geometry and element masses as they are (density times rest volume before a cut).
+Geometry geometry_as_is(const SimModel& model, const SimState& state) {
+  Geometry geometry{model.rest_position_m, state.position_m, state.velocity_m_per_s,
+                    model.element_mass_kg};
+  if (geometry.element_mass_kg.empty()) {
+    geometry.element_mass_kg.resize(model.tet_count);
+    for (std::size_t e = 0; e < model.tet_count; ++e)
+      geometry.element_mass_kg[e] = density_kg_per_m3(model, e) * model.rest_volume_m3[e];
+  }
+  return geometry;
+}
+
 // Moves node n to parameter s along its edge to node m, at rest and deformed (a point on an edge
 // is the same material point in every element holding the edge), when every element of n keeps
 // its shape. Returns whether it moved.
 bool try_snap(const SimModel& model, FaceNeighbours& neighbours, Geometry& geometry, NodeIndex n,
-              NodeIndex m, double s, double min_fraction) {
-  // A node on the surface moves only along the surface, so the organ keeps its shape.
+              NodeIndex m, double s, double min_fraction, double floor_m) {
+  // A node on the surface moves only along the surface, so the organ keeps its shape; one where
+  // regions meet (a lesion's boundary, a layer's) only along an edge where they meet too, so no
+  // tissue passes from one region to another (a lesion's margin is measured on them).
   if (on_boundary(model, neighbours, n) && !edge_on_boundary(model, neighbours, n, m)) return false;
+  if (!model.region.empty()) {
+    int around = -1, along = -1;
+    bool regions_meet = false, edge_between = false;
+    for_each_element_of(model, n, [&](std::size_t e) {
+      const int region = model.region[e];
+      if (around >= 0 && region != around) regions_meet = true;
+      around = region;
+      if (!element_has_node(model, e, m)) return;
+      if (along >= 0 && region != along) edge_between = true;
+      along = region;
+    });
+    if (regions_meet && !edge_between) return false;
+  }
   const NodeArray* configurations[2] = {&geometry.rest_m, &geometry.position_m};
   std::array<Eigen::Vector3d, 2> moved;
   for (int k = 0; k < 2; ++k) {
@@ -481,6 +517,7 @@ bool try_snap(const SimModel& model, FaceNeighbours& neighbours, Geometry& geome
       const ElementShape after = shape_of(p);
       keeps_shape = after.volume_m3 >= min_fraction * before.volume_m3 &&
                     after.min_height_m >= min_fraction * before.min_height_m &&
+                    (k == 1 || after.min_height_m >= std::min(floor_m, before.min_height_m)) &&
                     after.volume_m3 > 0.0;
     }
   });
@@ -544,7 +581,8 @@ Eigen::Matrix<double, 12, 12> element_rest_stiffness(const SimModel& model, std:
 
 }  // namespace
 
-double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<NodeIndex>& nodes) {
+LocalMode local_top_mode(const SimModel& model, const std::vector<NodeIndex>& nodes) {
+  LocalMode mode;
   std::vector<std::int32_t> local(model.node_count, -1);
   std::vector<double> inv_sqrt_mass;
   for (NodeIndex n : nodes)
@@ -552,7 +590,7 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
       local[n] = static_cast<std::int32_t>(inv_sqrt_mass.size());
       inv_sqrt_mass.push_back(std::sqrt(model.inverse_mass_per_kg[n]));
     }
-  if (inv_sqrt_mass.empty()) return 0.0;
+  if (inv_sqrt_mass.empty()) return mode;
   std::vector<std::size_t> elements;
   std::vector<std::uint8_t> taken(model.tet_count, 0);
   for (NodeIndex n : nodes)
@@ -649,20 +687,25 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
   current.tail<3>().setZero();
   current.normalize();
   std::vector<double> alpha, beta;
-  auto largest_ritz_value = [&] {
+  std::vector<Eigen::VectorXd> basis;  // the Lanczos vectors, for the mode
+  auto tridiagonal = [&] {
     const int k = static_cast<int>(alpha.size());
-    Eigen::MatrixXd tridiagonal = Eigen::MatrixXd::Zero(k, k);
+    Eigen::MatrixXd t = Eigen::MatrixXd::Zero(k, k);
     for (int i = 0; i < k; ++i) {
-      tridiagonal(i, i) = alpha[i];
-      if (i + 1 < k) tridiagonal(i, i + 1) = tridiagonal(i + 1, i) = beta[i];
+      t(i, i) = alpha[i];
+      if (i + 1 < k) t(i, i + 1) = t(i + 1, i) = beta[i];
     }
-    return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(tridiagonal, Eigen::EigenvaluesOnly)
+    return t;
+  };
+  auto largest_ritz_value = [&] {
+    return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(tridiagonal(), Eigen::EigenvaluesOnly)
         .eigenvalues()
         .maxCoeff();
   };
   double previous_beta = 0.0, checked = 0.0;
   std::optional<double> settled;
   for (int step = 0; step < kMaxSteps && step < static_cast<int>(dofs); ++step) {
+    basis.push_back(current);
     apply(current, next);
     next -= previous_beta * previous;
     alpha.push_back(next.dot(current));
@@ -681,7 +724,86 @@ double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<No
     previous.swap(current);
     current = next / previous_beta;
   }
-  return std::sqrt(std::max(settled ? *settled : largest_ritz_value(), 0.0));
+  // The Ritz vector of the largest value, and each node's share of its energy (|ψ_n|², ψ the
+  // eigenvector of A: the mode's kinetic energy goes as m_n·|φ_n|² = |ψ_n|²).
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ritz(tridiagonal());
+  Eigen::Index top = 0;
+  ritz.eigenvalues().maxCoeff(&top);
+  mode.frequency_rad_per_s = std::sqrt(std::max(settled ? *settled : ritz.eigenvalues()[top], 0.0));
+  Eigen::VectorXd psi = Eigen::VectorXd::Zero(dofs + 3);
+  for (Eigen::Index k = 0; k < ritz.eigenvectors().rows(); ++k)
+    psi += ritz.eigenvectors()(k, top) * basis[k];
+  const double norm = psi.head(dofs).squaredNorm();
+  mode.node.resize(inv_sqrt_mass.size());
+  mode.energy_share.resize(inv_sqrt_mass.size());
+  for (NodeIndex n : nodes)
+    if (local[n] >= 0) {
+      mode.node[local[n]] = n;
+      mode.energy_share[local[n]] =
+          norm > 0.0 ? psi.segment<3>(3 * local[n]).squaredNorm() / norm : 0.0;
+    }
+  return mode;
+}
+
+double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<NodeIndex>& nodes) {
+  return local_top_mode(model, nodes).frequency_rad_per_s;
+}
+
+double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& nodes,
+                                 double ceiling_rad_per_s, double max_added_mass_fraction,
+                                 NodeArray* velocity_m_per_s) {
+  constexpr int kMaxRounds = 24;
+  constexpr double kTolerance = 1e-3, kAmplitudeFraction = 0.5;
+  const double tissue_kg =
+      std::accumulate(model.lumped_mass_kg.begin(), model.lumped_mass_kg.end(), 0.0) -
+      model.added_mass_kg;
+  const double budget_kg = max_added_mass_fraction * tissue_kg;
+  double added_kg = 0.0;
+  LocalMode mode = local_top_mode(model, nodes);
+  for (int round = 0; round < kMaxRounds && model.added_mass_kg < budget_kg &&
+                      mode.frequency_rad_per_s > (1.0 + kTolerance) * ceiling_rad_per_s;
+       ++round) {
+    // Mass slows the mode most where it moves most: the nodes whose displacement in it
+    // (|φ_n|² = share_n / m_n, φ mass-normalised) is at least half the largest. Their masses times
+    // s, the mode's shape kept, its Rayleigh quotient is ω² / (1 + (s − 1)·E), E their share of
+    // its energy: s brings it to the ceiling.
+    double largest = 0.0;
+    for (std::size_t k = 0; k < mode.node.size(); ++k)
+      largest = std::max(largest, mode.energy_share[k] / model.lumped_mass_kg[mode.node[k]]);
+    double held = 0.0, moving_kg = 0.0;
+    for (std::size_t k = 0; k < mode.node.size(); ++k)
+      if (mode.energy_share[k] / model.lumped_mass_kg[mode.node[k]] >=
+          kAmplitudeFraction * largest) {
+        held += mode.energy_share[k];
+        moving_kg += model.lumped_mass_kg[mode.node[k]];
+      }
+    const double ratio = (mode.frequency_rad_per_s * mode.frequency_rad_per_s) /
+                         (ceiling_rad_per_s * ceiling_rad_per_s);
+    const double more = (ratio - 1.0) / held * (1.0 + kTolerance);  // s − 1
+    if (!(more > 0.0) || !(moving_kg > 0.0)) break;
+    // What is left of the budget, shared alike.
+    const double share = std::min(1.0, (budget_kg - model.added_mass_kg) / (more * moving_kg));
+    if (model.node_added_mass_kg.empty()) model.node_added_mass_kg.assign(model.node_count, 0.0);
+    std::vector<std::pair<NodeIndex, double>> adds;
+    for (std::size_t k = 0; k < mode.node.size(); ++k) {
+      const NodeIndex n = mode.node[k];
+      if (mode.energy_share[k] / model.lumped_mass_kg[n] < kAmplitudeFraction * largest) continue;
+      adds.emplace_back(n, share * more * model.lumped_mass_kg[n]);
+    }
+    for (const auto& [n, more_kg] : adds) {
+      // Momentum kept: the mass brings no energy.
+      if (velocity_m_per_s)
+        velocity_m_per_s->set(n, velocity_m_per_s->at(n) * (model.lumped_mass_kg[n] /
+                                                            (model.lumped_mass_kg[n] + more_kg)));
+      model.node_added_mass_kg[n] += more_kg;
+      added_kg += more_kg;
+    }
+    lump_node_masses(model);
+    mode = local_top_mode(model, nodes);
+  }
+  model.max_frequency_rad_per_s = std::max(model.max_frequency_rad_per_s, mode.frequency_rad_per_s);
+  model.stable_time_step_s = stable_time_step_s(model, StepInputs{});
+  return added_kg;
 }
 
 namespace {
@@ -715,15 +837,10 @@ void reshape_element(SimModel& m, std::size_t i) {
   m.rest_volume_m3[i] = dm.determinant() / 6.0;
 }
 
-// Lumped and inverse masses from the element masses, and the node incidence.
+// Lumped and inverse masses from the element masses (the mass scaling's too), and the node
+// incidence.
 void lump_masses(SimModel& m) {
-  m.lumped_mass_kg.assign(m.node_count, 0.0);
-  for (std::size_t i = 0; i < m.tet_count; ++i)
-    for (int c = 0; c < 4; ++c) m.lumped_mass_kg[m.corner[c][i]] += m.element_mass_kg[i] / 4.0;
-  m.inverse_mass_per_kg.resize(m.node_count);
-  for (std::size_t n = 0; n < m.node_count; ++n)
-    m.inverse_mass_per_kg[n] =
-        !m.is_fixed[n] && m.lumped_mass_kg[n] > 0.0 ? 1.0 / m.lumped_mass_kg[n] : 0.0;
+  lump_node_masses(m);
   build_node_incidence(m);
 }
 
@@ -794,9 +911,20 @@ void splits_of(const SimModel& model, std::size_t e, const std::vector<EdgeSplit
 
 // Leaves out of `splits` the edges of every element that would have a part thinner than the
 // mesh's smallest element (the explicit step would fall) or than `min_fraction` of its own
-// smallest height at rest, until none would.
+// smallest height at rest or than `floor_m`, until none would.
 void refuse_thin_parts(const SimModel& model, const NodeArray& rest_m, double min_fraction,
-                       std::vector<EdgeSplit>& splits) {
+                       double floor_m, std::vector<EdgeSplit>& splits,
+                       const std::vector<std::uint8_t>* half_floor = nullptr) {
+  // The elements `half_floor` marks may have parts down to half the floor (see cut_along, 6b).
+  // Not in viscous regions: each element there keeps its own pressure, and its thin parts'
+  // frequencies were 2–4 times the mesh's; a 45 mm-deep stroke through the wedge scenario's liver
+  // spent the whole mass budget on them and the step fell to 0.14 ms.
+  auto floor_of = [&](std::size_t e) {
+    const bool viscous = model.effects.viscous && model.viscous_parameters[model.region[e]];
+    return !viscous && half_floor && half_floor->size() == model.tet_count && (*half_floor)[e]
+               ? 0.5 * floor_m
+               : floor_m;
+  };
   auto rest_at = [&](NodeIndex n) -> Eigen::Vector3d {
     if (n < static_cast<NodeIndex>(model.node_count)) return rest_m.at(n);
     const EdgeSplit& split = splits[n - static_cast<NodeIndex>(model.node_count)];
@@ -812,7 +940,9 @@ void refuse_thin_parts(const SimModel& model, const NodeArray& rest_m, double mi
       std::array<Eigen::Vector3d, 4> p;
       for (int c = 0; c < 4; ++c) p[c] = rest_at(part[c]);
       const double height_m = shape_of(p).min_height_m;
-      if (height_m < min_fraction * parent_height_m || height_m < model.min_element_height_m)
+      const bool halved = floor_of(e) < floor_m;
+      if (height_m < (halved ? 0.5 : 1.0) * min_fraction * parent_height_m ||
+          height_m < floor_of(e))
         return true;
     }
     return false;
@@ -943,6 +1073,7 @@ Refinement split_edges(const SimModel& model, const SimState& state, const Geome
     velocity.set(n, between(geometry.velocity_m_per_s, splits[k]));
     m.is_fixed[n] = model.is_fixed[splits[k].a] && model.is_fixed[splits[k].b];
   }
+  if (!m.node_added_mass_kg.empty()) m.node_added_mass_kg.resize(m.node_count, 0.0);
 
   // Shapes of the children and of the elements a snap moved; masses by rest volume.
   std::vector<double> parent_volume(tets, 0.0);
@@ -1068,11 +1199,29 @@ struct AfterSplitting {
 
 // cut_tissue on a sweep. Without `after` nodes may be made on edges, and the cut then runs again
 // on the model with them, given what this one found.
+// The frequency a cut's mass scaling holds the model to: the uncut model's.
+double frequency_ceiling(const SimModel& model) {
+  return model.uncut_frequency_rad_per_s > 0.0 ? model.uncut_frequency_rad_per_s
+                                               : model.max_frequency_rad_per_s;
+}
+
 CutResult cut_along(const SimModel& model, const SimState& state, const SweepSurface& surface,
-                    const CuttingSettings& settings, const AfterSplitting* after) {
+                    const CuttingSettings& settings, const AfterSplitting* after,
+                    const SweepSurface* front = nullptr,
+                    const std::vector<std::uint8_t>* half_floor = nullptr) {
   CutResult result;
   CutReport& report = result.report;
   FaceNeighbours neighbours(model);
+  // No element a cut moves, splits or refines may be thinner than this (the explicit step goes
+  // with the smallest height, and the mass that keeps it with its inverse square), unless the mesh
+  // already had one as thin; on a coarse mesh, not thinner than kLeastPartOfReference of its
+  // thinnest element either.
+  constexpr double kLeastPartOfReference = 0.4;
+  const double reference_m = model.reference_element_height_m > 0.0
+                                 ? model.reference_element_height_m
+                                 : model.min_element_height_m;
+  const double floor_m = std::min(
+      reference_m, std::max(settings.min_part_height_m, kLeastPartOfReference * reference_m));
 
   // 1. The elements the sweep touches, and those of them stressed past the threshold.
   Aabb sweep_box;
@@ -1098,15 +1247,97 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   report.elements_swept = zone.size();
   if (report.elements_over_threshold == 0) return result;
 
+  // 1b. Elements at the cut's front (those the stroke's last stretch touches: the blade is in
+  // them) that are longer than settings.refine_edge_m are bisected on their longest edge (one
+  // level an update; an element at most once), so that the front can open within a short stroke
+  // on a coarse mesh. Behind the front the snapping and splitting part what the stroke passed
+  // through; refined there too, a deep stroke spent the mass budget on small parts it did not
+  // need. The cut then runs on the refined model, which stands even when nothing parts.
+  if (!after && settings.refine_edge_m > 0.0 && front) {
+    struct Longest {
+      double length_m;
+      NodeIndex a, b;
+    };
+    std::vector<Longest> longest;
+    for (std::size_t e : zone) {
+      if (!over_threshold[e]) continue;
+      const auto p = corners_at(model, state.position_m, e);
+      Aabb box;
+      for (const auto& q : p) box.grow(q);
+      if (!tet_touches_sweep(p, box, *front)) continue;
+      Longest best{0.0, 0, 0};
+      for (const auto& edge : kEdge) {
+        const NodeIndex a = model.corner[edge[0]][e], b = model.corner[edge[1]][e];
+        const double length_m = (model.rest_position_m.at(a) - model.rest_position_m.at(b)).norm();
+        if (length_m > best.length_m) best = {length_m, std::min(a, b), std::max(a, b)};
+      }
+      if (best.length_m > settings.refine_edge_m) longest.push_back(best);
+    }
+    std::sort(longest.begin(), longest.end(), [](const Longest& l, const Longest& r) {
+      return std::tie(r.length_m, l.a, l.b) < std::tie(l.length_m, r.a, r.b);
+    });
+    std::vector<std::uint8_t> taken(tets, 0);
+    std::vector<EdgeSplit> halves;
+    for (const Longest& edge : longest) {
+      bool free = true;
+      for_each_element_of(model, edge.a, [&](std::size_t e) {
+        if (element_has_node(model, e, edge.b) && taken[e]) free = false;
+      });
+      if (!free) continue;
+      for_each_element_of(model, edge.a, [&](std::size_t e) {
+        if (element_has_node(model, e, edge.b)) taken[e] = 1;
+      });
+      halves.push_back({edge.a, edge.b, 0.5});
+    }
+    std::sort(halves.begin(), halves.end());
+    refuse_thin_parts(model, model.rest_position_m, settings.split_min_fraction, floor_m, halves);
+    if (!halves.empty()) {
+      const Geometry as_is = geometry_as_is(model, state);
+      Refinement refined =
+          split_edges(model, state, as_is, std::vector<std::uint8_t>(model.node_count, 0), halves);
+      CuttingSettings once = settings;
+      once.refine_edge_m = 0.0;
+      CutResult cut = cut_along(*refined.model, refined.state, surface, once, nullptr);
+      if (!cut.cut()) {
+        // Nothing parted: the refined model stands, with its frequency estimated here.
+        SimModel& m = *refined.model;
+        std::vector<NodeIndex> around;
+        for (std::size_t n = 0; n < m.node_count; ++n)
+          if (refined.reshaped_around[n]) around.push_back(static_cast<NodeIndex>(n));
+        scale_masses_to_frequency(m, around, frequency_ceiling(model),
+                                  settings.max_added_mass_fraction,
+                                  &refined.state.velocity_m_per_s);
+        open_energy_books(m, refined.state);
+        cut.report.added_mass_kg = m.added_mass_kg;
+        cut.model = refined.model;
+        cut.state = std::move(refined.state);
+        cut.node_origin.resize(m.node_count);
+        std::iota(cut.node_origin.begin(), cut.node_origin.end(), 0);
+        cut.element_origin.resize(m.tet_count);
+        std::iota(cut.element_origin.begin(), cut.element_origin.end(), 0);
+      } else {
+        // The refined model's frequency rose around its parts too.
+        SimModel& m = const_cast<SimModel&>(*cut.model);
+        std::vector<NodeIndex> around;
+        for (std::size_t n = 0; n < m.node_count; ++n)
+          if (cut.node_origin[n] >= 0 && refined.reshaped_around[cut.node_origin[n]])
+            around.push_back(static_cast<NodeIndex>(n));
+        scale_masses_to_frequency(m, around, frequency_ceiling(model),
+                                  settings.max_added_mass_fraction, &cut.state.velocity_m_per_s);
+        open_energy_books(m, cut.state);
+        cut.report.added_mass_kg = m.added_mass_kg;
+      }
+      for (NodeIndex& n : cut.node_origin)
+        if (n >= static_cast<NodeIndex>(model.node_count)) n = -1;
+      for (TetIndex& e : cut.element_origin) e = refined.element_origin[e];
+      cut.report.elements_refined += halves.size();
+      return cut;
+    }
+  }
+
   // 2. Snap nodes onto the sweep where it crosses the edges of elements it will cut, nearest
   // crossings first.
-  Geometry geometry{model.rest_position_m, state.position_m, state.velocity_m_per_s,
-                    model.element_mass_kg};
-  if (geometry.element_mass_kg.empty()) {
-    geometry.element_mass_kg.resize(tets);
-    for (std::size_t e = 0; e < tets; ++e)
-      geometry.element_mass_kg[e] = density_kg_per_m3(model, e) * model.rest_volume_m3[e];
-  }
+  Geometry geometry = geometry_as_is(model, state);
   struct Crossing {
     NodeIndex node, other;
     double s;           // along the edge from node to other
@@ -1145,7 +1376,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
     const auto s = crossing_of(crossing.node, crossing.other);
     if (!s || *s > settings.snap_fraction) continue;
     if (try_snap(model, neighbours, geometry, crossing.node, crossing.other, *s,
-                 settings.snap_min_shape_fraction)) {
+                 settings.snap_min_shape_fraction, floor_m)) {
       snapped[crossing.node] = 1;
       ++report.snapped_nodes;
     }
@@ -1207,7 +1438,8 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
                                return l.a == r.a && l.b == r.b;
                              }),
                  splits.end());
-    refuse_thin_parts(model, geometry.rest_m, settings.split_min_fraction, splits);
+    refuse_thin_parts(model, geometry.rest_m, settings.split_min_fraction, floor_m, splits,
+                      half_floor);
     if (!splits.empty()) {
       const Refinement refined = split_edges(model, state, geometry, snapped, splits);
       // The parts of elements the sweep did not touch do not touch it either (an edge it crosses
@@ -1218,7 +1450,10 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
       known.may_touch.resize(refined.model->tet_count);
       for (std::size_t i = 0; i < known.may_touch.size(); ++i)
         known.may_touch[i] = swept[refined.element_origin[i]];
-      CutResult cut = cut_along(*refined.model, refined.state, surface, settings, &known);
+      // (Its elements are others: no second run of it with half the floor.)
+      static const std::vector<std::uint8_t> no_half_floor;
+      CutResult cut = cut_along(*refined.model, refined.state, surface, settings, &known, nullptr,
+                                half_floor ? &no_half_floor : nullptr);
       cut.report.snapped_nodes += report.snapped_nodes;
       cut.report.nodes_made_on_edges = splits.size();
       if (!cut.cut()) return cut;
@@ -1235,7 +1470,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   // element the sweep enters but does not pass all the way through (the blade ends inside it)
   // is not cut: the cut stops at its faces.
   std::vector<std::int8_t> element_side(tets, 0);
-  std::vector<std::uint8_t> cut_through(tets, 0);
+  std::vector<std::uint8_t> cut_through(tets, 0), left_whole(tets, 0);
   for (std::size_t e : zone) {
     bool plus = false, minus = false, through = true;
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -1251,6 +1486,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
         if (label_of(a) * label_of(b) < 0) through &= crossing_of(a, b).has_value();
       }
     cut_through[e] = through;
+    left_whole[e] = plus && minus && through;
     element_side[e] =
         plus && minus ? (surface.side_distance_m(centroid) >= 0.0 ? 1 : -1) : (plus ? 1 : -1);
   }
@@ -1507,6 +1743,23 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
       report.merged_volume_m3 += shape_of(corners_at(model, geometry.rest_m, e)).volume_m3;
     }
   }
+  // A flap the stroke passed through whole (its crossings could be neither snapped nor split
+  // above the height floor) would take its volume off the blade's path: in a block, a blade 15 mm
+  // deep then met 4 mm less tissue. The cut runs once more with those elements split down to
+  // half the floor, their thinner parts held by added mass. (Half the floor for every element
+  // the stroke passes through halted a live stroke; only these few are let through.)
+  if (!half_floor) {
+    std::vector<std::uint8_t> thinner(tets, 0);
+    bool any = false;
+    // (With the elements around them: an edge is split only if every element holding it may be.)
+    for (std::size_t e = 0; e < tets; ++e)
+      if (merged[e] && left_whole[e]) {
+        any = true;
+        for (int c = 0; c < 4; ++c)
+          for_each_element_of(model, model.corner[c][e], [&](std::size_t o) { thinner[o] = 1; });
+      }
+    if (any) return cut_along(model, state, surface, settings, after, front, &thinner);
+  }
 
   // 7. The new model: the kept elements (in their old order) and the nodes they use.
   std::vector<TetIndex> element_origin;
@@ -1599,6 +1852,22 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
     if (!moved) continue;
     reshape_element(m, i);
   }
+  // A node's added mass goes with it, shared among its copies by their masses (a copy in a piece
+  // that came free takes its share away).
+  if (!model.node_added_mass_kg.empty()) {
+    m.node_added_mass_kg.clear();
+    lump_masses(m);
+    std::vector<double> copies_kg(model.node_count, 0.0);
+    for (std::size_t i = 0; i < m.node_count; ++i) copies_kg[origin[i]] += m.lumped_mass_kg[i];
+    m.node_added_mass_kg.assign(m.node_count, 0.0);
+    for (std::size_t i = 0; i < m.node_count; ++i) {
+      const NodeIndex n = origin[i];
+      const double own_kg = model.lumped_mass_kg[n] - model.node_added_mass_kg[n];
+      if (own_kg > 0.0)
+        m.node_added_mass_kg[i] =
+            model.node_added_mass_kg[n] * m.lumped_mass_kg[i] / std::max(own_kg, copies_kg[n]);
+    }
+  }
   lump_masses(m);
 
   // The stable step: the mesh's largest frequency is the old one or one of the modes around the
@@ -1621,16 +1890,17 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
     }
     m.min_element_height_m = std::min(m.min_element_height_m, shape_of(p).min_height_m);
   }
-  m.max_frequency_rad_per_s =
-      std::max(m.max_frequency_rad_per_s, local_max_frequency_rad_per_s(m, around_cut));
-  m.stable_time_step_s = stable_time_step_s(m, StepInputs{});
-
   // 8. The state carried over: positions and velocities of each node's origin, the history of
   // each element; the energy books open again on the new model.
   NodeArray velocity;
   velocity.resize(m.node_count);
   for (std::size_t n = 0; n < m.node_count; ++n)
     velocity.set(n, geometry.velocity_m_per_s.at(origin[n]));
+  // Small parts would raise the frequency: they are given mass instead, so that the explicit step
+  // stays.
+  scale_masses_to_frequency(m, around_cut, frequency_ceiling(model),
+                            settings.max_added_mass_fraction, &velocity);
+  report.added_mass_kg = m.added_mass_kg;
   result.state =
       carried_state(m, state, std::move(position), std::move(velocity), element_origin, true);
   result.model = std::move(next);
@@ -1650,6 +1920,12 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   // A blade that did not move sweeps nothing.
   const SweepSurface surface = sweep_surface(stroke);
   if (surface.size() == 0) return {};
+  if (settings.refine_edge_m > 0.0 && stroke.edges_m.size() >= 2) {
+    BladeStroke last;
+    last.edges_m.assign(stroke.edges_m.end() - 2, stroke.edges_m.end());
+    const SweepSurface front = sweep_surface(last);
+    if (front.size() > 0) return cut_along(model, state, surface, settings, nullptr, &front);
+  }
   return cut_along(model, state, surface, settings, nullptr);
 }
 

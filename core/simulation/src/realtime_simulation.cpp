@@ -57,6 +57,14 @@ StepAccumulator::Due StepAccumulator::add(double elapsed_s) {
   return due;
 }
 
+// Elements longer than this around a cutting blade are bisected (CuttingSettings::refine_edge_m).
+constexpr double kBladeRefineEdgeM = 0.008;
+// The stroke gains an instant (and the tissue a cut update) each time the edge has moved this far:
+// a quarter of the thinnest part a cut may make (CuttingSettings::min_part_height_m), so the
+// crack's front still moves in steps finer than any element, at a fifth of the updates a tenth of
+// a millimetre made (each update is a pass over the elements on the simulation's thread).
+constexpr double kStrokeInstantM = 0.0005;
+
 double realtime_step_s(const SimModel& model) {
   return model.integrator.step_s > 0.0 ? model.integrator.step_s
                                        : kLoopStepFraction * model.stable_time_step_s;
@@ -155,10 +163,11 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     return;
   }
   resist_cutting(edge, in);
-  // A new instant of the stroke once the edge has moved a tenth of a millimetre (a broken-in
-  // blade's stroke starts where it broke in).
+  // A new instant of the stroke once the edge has moved kStrokeInstantM (a broken-in blade's
+  // stroke starts where it broke in).
   const auto& last = stroke_.edges_m.back();
-  if ((edge[0] - last[0]).norm() < 1e-4 && (edge[1] - last[1]).norm() < 1e-4) return;
+  if ((edge[0] - last[0]).norm() < kStrokeInstantM && (edge[1] - last[1]).norm() < kStrokeInstantM)
+    return;
   // Drawn out of the tissue, the blade has to break in again.
   if (!in.within_reach) return end_stroke();
   // Disarmed, the blade passes on without cutting; armed again, the stroke goes on from here.
@@ -175,6 +184,9 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   // the blade pass uncut.
   CuttingSettings propagating = *cutting_;
   propagating.cutting_stress_pa = 0.0;
+  // And the mesh is refined around the blade as it goes, so that a short stroke parts tissue on
+  // the shipped meshes (elements 10–14 mm across).
+  propagating.refine_edge_m = kBladeRefineEdgeM;
   CutResult cut = cut_tissue(*model_, state_, stroke_, propagating);
   const auto trace_cut = [&](bool parted) {
     if (!trace_) return;
@@ -213,7 +225,7 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   active_springs_.clear();
   ++topology_version_;
   resected_volume_m3_ += cut.report.resected_volume_m3;
-  trace_cut(true);
+  trace_cut(cut.report.separated_faces > 0);
 }
 
 void RealtimeSimulation::trace_loop(SpscRing<LoopRecord>* trace) {

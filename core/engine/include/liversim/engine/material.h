@@ -64,6 +64,9 @@ Eigen::Matrix<double, 9, 9> stress_tangent(const Eigen::Matrix3d& F, double mu, 
 // U''(J) / U''(1): how much stiffer the volumetric response is at J than at rest (≥ 1 under
 // compression). The stable explicit step scales with its inverse square root.
 double volumetric_stiffening(double J, double mu, double lambda);
+// The same with the λ pressure averaged over nodes: the λ part at the nodal J, the −μ/J part at
+// the element's (1 at rest; the unsplit value when both are the same).
+double split_volumetric_stiffening(double nodal_J, double element_J, double mu, double lambda);
 
 }  // namespace neo_hookean
 

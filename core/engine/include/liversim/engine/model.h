@@ -137,11 +137,21 @@ struct SimModel {
   // step used: safety · 2/ω_max (reduced for damping).
   double max_frequency_rad_per_s = 0.0;
   double stable_time_step_s = 0.0;
+  // That frequency as the materials were last set (build_model, set_region_materials): a cut's
+  // mass scaling holds the frequency to it, so that cut after cut it does not creep up.
+  double uncut_frequency_rad_per_s = 0.0;
   double stable_step_safety = 0.8;
   IntegratorSettings integrator;
   // Smallest element height at rest: no node may travel more than a tenth of it in one step, which
   // keeps fast, large distortions (a yank, an inversion) from jumping past the stiffening.
   double min_element_height_m = 0.0;
+  // The smallest element height of the mesh as built: no element a cut moves or makes may be
+  // thinner (CuttingSettings::min_part_height_m aside).
+  double reference_element_height_m = 0.0;
+  // Mass added to nodes so that a cut does not raise the mesh's highest frequency (selective mass
+  // scaling, cutting.h), in lumped_mass_kg; empty until a cut adds some. And its total.
+  std::vector<double> node_added_mass_kg;
+  double added_mass_kg = 0.0;
   // Faces made by cuts (cutting.h), per element: bit c for the face opposite corner c. Empty until
   // the first cut.
   std::vector<std::uint8_t> cut_face_mask;

@@ -27,6 +27,11 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options);
 // if the throw came from validation (callers change a copy).
 void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& regions);
 
+// Each node's lumped mass, a quarter of each of its elements' (element_mass_kg, or density times
+// rest volume before a cut) and its added mass (node_added_mass_kg), the total added, and the
+// inverse masses (0 on fixed nodes and on nodes no element holds).
+void lump_node_masses(SimModel& model);
+
 // Switches gravity on with this acceleration (m/s², the mesh's axes; zero: off) and the support
 // the organ rests on (null: none), as build_model would make them, also on a cut model: the
 // support's stiffness follows the model's largest frequency, and the stable step follows both.

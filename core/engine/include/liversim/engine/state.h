@@ -15,12 +15,15 @@
 namespace liversim {
 
 // What a force evaluation saw that bears on the stable explicit step: the extremes of the element
-// volume ratio J = det F (compression stiffens the volumetric response) and the largest fibre
-// tangent stiffness (stretched fibres stiffen exponentially).
+// volume ratio J = det F (compression stiffens the volumetric response), the smallest nodal
+// average of it where the λ pressure is averaged over nodes (it is that average the λ part
+// stiffens with), and the largest fibre tangent stiffness (stretched fibres stiffen
+// exponentially).
 struct ElasticEvaluation {
   double min_volume_ratio = 1.0;
   double max_volume_ratio = 1.0;
   double max_fibre_modulus_pa = 0.0;
+  double min_nodal_volume_ratio = 1.0;
 };
 
 // Scratch of one force evaluation, sized once for a model.
@@ -30,6 +33,10 @@ struct ForceScratch {
   NodeArray corner_force_n;
   std::vector<double> element_volume_ratio;      // J per element (average nodal pressure only)
   std::vector<double> nodal_lambda_pressure_pa;  // p_λ at that J with the node's mean λ (likewise)
+  // The smallest nodal J of each chunk of kNodesPerChunk nodes, and of all (likewise; +inf when
+  // the evaluation averaged none).
+  std::vector<double> chunk_min_nodal_volume_ratio;
+  double min_nodal_volume_ratio = 0.0;
   // Element loops run in fixed chunks of kElementsPerChunk, whatever the thread count, and their
   // results are combined in chunk order, so one thread and two give the same numbers.
   std::vector<ElasticEvaluation> chunk_seen;

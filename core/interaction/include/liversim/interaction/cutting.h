@@ -60,6 +60,18 @@ struct CuttingSettings {
   // of its length from either end (nearer, the element is left whole: a child that thin would set
   // the explicit step).
   double split_min_fraction = 0.25;
+  // Elements the sweep touches whose longest edge is longer than this are bisected on it, a level
+  // an update (0: never), so that a short stroke opens a crack on a coarse mesh: a crack opens
+  // only at a node whose elements the cut parts all round, and a 2 cm stroke over elements 14 mm
+  // across has none (issue 42).
+  double refine_edge_m = 0.0;
+  // No element a snap moves or a split or refinement makes may be thinner than this at rest,
+  // unless the mesh already had one as thin: the explicit step goes with the smallest height. (Each
+  // guarding only relative to its own element, a refined mesh's cuts brought the step to 0.02 ms.)
+  double min_part_height_m = 0.002;
+  // The most mass a cut may add (as a fraction of the tissue's) so that its small parts do not
+  // lower the explicit step (scale_masses_to_frequency); past it the step falls instead.
+  double max_added_mass_fraction = 0.005;
 };
 
 // The problem with the settings, if any (a message naming the setting, its value and what is
@@ -109,6 +121,7 @@ struct CutReport {
   std::size_t elements_over_threshold = 0;  // of those, stressed past the cutting threshold
   std::size_t snapped_nodes = 0;
   std::size_t nodes_made_on_edges = 0;  // where no node could be moved (elements split on them)
+  std::size_t elements_refined = 0;     // edges bisected to refine the mesh around the sweep
   std::size_t separated_faces = 0;
   std::size_t duplicated_nodes = 0;  // node copies made
   std::size_t removed_elements = 0;  // in pieces that came free
@@ -119,10 +132,14 @@ struct CutReport {
   // neighbour that takes their mass (cut_tissue step 6b); their rest volume.
   std::size_t merged_elements = 0;
   double merged_volume_m3 = 0.0;
+  // The new model's added mass (SimModel::reference_element_height_m): elements a cut left thinner
+  // than the mesh as built step no faster than it did.
+  double added_mass_kg = 0.0;
 };
 
 struct CutResult {
-  // Null when the sweep separated nothing (the old model and state stand).
+  // Null when the sweep changed nothing (the old model and state stand). A refinement around the
+  // sweep (refine_edge_m) stands even when nothing parted (report.separated_faces 0).
   std::shared_ptr<const SimModel> model;
   SimState state;
   // For each node and element of the new model, the one of the old model it came from (an
@@ -149,6 +166,27 @@ double element_cutting_stress_pa(const SimModel& model, const SimState& state, s
 // the whole mesh's (Cauchy interlacing); the modes a cut raises are local to the cut, so the block
 // around it holds them, and a cut takes the larger of it and the model's old frequency.
 double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<NodeIndex>& nodes);
+
+// That frequency and its mode: for each free node of the block, its share of the mode's kinetic
+// energy (they sum to 1).
+struct LocalMode {
+  double frequency_rad_per_s = 0.0;
+  std::vector<NodeIndex> node;
+  std::vector<double> energy_share;
+};
+LocalMode local_top_mode(const SimModel& model, const std::vector<NodeIndex>& nodes);
+
+// Selective mass scaling: adds mass to the free nodes among `nodes` (node_added_mass_kg) until the
+// block's highest frequency is at most `ceiling_rad_per_s` (to a part in a thousand), each time to
+// the nodes the top mode moves most (at least half the largest displacement), by the factor that
+// brings that mode's Rayleigh quotient to the ceiling, but never past `max_added_mass_fraction` of
+// the tissue's mass in all; then the model's frequency (the block's, if higher) and stable step.
+// Returns the mass added (kg). Given the nodes' velocities, a node given mass keeps its momentum
+// (slows), so the mass brings no energy. A cut calls it with the frequency of the model it cut, so
+// that its small parts do not lower the explicit step.
+double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& nodes,
+                                 double ceiling_rad_per_s, double max_added_mass_fraction,
+                                 NodeArray* velocity_m_per_s = nullptr);
 
 // The mesh of a model (rest positions, elements, regions), e.g. to extract its surface.
 TetMesh model_mesh(const SimModel& model);

@@ -177,7 +177,10 @@ class RealtimeSimulation {
  public:
   struct Options {
     std::size_t spring_capacity = 1024;
-    double cycle_s = 1.0 / 120.0;  // simulated time a cycle may cover, when max_steps_per_cycle=0
+    // Simulated time a cycle may cover, when max_steps_per_cycle=0: a display frame, so that the
+    // loop catches up a cycle held up by a cut update (at most a frame, issue 42) instead of
+    // dropping the time.
+    double cycle_s = 1.0 / 60.0;
     // Steps one cycle (one published snapshot) may take at most; 0: as many as fit in cycle_s
     // (at least one).
     int max_steps_per_cycle = 0;
