@@ -581,7 +581,13 @@ Eigen::Matrix<double, 12, 12> element_rest_stiffness(const SimModel& model, std:
 
 }  // namespace
 
-LocalMode local_top_mode(const SimModel& model, const std::vector<NodeIndex>& nodes) {
+namespace {
+
+// local_top_mode, with the block's element stiffness kept in `stiffness` between calls on the same
+// nodes of the same model (only the masses may change): computing it was most of an estimate's
+// time, and the mass scaling estimates the same block round after round.
+LocalMode top_mode_of_block(const SimModel& model, const std::vector<NodeIndex>& nodes,
+                            std::vector<Eigen::Matrix<double, 12, 12>>& stiffness) {
   LocalMode mode;
   std::vector<std::int32_t> local(model.node_count, -1);
   std::vector<double> inv_sqrt_mass;
@@ -612,8 +618,9 @@ LocalMode local_top_mode(const SimModel& model, const std::vector<NodeIndex>& no
       element_local[i][c] = at >= 0 ? at : padding;
       scale.segment<3>(3 * c).setConstant(at >= 0 ? inv_sqrt_mass[at] : 0.0);
     }
-    scaled_stiffness[i] =
-        scale.asDiagonal() * element_rest_stiffness(model, elements[i]) * scale.asDiagonal();
+    if (stiffness.size() < elements.size())
+      stiffness.push_back(element_rest_stiffness(model, elements[i]));
+    scaled_stiffness[i] = scale.asDiagonal() * stiffness[i] * scale.asDiagonal();
   }
   // Average nodal pressure: the volumetric energy Σ_n V_n·λ_n/2·δJ_n² of node n's volume-averaged
   // J (V_n = W_n/4, W_n its elements' volume) adds λ_n/(4 W_n)·c_n·c_nᵀ, c_n = Σ_e V_e·∂J_e/∂u,
@@ -745,6 +752,13 @@ LocalMode local_top_mode(const SimModel& model, const std::vector<NodeIndex>& no
   return mode;
 }
 
+}  // namespace
+
+LocalMode local_top_mode(const SimModel& model, const std::vector<NodeIndex>& nodes) {
+  std::vector<Eigen::Matrix<double, 12, 12>> stiffness;
+  return top_mode_of_block(model, nodes, stiffness);
+}
+
 double local_max_frequency_rad_per_s(const SimModel& model, const std::vector<NodeIndex>& nodes) {
   return local_top_mode(model, nodes).frequency_rad_per_s;
 }
@@ -759,7 +773,8 @@ double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& 
       model.added_mass_kg;
   const double budget_kg = max_added_mass_fraction * tissue_kg;
   double added_kg = 0.0;
-  LocalMode mode = local_top_mode(model, nodes);
+  std::vector<Eigen::Matrix<double, 12, 12>> stiffness;
+  LocalMode mode = top_mode_of_block(model, nodes, stiffness);
   for (int round = 0; round < kMaxRounds && model.added_mass_kg < budget_kg &&
                       mode.frequency_rad_per_s > (1.0 + kTolerance) * ceiling_rad_per_s;
        ++round) {
@@ -799,7 +814,7 @@ double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& 
       added_kg += more_kg;
     }
     lump_node_masses(model);
-    mode = local_top_mode(model, nodes);
+    mode = top_mode_of_block(model, nodes, stiffness);
   }
   model.max_frequency_rad_per_s = std::max(model.max_frequency_rad_per_s, mode.frequency_rad_per_s);
   model.stable_time_step_s = stable_time_step_s(model, StepInputs{});
