@@ -1,6 +1,7 @@
 #include "live_cut_bench.h"
 
 #include "cli_commands.h"
+#include "liversim/engine/model_building.h"
 #include "liversim/haptics/emulated_devices.h"
 #include "liversim/haptics/haptics.h"
 #include "liversim/haptics/spsc_ring.h"
@@ -128,12 +129,8 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   const std::shared_ptr<const SimModel> end_model = station->simulation().snapshot().model;
   const std::size_t end_tets = end_model ? end_model->tet_count : start_tets;
   // The mass the cuts added to keep the step (selective mass scaling), against the tissue's.
-  double added_mass_kg = 0.0, tissue_mass_kg = 0.0;
-  if (end_model) {
-    added_mass_kg = end_model->added_mass_kg;
-    for (double m : end_model->lumped_mass_kg) tissue_mass_kg += m;
-    tissue_mass_kg -= added_mass_kg;
-  }
+  const double added_mass_kg = end_model ? end_model->added_mass_kg : 0.0;
+  const double tissue_kg = end_model ? tissue_mass_kg(*end_model) : 0.0;
   station.reset();
   fs::remove(database);
   if (!fault.empty()) return fail("the scripted device stopped: " + fault);
@@ -228,10 +225,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << kFrameMs << " ms: " << (slowest_ms <= kFrameMs ? "met" : "**not met**") << "). Mass the "
       << "cuts added so that their small parts keep the step: " << std::setprecision(2)
       << added_mass_kg * 1e3 << " g, " << std::setprecision(3)
-      << (tissue_mass_kg > 0.0 ? 100.0 * added_mass_kg / tissue_mass_kg : 0.0)
-      << " % of the tissue's " << std::setprecision(0) << tissue_mass_kg * 1e3
-      << " g (bound: " << std::setprecision(1) << 100.0 * CuttingSettings{}.max_added_mass_fraction
-      << " %).\n";
+      << (tissue_kg > 0.0 ? 100.0 * added_mass_kg / tissue_kg : 0.0) << " % of the tissue's "
+      << std::setprecision(0) << tissue_kg * 1e3 << " g (bound: " << std::setprecision(1)
+      << 100.0 * CuttingSettings{}.max_added_mass_fraction << " %).\n";
   if (trace.dropped() > 0)
     doc << "\n" << trace.dropped() << " records of the loop were dropped (the ring was full).\n";
 

@@ -56,8 +56,7 @@ BladeStroke vertical_cut(double x, double bottom_z) {
 
 // The tissue's mass: the lumped masses less what the mass scaling added.
 double total_mass_kg(const SimModel& model) {
-  return std::accumulate(model.lumped_mass_kg.begin(), model.lumped_mass_kg.end(), 0.0) -
-         model.added_mass_kg;
+  return tissue_mass_kg(model);
 }
 double total_volume_m3(const SimModel& model) {
   return std::accumulate(model.rest_volume_m3.begin(), model.rest_volume_m3.end(), 0.0);
@@ -590,6 +589,20 @@ TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
   settings = {};
   settings.snap_min_shape_fraction = std::nan("");
   EXPECT_TRUE(validate(settings).has_value());
+  // The refinement, the height floor and the mass budget, each by its name.
+  const std::pair<double CuttingSettings::*, std::vector<double>> bad[] = {
+      {&CuttingSettings::refine_edge_m, {-0.001, std::nan(""), INFINITY}},
+      {&CuttingSettings::min_part_height_m, {0.0, -0.002, std::nan(""), INFINITY}},
+      {&CuttingSettings::max_added_mass_fraction, {-0.001, 0.5, std::nan("")}}};
+  const char* names[] = {"refinement edge", "smallest part height", "added mass fraction"};
+  for (std::size_t k = 0; k < std::size(bad); ++k)
+    for (double value : bad[k].second) {
+      settings = {};
+      settings.*bad[k].first = value;
+      const auto problem = validate(settings);
+      ASSERT_TRUE(problem.has_value()) << names[k] << " " << value << " was taken";
+      EXPECT_NE(problem->find(names[k]), std::string::npos) << *problem;
+    }
   EXPECT_FALSE(validate(CuttingSettings{}).has_value());
 }
 

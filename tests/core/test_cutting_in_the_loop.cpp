@@ -263,8 +263,7 @@ TEST_P(ShortStrokeTest, PartsTheTissueAndKeepsTheStep) {
                             c = after.rest_position_m.at(after.corner[kTetFace[f][2]][e]);
       cut_area_m2 += 0.25 * (b - a).cross(c - a).norm();
     }
-  double tissue_kg = -after.added_mass_kg;
-  for (double m : after.lumped_mass_kg) tissue_kg += m;
+  const double tissue_kg = tissue_mass_kg(after);
   std::cout << GetParam() << " tetrahedra asked: " << after.tet_count << " after (" << changes
             << " changes of the mesh), column " << thickest_m * 1e3 << " mm thick at ("
             << start.x() * 1e3 << ", " << start.y() * 1e3 << ") mm, cut " << cut_area_m2 * 1e4

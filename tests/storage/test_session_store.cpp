@@ -12,6 +12,7 @@
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -403,48 +404,50 @@ std::optional<std::string> other_build_than_the_digests() {
   return std::nullopt;
 }
 
-// A session recorded by `liversim-cli record` before the station existed (commit 0c1087a: 2.5 s
-// of a scripted scalpel drawn through the 1500-element built-in liver, two cuts, at 1 kHz;
-// tests/data/storage/session-v5-scalpel-cut.sqlite) still reads and replays to its end with its
-// cuts. Until the scalpel broke in by the tissue's toughness (issue 42) its replay gave that
-// commit's state to the last bit; a deliberate change of the cutting physics ends that, and the
-// bit-for-bit guard moved to a session recorded with the new physics (below).
-TEST(SessionReplay, ASessionRecordedBeforeTheStationStillReplaysToItsEndWithItsCuts) {
-  const ReplayedEnd end = replay_to_the_end(
-      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cut.sqlite",
-      "recorded-before-the-station");
+// Sessions recorded by engines before this one still read and replay to their end with their cuts
+// (each gave its recording's state to the last bit until a deliberate change of the cutting
+// physics; the bit-for-bit guard moved on to a session recorded with the new physics, below):
+// - before the station existed (commit 0c1087a: 2.5 s of a scripted scalpel drawn through the
+//   1500-element built-in liver, two cuts, at 1 kHz), until the scalpel broke in by the tissue's
+//   toughness;
+// - when a broken-in scalpel came to cut with the whole tool (cutting_edge_m): `liversim-cli record
+//   --tets 1500 --tool scalpel --duration 2.6 --trajectory
+//   tests/data/trajectories/free-practice-three-strokes.txt`, two cuts; recorded before the loop's
+//   step was kept with a session, it replays with the step its loop took then
+//   (legacy_loop_step_s, 4429 steps when recorded);
+// - once the loop's step was kept with it (the loop steps at 0.9 of the stable step, schema 6), by
+//   the same command; it replays with its own step.
+// The last two were bit for bit until cuts came to refine the mesh at the blade and give small
+// parts mass (issue 42).
+struct OlderSession {
+  const char* file;    // in tests/data/storage
+  const char* label;   // of its replay's working folder
+  double least_end_s;  // its recording's length, give or take its last cycle
+};
+
+class OlderSessionTest : public ::testing::TestWithParam<OlderSession> {};
+
+TEST_P(OlderSessionTest, StillReplaysToItsEndWithItsCuts) {
+  const OlderSession& older = GetParam();
+  const ReplayedEnd end =
+      replay_to_the_end(fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / older.file, older.label);
   EXPECT_GT(end.cuts, 0u) << "its scalpel cut nothing";
-  EXPECT_GT(end.time_s, 2.4);
+  EXPECT_GT(end.time_s, older.least_end_s);
 }
 
-// A session recorded when a broken-in scalpel came to cut with the whole tool (issue 42:
-// cutting_edge_m): `liversim-cli record --tets 1500 --tool scalpel --duration 2.6 --trajectory
-// tests/data/trajectories/free-practice-three-strokes.txt`, two cuts
-// (tests/data/storage/session-v5-scalpel-cuts-whole-tool.sqlite). Recorded before the loop's step
-// was kept with a session, it replays with the step its loop took then (legacy_loop_step_s), to
-// its end with its cuts. Its replay gave the recorded state to the last bit until cuts came to
-// refine the mesh around the blade and give small parts mass (issue 42); the bit-for-bit guard
-// moved to a session recorded with them (below).
-TEST(SessionReplay, ASessionRecordedBeforeItsLoopStepWasKeptReplaysToItsEndWithItsCuts) {
-  const ReplayedEnd end = replay_to_the_end(
-      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v5-scalpel-cuts-whole-tool.sqlite",
-      "recorded-cutting-with-the-whole-tool");
-  EXPECT_GT(end.cuts, 0u) << "its scalpel cut nothing";
-  // 4429 steps of the legacy step (the stable step) when recorded.
-  EXPECT_GT(end.time_s, 2.59);
-}
-
-// A session recorded once the loop's step was kept with it (issue 42: the loop steps at 0.9 of
-// the stable step, schema 6), by the same command as above
-// (tests/data/storage/session-v6-scalpel-cuts-loop-step.sqlite): it replays with its own step to
-// its end, with its cuts (bit for bit until cuts came to refine the mesh, as above).
-TEST(SessionReplay, ASessionRecordedWithItsLoopStepReplaysToItsEndWithItsCuts) {
-  const ReplayedEnd end = replay_to_the_end(
-      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v6-scalpel-cuts-loop-step.sqlite",
-      "recorded-with-its-loop-step");
-  EXPECT_GT(end.cuts, 0u) << "its scalpel cut nothing";
-  EXPECT_GT(end.time_s, 2.59);
-}
+INSTANTIATE_TEST_SUITE_P(SessionReplay, OlderSessionTest,
+                         ::testing::Values(OlderSession{"session-v5-scalpel-cut.sqlite",
+                                                        "recorded-before-the-station", 2.4},
+                                           OlderSession{"session-v5-scalpel-cuts-whole-tool.sqlite",
+                                                        "recorded-cutting-with-the-whole-tool",
+                                                        2.59},
+                                           OlderSession{"session-v6-scalpel-cuts-loop-step.sqlite",
+                                                        "recorded-with-its-loop-step", 2.59}),
+                         [](const ::testing::TestParamInfo<OlderSession>& info) {
+                           std::string name = info.param.label;
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
 
 // A session recorded once cuts refine the mesh around the blade and give their small parts mass
 // (issue 42), by the same command as above

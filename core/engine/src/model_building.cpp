@@ -254,6 +254,12 @@ void lump_node_masses(SimModel& model) {
   }
 }
 
+double tissue_mass_kg(const SimModel& model) {
+  double total_kg = -model.added_mass_kg;
+  for (double m : model.lumped_mass_kg) total_kg += m;
+  return total_kg;
+}
+
 void set_gravity(SimModel& model, const Eigen::Vector3d& gravity_m_per_s2,
                  std::shared_ptr<const SupportSurface> support) {
   if (!gravity_m_per_s2.allFinite())

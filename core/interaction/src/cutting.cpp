@@ -768,10 +768,7 @@ double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& 
                                  NodeArray* velocity_m_per_s) {
   constexpr int kMaxRounds = 24;
   constexpr double kTolerance = 1e-3, kAmplitudeFraction = 0.5;
-  const double tissue_kg =
-      std::accumulate(model.lumped_mass_kg.begin(), model.lumped_mass_kg.end(), 0.0) -
-      model.added_mass_kg;
-  const double budget_kg = max_added_mass_fraction * tissue_kg;
+  const double budget_kg = max_added_mass_fraction * tissue_mass_kg(model);
   double added_kg = 0.0;
   std::vector<Eigen::Matrix<double, 12, 12>> stiffness;
   LocalMode mode = top_mode_of_block(model, nodes, stiffness);
@@ -782,13 +779,14 @@ double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& 
     // (|φ_n|² = share_n / m_n, φ mass-normalised) is at least half the largest. Their masses times
     // s, the mode's shape kept, its Rayleigh quotient is ω² / (1 + (s − 1)·E), E their share of
     // its energy: s brings it to the ceiling.
+    auto amplitude = [&](std::size_t k) {
+      return mode.energy_share[k] / model.lumped_mass_kg[mode.node[k]];
+    };
     double largest = 0.0;
-    for (std::size_t k = 0; k < mode.node.size(); ++k)
-      largest = std::max(largest, mode.energy_share[k] / model.lumped_mass_kg[mode.node[k]]);
+    for (std::size_t k = 0; k < mode.node.size(); ++k) largest = std::max(largest, amplitude(k));
     double held = 0.0, moving_kg = 0.0;
     for (std::size_t k = 0; k < mode.node.size(); ++k)
-      if (mode.energy_share[k] / model.lumped_mass_kg[mode.node[k]] >=
-          kAmplitudeFraction * largest) {
+      if (amplitude(k) >= kAmplitudeFraction * largest) {
         held += mode.energy_share[k];
         moving_kg += model.lumped_mass_kg[mode.node[k]];
       }
@@ -799,13 +797,11 @@ double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& 
     // What is left of the budget, shared alike.
     const double share = std::min(1.0, (budget_kg - model.added_mass_kg) / (more * moving_kg));
     if (model.node_added_mass_kg.empty()) model.node_added_mass_kg.assign(model.node_count, 0.0);
-    std::vector<std::pair<NodeIndex, double>> adds;
+    // (lumped_mass_kg changes only with lump_node_masses below.)
     for (std::size_t k = 0; k < mode.node.size(); ++k) {
+      if (amplitude(k) < kAmplitudeFraction * largest) continue;
       const NodeIndex n = mode.node[k];
-      if (mode.energy_share[k] / model.lumped_mass_kg[n] < kAmplitudeFraction * largest) continue;
-      adds.emplace_back(n, share * more * model.lumped_mass_kg[n]);
-    }
-    for (const auto& [n, more_kg] : adds) {
+      const double more_kg = share * more * model.lumped_mass_kg[n];
       // Momentum kept: the mass brings no energy.
       if (velocity_m_per_s)
         velocity_m_per_s->set(n, velocity_m_per_s->at(n) * (model.lumped_mass_kg[n] /
@@ -924,9 +920,9 @@ void splits_of(const SimModel& model, std::size_t e, const std::vector<EdgeSplit
   std::sort(mine.begin(), mine.end());
 }
 
-// Leaves out of `splits` the edges of every element that would have a part thinner than the
-// mesh's smallest element (the explicit step would fall) or than `min_fraction` of its own
-// smallest height at rest or than `floor_m`, until none would.
+// Leaves out of `splits` the edges of every element that would have a part thinner at rest than
+// `min_fraction` of its own smallest height or than `floor_m` (the explicit step goes with the
+// smallest height), until none would.
 void refuse_thin_parts(const SimModel& model, const NodeArray& rest_m, double min_fraction,
                        double floor_m, std::vector<EdgeSplit>& splits,
                        const std::vector<std::uint8_t>* half_floor = nullptr) {
@@ -1206,19 +1202,23 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
 
 namespace {
 
-// What a cut on the model with the nodes made on edges knows from the cut before them.
+// What a cut on a model refined by the cut before it (nodes made on edges, or the mesh refined at
+// the blade's front) knows from that cut.
 struct AfterSplitting {
-  std::vector<std::uint8_t> may_touch;        // per element: part of one the sweep touched
+  // Per element: part of one the sweep touched (empty: every element may touch it).
+  std::vector<std::uint8_t> may_touch;
   std::vector<std::uint8_t> reshaped_around;  // per node: Refinement's
+  bool may_make_nodes = false;                // after the front's refinement, not after a split
 };
 
-// cut_tissue on a sweep. Without `after` nodes may be made on edges, and the cut then runs again
-// on the model with them, given what this one found.
 // The frequency a cut's mass scaling holds the model to: the uncut model's.
 double frequency_ceiling(const SimModel& model) {
   return model.uncut_frequency_rad_per_s > 0.0 ? model.uncut_frequency_rad_per_s
                                                : model.max_frequency_rad_per_s;
 }
+
+// cut_tissue on a sweep. Unless `after` says otherwise, nodes may be made on edges, and the cut
+// then runs again on the model with them, given what this one found.
 
 CutResult cut_along(const SimModel& model, const SimState& state, const SweepSurface& surface,
                     const CuttingSettings& settings, const AfterSplitting* after,
@@ -1249,7 +1249,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
            element_cutting_stress_pa(model, state, e) >= settings.cutting_stress_pa;
   };
   for (std::size_t e = 0; e < tets; ++e) {
-    if (after && !after->may_touch[e]) continue;
+    if (after && !after->may_touch.empty() && !after->may_touch[e]) continue;
     const auto p = corners_at(model, state.position_m, e);
     Aabb box;
     for (const auto& q : p) box.grow(q);
@@ -1310,11 +1310,13 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
       const Geometry as_is = geometry_as_is(model, state);
       Refinement refined =
           split_edges(model, state, as_is, std::vector<std::uint8_t>(model.node_count, 0), halves);
-      CuttingSettings once = settings;
-      once.refine_edge_m = 0.0;
-      CutResult cut = cut_along(*refined.model, refined.state, surface, once, nullptr);
+      // The cut on the refined model takes the refinement's parts into its mass scaling.
+      AfterSplitting refinement;
+      refinement.reshaped_around = refined.reshaped_around;
+      refinement.may_make_nodes = true;
+      CutResult cut = cut_along(*refined.model, refined.state, surface, settings, &refinement);
       if (!cut.cut()) {
-        // Nothing parted: the refined model stands, with its frequency estimated here.
+        // Nothing parted: the refined model stands, its small parts given mass here.
         SimModel& m = *refined.model;
         std::vector<NodeIndex> around;
         for (std::size_t n = 0; n < m.node_count; ++n)
@@ -1330,17 +1332,6 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
         std::iota(cut.node_origin.begin(), cut.node_origin.end(), 0);
         cut.element_origin.resize(m.tet_count);
         std::iota(cut.element_origin.begin(), cut.element_origin.end(), 0);
-      } else {
-        // The refined model's frequency rose around its parts too.
-        SimModel& m = const_cast<SimModel&>(*cut.model);
-        std::vector<NodeIndex> around;
-        for (std::size_t n = 0; n < m.node_count; ++n)
-          if (cut.node_origin[n] >= 0 && refined.reshaped_around[cut.node_origin[n]])
-            around.push_back(static_cast<NodeIndex>(n));
-        scale_masses_to_frequency(m, around, frequency_ceiling(model),
-                                  settings.max_added_mass_fraction, &cut.state.velocity_m_per_s);
-        open_energy_books(m, cut.state);
-        cut.report.added_mass_kg = m.added_mass_kg;
       }
       for (NodeIndex& n : cut.node_origin)
         if (n >= static_cast<NodeIndex>(model.node_count)) n = -1;
@@ -1426,7 +1417,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   // away from both ends (no node could be moved there), a node is made on that edge, and the cut
   // runs on the model with those nodes: its elements then lie each on one side, none goes whole
   // to the side of its centroid (which left islands of elements joined to nothing on their side).
-  if (!after) {
+  if (!after || after->may_make_nodes) {
     std::vector<EdgeSplit> splits, crossed;
     for (std::size_t e : zone) {
       if (!over_threshold[e]) continue;
@@ -1460,8 +1451,12 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
       // The parts of elements the sweep did not touch do not touch it either (an edge it crosses
       // is in every element holding it, all touched); the nodes moved or made onto it are on it,
       // and their elements touch it.
+      // (Nodes the front's refinement reshaped keep their numbers: split_edges appends.)
       AfterSplitting known;
       known.reshaped_around = refined.reshaped_around;
+      if (after)
+        for (std::size_t n = 0; n < model.node_count; ++n)
+          known.reshaped_around[n] |= after->reshaped_around[n];
       known.may_touch.resize(refined.model->tet_count);
       for (std::size_t i = 0; i < known.may_touch.size(); ++i)
         known.may_touch[i] = swept[refined.element_origin[i]];
@@ -1871,7 +1866,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   // that came free takes its share away).
   if (!model.node_added_mass_kg.empty()) {
     m.node_added_mass_kg.clear();
-    lump_masses(m);
+    lump_node_masses(m);
     std::vector<double> copies_kg(model.node_count, 0.0);
     for (std::size_t i = 0; i < m.node_count; ++i) copies_kg[origin[i]] += m.lumped_mass_kg[i];
     m.node_added_mass_kg.assign(m.node_count, 0.0);

@@ -31,6 +31,8 @@ void set_region_materials(SimModel& model, const std::vector<RegionMaterial>& re
 // rest volume before a cut) and its added mass (node_added_mass_kg), the total added, and the
 // inverse masses (0 on fixed nodes and on nodes no element holds).
 void lump_node_masses(SimModel& model);
+// The tissue's mass: the lumped masses less what the mass scaling added (kg).
+double tissue_mass_kg(const SimModel& model);
 
 // Switches gravity on with this acceleration (m/s², the mesh's axes; zero: off) and the support
 // the organ rests on (null: none), as build_model would make them, also on a cut model: the
