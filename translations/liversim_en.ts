@@ -22,6 +22,30 @@
     </message>
 </context>
 <context>
+    <name>liversim::MainWindow</name>
+    <message numerus="yes">
+        <source>Took %n specimen(s) out of the field.</source>
+        <translation>
+            <numerusform>Took %n specimen out of the field.</numerusform>
+            <numerusform>Took %n specimens out of the field.</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source> | %n piece(s) cut free: lift out or Session ▸ Remove Specimen</source>
+        <translation>
+            <numerusform> | %n piece cut free: lift out or Session ▸ Remove Specimen</numerusform>
+            <numerusform> | %n pieces cut free: lift out or Session ▸ Remove Specimen</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source> | %n specimen(s) taken out</source>
+        <translation>
+            <numerusform> | %n specimen taken out</numerusform>
+            <numerusform> | %n specimens taken out</numerusform>
+        </translation>
+    </message>
+</context>
+<context>
     <name>liversim::ScenarioPanel</name>
     <message numerus="yes">
         <source>%n lesion(s)</source>

@@ -1855,6 +1855,36 @@ The scene that was running goes on.</source>
         <source>The liver was cut while gravity was switched; switch it again.</source>
         <translation>切换重力时肝脏被切割了；请再次切换。</translation>
     </message>
+    <message>
+        <source>Remove &amp;Specimen</source>
+        <translation>取出标本(&amp;S)</translation>
+    </message>
+    <message>
+        <source>There is no specimen to remove: no piece has been cut free.</source>
+        <translation>没有可取出的标本：尚无切下的组织块。</translation>
+    </message>
+    <message numerus="yes">
+        <source>Took %n specimen(s) out of the field.</source>
+        <translation>
+            <numerusform>已从术野取出 %n 个标本。</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>Take the pieces cut free out of the field; they are kept as the session&apos;s specimen</source>
+        <translation>将切下的组织块移出术野；它们作为本次训练的标本保存</translation>
+    </message>
+    <message numerus="yes">
+        <source> | %n piece(s) cut free: lift out or Session ▸ Remove Specimen</source>
+        <translation>
+            <numerusform> | 已切下 %n 块组织：请取出，或使用 训练 ▸ 取出标本</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source> | %n specimen(s) taken out</source>
+        <translation>
+            <numerusform> | 已取出 %n 个标本</numerusform>
+        </translation>
+    </message>
 </context>
 <context>
     <name>liversim::MaterialPanel</name>

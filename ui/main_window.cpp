@@ -577,6 +577,15 @@ void MainWindow::buildMenus() {
       session->addAction(tr("&Mark the Lesion Here"), this, [this] { markLesionUnderTool(); });
   mark->setObjectName("markLesionAction");
   mark->setShortcut(QKeySequence(Qt::Key_M));
+  QAction* removeSpecimen = session->addAction(tr("Remove &Specimen"), this, [this] {
+    const int bodies = station_->take_out_specimens();
+    statusBar()->showMessage(bodies == 0
+                                 ? tr("There is no specimen to remove: no piece has been cut free.")
+                                 : tr("Took %n specimen(s) out of the field.", nullptr, bodies));
+  });
+  removeSpecimen->setObjectName("removeSpecimenAction");
+  removeSpecimen->setToolTip(
+      tr("Take the pieces cut free out of the field; they are kept as the session's specimen"));
   QAction* review =
       session->addAction(tr("&Review Sessions…"), this, [this] { openSessionReview(); });
   review->setObjectName("reviewSessionsAction");
@@ -853,6 +862,8 @@ void MainWindow::updateStatus() {
   if (const auto pull = mouseControl_->grabForce_n(snapshot.position_m))
     status.pullingForce_n = pull->norm();
   status.resectedVolume_m3 = snapshot.resected_volume_m3;
+  status.freeBodies = snapshot.free_bodies;
+  status.specimensTakenOut = snapshot.specimens_taken_out;
   statusLabel_->setText(simulationStatusText(status));
 }
 

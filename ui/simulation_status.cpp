@@ -56,6 +56,13 @@ QString simulationStatusText(const SimulationStatus& status) {
   if (status.resectedVolume_m3 > 0.0)
     text += QCoreApplication::translate("liversim::MainWindow", " | resected %1 mL")
                 .arg(status.resectedVolume_m3 * 1e6, 0, 'f', 1);
+  if (status.freeBodies > 0)
+    text += QCoreApplication::translate(
+        "liversim::MainWindow", " | %n piece(s) cut free: lift out or Session ▸ Remove Specimen",
+        nullptr, status.freeBodies);
+  if (status.specimensTakenOut > 0)
+    text += QCoreApplication::translate("liversim::MainWindow", " | %n specimen(s) taken out",
+                                        nullptr, status.specimensTakenOut);
   return text;
 }
 

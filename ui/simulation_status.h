@@ -17,6 +17,8 @@ struct SimulationStatus {
   RealtimeStats stats;
   std::optional<double> pullingForce_n;  // while the hand grabs
   double resectedVolume_m3 = 0.0;
+  int freeBodies = 0;         // pieces cut free, still in the field
+  int specimensTakenOut = 0;  // taken out of it
 };
 
 QString simulationStatusText(const SimulationStatus& status);

@@ -244,19 +244,64 @@ CutResult cut_the_top_off(const SimModel& model) {
                     cut_anything());
 }
 
-TEST(Cutting, CuttingAPieceFreeTakesItOutAndMeasuresTheResectedVolume) {
+// Issue 42: a piece a cut frees stays as a body of its own (a specimen to lift out), unless it is a
+// crumb under CuttingSettings::min_free_body_volume_m3.
+TEST(Cutting, APieceCutFreeStaysAsABodyOfItsOwnAndCountsAsResected) {
   const SimModel model = block_model();
   const double z = kTopCutZ;
   const CutResult cut = cut_the_top_off(model);
   ASSERT_TRUE(cut.cut());
   const double expected_volume = 0.06 * 0.05 * (0.04 - z);
   EXPECT_NEAR(cut.report.resected_volume_m3, expected_volume, 1e-9 * expected_volume);
-  EXPECT_NEAR(cut.report.resected_mass_kg, 1060.0 * expected_volume, 1e-9 * expected_volume);
+  EXPECT_NEAR(cut.report.freed_volume_m3, expected_volume, 1e-9 * expected_volume);
+  EXPECT_GT(cut.report.freed_elements, 0u);
+  EXPECT_EQ(cut.report.removed_elements, 0u);
+  const SimModel& after = *cut.model;
+  EXPECT_EQ(piece_count(after), 2u);
+  // Nothing is lost: the body keeps its mass.
+  EXPECT_NEAR(total_mass_kg(after), total_mass_kg(model), 1e-12 * total_mass_kg(model));
+  const std::vector<FreeBody> bodies = free_bodies(after);
+  ASSERT_EQ(bodies.size(), 1u);
+  EXPECT_EQ(bodies[0].elements.size(), cut.report.freed_elements);
+  EXPECT_NEAR(bodies[0].rest_volume_m3, expected_volume, 1e-9 * expected_volume);
+  const std::vector<std::uint8_t> organ = organ_elements(after);
+  for (std::size_t e = 0; e < after.tet_count; ++e) {
+    double lowest = INFINITY;
+    for (int c = 0; c < 4; ++c)
+      lowest = std::min(lowest, after.rest_position_m.z[after.corner[c][e]]);
+    EXPECT_EQ(organ[e] != 0, lowest < z - 1e-12) << "element " << e;  // the top is not organ
+  }
+  EXPECT_TRUE(boundary_is_manifold(after));
+  EXPECT_TRUE(elements_are_sound(after, cut.state));
+
+  // A second cut parts the body in two and grooves the organ under it: nothing more resected.
+  const BladeStroke through_body =
+      sweep_of({0.03, -0.01, 0.05}, {0.03, 0.06, 0.05}, {0.0, 0.0, -0.025});
+  const CutResult again = cut_tissue(after, cut.state, through_body, cut_anything());
+  ASSERT_TRUE(again.cut());
+  EXPECT_EQ(again.report.resected_volume_m3, 0.0);
+  EXPECT_EQ(free_bodies(*again.model).size(), 2u);
+}
+
+TEST(Cutting, ACrumbCutFreeIsTakenOutAndItsMassGoesWithIt) {
+  const SimModel model = block_model();
+  const double z = kTopCutZ;
+  CuttingSettings crumbs = cut_anything();
+  crumbs.min_free_body_volume_m3 = 1e-4;  // 100 cm³: the top (24 cm³) is a crumb
+  const CutResult cut =
+      cut_tissue(model, make_rest_state(model),
+                 sweep_of({-0.01, -0.01, z}, {-0.01, 0.06, z}, {0.08, 0.0, 0.0}), crumbs);
+  ASSERT_TRUE(cut.cut());
+  const double expected_volume = 0.06 * 0.05 * (0.04 - z);
+  EXPECT_NEAR(cut.report.resected_volume_m3, expected_volume, 1e-9 * expected_volume);
+  EXPECT_NEAR(cut.report.removed_mass_kg, 1060.0 * expected_volume, 1e-9 * expected_volume);
   EXPECT_GT(cut.report.removed_elements, 0u);
+  EXPECT_EQ(cut.report.freed_elements, 0u);
   const SimModel& after = *cut.model;
   EXPECT_EQ(piece_count(after), 1u);
+  EXPECT_TRUE(free_bodies(after).empty());
   // Lost mass is exactly what came off.
-  EXPECT_NEAR(total_mass_kg(after), total_mass_kg(model) - cut.report.resected_mass_kg,
+  EXPECT_NEAR(total_mass_kg(after), total_mass_kg(model) - cut.report.removed_mass_kg,
               1e-12 * total_mass_kg(model));
   for (std::size_t n = 0; n < after.node_count; ++n)
     EXPECT_LE(after.rest_position_m.z[n], z + 1e-12);
@@ -264,8 +309,54 @@ TEST(Cutting, CuttingAPieceFreeTakesItOutAndMeasuresTheResectedVolume) {
   EXPECT_TRUE(elements_are_sound(after, cut.state));
 }
 
+// Taking the body out leaves the organ a crumb's cut would have left: the same elements, nodes,
+// masses, positions and step.
+TEST(Cutting, TakingOutAFreeBodyLeavesWhatTakingItOutAtTheCutWouldHave) {
+  const SimModel model = block_model();
+  const CutResult kept = cut_the_top_off(model);
+  ASSERT_TRUE(kept.cut());
+  CuttingSettings crumbs = cut_anything();
+  crumbs.min_free_body_volume_m3 = INFINITY;
+  const CutResult at_once = cut_tissue(
+      model, make_rest_state(model),
+      sweep_of({-0.01, -0.01, kTopCutZ}, {-0.01, 0.06, kTopCutZ}, {0.08, 0.0, 0.0}), crumbs);
+  const std::vector<FreeBody> bodies = free_bodies(*kept.model);
+  ASSERT_EQ(bodies.size(), 1u);
+  const CutResult out = take_out_body(*kept.model, kept.state, bodies[0].elements.back());
+  ASSERT_TRUE(out.cut());
+  const SimModel& a = *out.model;
+  const SimModel& b = *at_once.model;
+  ASSERT_EQ(a.tet_count, b.tet_count);
+  ASSERT_EQ(a.node_count, b.node_count);
+  EXPECT_EQ(out.report.removed_elements, bodies[0].elements.size());
+  EXPECT_EQ(out.report.resected_volume_m3, 0.0);  // counted when it came free
+  // The body's mass, and the mass the cut's scaling gave its nodes (selective mass scaling).
+  EXPECT_NEAR(out.report.removed_mass_kg,
+              at_once.report.removed_mass_kg + kept.model->added_mass_kg - a.added_mass_kg,
+              1e-12 * total_mass_kg(model));
+  EXPECT_NEAR(total_mass_kg(a), total_mass_kg(b), 1e-12 * total_mass_kg(model));
+  for (std::size_t n = 0; n < a.node_count; ++n)
+    EXPECT_EQ(a.rest_position_m.at(n), b.rest_position_m.at(n)) << "node " << n;
+  EXPECT_EQ(a.stable_time_step_s, kept.model->stable_time_step_s);
+  EXPECT_TRUE(free_bodies(a).empty());
+  EXPECT_TRUE(boundary_is_manifold(a));
+  EXPECT_TRUE(elements_are_sound(a, out.state));
+  // The organ is not a free body.
+  EXPECT_THROW(take_out_body(a, out.state, 0), std::invalid_argument);
+  EXPECT_THROW(take_out_body(a, out.state, static_cast<TetIndex>(a.tet_count)),
+               std::invalid_argument);
+}
+
 TEST(Cutting, ANewDensityScalesTheMassesACutModelKept) {
-  const CutResult cut = cut_the_top_off(block_model());
+  // The top taken out at once: the cut adds no mass then (a top kept as a body holds thin elements
+  // that do), so that the masses double exactly.
+  CuttingSettings crumbs = cut_anything();
+  crumbs.min_free_body_volume_m3 = INFINITY;
+  const SimModel model = block_model();
+  const CutResult cut = cut_tissue(
+      model, make_rest_state(model),
+      sweep_of({-0.01, -0.01, kTopCutZ}, {-0.01, 0.06, kTopCutZ}, {0.08, 0.0, 0.0}), crumbs);
+  ASSERT_EQ(cut.model->added_mass_kg, 0.0);
   ASSERT_TRUE(cut.cut());
   // The same material again first: the cut's own frequency is a local estimate, this one the
   // whole model's power iteration.
@@ -392,7 +483,7 @@ TEST(CuttingRobustness, ThousandsOfRandomCutsThroughTheLiverKeepItSound) {
       if (!cut.cut()) continue;
       ++cuts_made;
       pieces_removed += cut.report.removed_elements > 0;
-      removed_mass += cut.report.resected_mass_kg;
+      removed_mass += cut.report.removed_mass_kg;
       model = cut.model;
       state = std::move(cut.state);
       const std::string where =

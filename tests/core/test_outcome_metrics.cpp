@@ -204,6 +204,13 @@ Scenario resection(double lesion_radius_mm, double margin_mm) {
   return scenario;
 }
 
+// A tracker that has followed the block through the cut (nothing taken out).
+OutcomeTracker tracker_before_take_out(const Block& block, const CutResult& cut) {
+  OutcomeTracker tracker(block.model, std::nullopt);
+  tracker.carry_over(cut);
+  return tracker;
+}
+
 double metric(const std::vector<MetricValue>& values, const std::string& name) {
   for (const MetricValue& v : values)
     if (v.name == name) return v.value;
@@ -257,6 +264,97 @@ TEST(OutcomeMetrics, ResectingTheTopOfABlockMeasuresMarginPlaneVolumeAndSuccess)
   EXPECT_EQ(metric(outcome_metric_values(m, &big), "lesion_breached"), 1.0);
 }
 
+// Issue 42: the top the cut freed stays as a body, the specimen. Worked out by hand: its volume is
+// the top's, 60 × 50 × 8 mm; the lesion's elements (the cell over x, y in 20–30 mm, z in 30–40 mm)
+// are all in it; its cut faces lie on z = 32 mm, 3 mm below the 2 mm ball around z = 37 mm.
+TEST(OutcomeMetrics, TheSpecimenHoldsTheLesionWithItsMarginAndIsR0WhenTheMarginSuffices) {
+  const Block block = lesion_block();
+  OutcomeTracker tracker(block.model, std::nullopt);
+  const CutResult cut = cut_top_off(block);
+  ASSERT_TRUE(cut.cut());
+  tracker.carry_over(cut);
+  const double spacing_mm = OutcomeSettings{}.margin_sample_spacing_mm;
+  const double top_mm3 = 60.0 * 50.0 * 8.0;
+  const Scenario wide = resection(2.0, 2.5);
+  OutcomeMetrics m = compute_outcome_metrics(block.model, *cut.model, tracker, &wide, {});
+  ASSERT_EQ(m.specimens.size(), 1u);
+  EXPECT_FALSE(m.specimens[0].taken_out);  // still in the field
+  EXPECT_NEAR(m.specimens[0].volume_mm3, top_mm3, 1e-9 * top_mm3);
+  ASSERT_EQ(m.specimens[0].lesions.size(), 1u);
+  EXPECT_TRUE(m.specimens[0].lesions[0].whole);
+  ASSERT_TRUE(m.specimens[0].lesions[0].margin);
+  EXPECT_FALSE(m.specimens[0].lesions[0].margin->breached);
+  std::vector<MetricValue> values = outcome_metric_values(m, &wide);
+  EXPECT_NEAR(metric(values, "specimen_volume_mm3"), top_mm3, 1e-9 * top_mm3);
+  EXPECT_EQ(metric(values, "specimen_contains_lesion"), 1.0);
+  EXPECT_GE(metric(values, "specimen_margin_mm"), 3.0 - 1e-9);
+  EXPECT_LE(metric(values, "specimen_margin_mm"), 3.0 + spacing_mm);
+  EXPECT_EQ(metric(values, "specimen_margin_mm:tumour"), metric(values, "specimen_margin_mm"));
+  EXPECT_EQ(metric(values, "specimen_r0"), 1.0);
+  EXPECT_TRUE(m.lesions[0].removed);  // out of the organ, in the specimen
+  EXPECT_EQ(m.task_success, std::optional<bool>(true));
+
+  // Taken out of the field, the specimen is measured the same.
+  const std::vector<FreeBody> bodies = free_bodies(*cut.model);
+  ASSERT_EQ(bodies.size(), 1u);
+  const CutResult removal = take_out_body(*cut.model, cut.state, bodies[0].elements.front());
+  tracker.take_out(*cut.model, bodies[0].elements, removal);
+  ASSERT_EQ(tracker.specimens_taken_out().size(), 1u);
+  const OutcomeMetrics out =
+      compute_outcome_metrics(block.model, *removal.model, tracker, &wide, {});
+  ASSERT_EQ(out.specimens.size(), 1u);
+  EXPECT_TRUE(out.specimens[0].taken_out);
+  EXPECT_NEAR(out.specimens[0].volume_mm3, top_mm3, 1e-9 * top_mm3);
+  const std::vector<MetricValue> out_values = outcome_metric_values(out, &wide);
+  EXPECT_EQ(metric(out_values, "specimen_margin_mm"), metric(values, "specimen_margin_mm"));
+  EXPECT_EQ(metric(out_values, "specimen_r0"), 1.0);
+  EXPECT_EQ(metric(out_values, "resected_volume_mm3"), metric(values, "resected_volume_mm3"));
+
+  // Against a 4 mm margin the same specimen is not R0; a 6 mm lesion reaches through the cut faces.
+  const Scenario narrow = resection(2.0, 4.0);
+  values = outcome_metric_values(
+      compute_outcome_metrics(block.model, *cut.model, tracker_before_take_out(block, cut), &narrow,
+                              {}),
+      &narrow);
+  EXPECT_EQ(metric(values, "specimen_contains_lesion"), 1.0);
+  EXPECT_EQ(metric(values, "specimen_r0"), 0.0);
+  const Scenario big = resection(6.0, 1.0);
+  values =
+      outcome_metric_values(compute_outcome_metrics(block.model, *cut.model,
+                                                    tracker_before_take_out(block, cut), &big, {}),
+                            &big);
+  EXPECT_EQ(metric(values, "specimen_margin_mm"), 0.0);
+  EXPECT_EQ(metric(values, "specimen_r0"), 0.0);
+}
+
+// A cut under the lesion's cell leaves part of it in the organ: the specimen does not hold the
+// lesion, it has no specimen margin, and R0 fails.
+TEST(OutcomeMetrics, ASpecimenHoldingPartOfTheLesionDoesNotContainIt) {
+  Block block = lesion_block();
+  for (std::size_t e = 0; e < block.model.tet_count; ++e) {  // the lesion's column down to 20 mm
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (int c = 0; c < 4; ++c)
+      centroid += block.model.rest_position_m.at(block.model.corner[c][e]) / 4.0;
+    if (centroid.x() > 0.02 && centroid.x() < 0.03 && centroid.y() > 0.02 && centroid.y() < 0.03 &&
+        centroid.z() > 0.02)
+      block.model.region[e] = 1;
+  }
+  OutcomeTracker tracker(block.model, std::nullopt);
+  const CutResult cut = cut_top_off(block);
+  ASSERT_TRUE(cut.cut());
+  tracker.carry_over(cut);
+  const Scenario scenario = resection(2.0, 1.0);
+  const OutcomeMetrics m = compute_outcome_metrics(block.model, *cut.model, tracker, &scenario, {});
+  ASSERT_EQ(m.specimens.size(), 1u);
+  ASSERT_EQ(m.specimens[0].lesions.size(), 1u);
+  EXPECT_FALSE(m.specimens[0].lesions[0].whole);
+  EXPECT_FALSE(m.lesions[0].removed);
+  const std::vector<MetricValue> values = outcome_metric_values(m, &scenario);
+  EXPECT_EQ(metric(values, "specimen_contains_lesion"), 0.0);
+  EXPECT_FALSE(has_metric(values, "specimen_margin_mm"));
+  EXPECT_EQ(metric(values, "specimen_r0"), 0.0);
+}
+
 TEST(OutcomeMetrics, BeforeAnyCutThereIsNoMarginNorPlaneDeviationAndTheLesionIsNotRemoved) {
   const Block block = lesion_block();
   OutcomeTracker tracker(block.model, std::nullopt);
@@ -271,6 +369,9 @@ TEST(OutcomeMetrics, BeforeAnyCutThereIsNoMarginNorPlaneDeviationAndTheLesionIsN
   EXPECT_FALSE(has_metric(values, "lesion_margin_mm"));
   EXPECT_FALSE(has_metric(values, "plane_deviation_mm"));
   EXPECT_EQ(metric(values, "resected_volume_mm3"), 0.0);
+  EXPECT_FALSE(has_metric(values, "specimen_volume_mm3"));
+  EXPECT_EQ(metric(values, "specimen_contains_lesion"), 0.0);
+  EXPECT_EQ(metric(values, "specimen_r0"), 0.0);
   // Free practice: no scenario, no task.
   const OutcomeMetrics free =
       compute_outcome_metrics(block.model, block.model, tracker, nullptr, {});

@@ -53,6 +53,29 @@ TEST(SessionEvents, GraspReleaseCutExcessiveForceAndRecoveryEachOnceWhenTheyHapp
   EXPECT_EQ(events[5].detail, "1 rollback(s)");
 }
 
+// A specimen taken out changes the model as a cut does; it is its own event, and a cut in the
+// same frame is still reported.
+TEST(SessionEvents, ASpecimenTakenOutIsItsOwnEventNotACut) {
+  SessionEventDetector detector;
+  std::vector<SessionEvent> events;
+  SimulationObservation o;
+  o.topology_version = 5;
+  detector.observe(0.0, o, events);
+  o.topology_version = 6;
+  o.specimens_taken_out = 1;
+  o.specimens_taken_out_m3 = 2.4e-5;
+  detector.observe(0.1, o, events);
+  ASSERT_EQ(kinds(events), std::vector<SessionEventKind>{SessionEventKind::specimen_removed});
+  EXPECT_EQ(events[0].detail, "2.4e+04 mm3");
+  EXPECT_EQ(session_event_name(events[0].kind), "specimen_removed");
+  events.clear();
+  o.topology_version = 8;  // a cut and another take-out between two frames
+  o.specimens_taken_out = 2;
+  detector.observe(0.2, o, events);
+  EXPECT_EQ(kinds(events), (std::vector<SessionEventKind>{SessionEventKind::specimen_removed,
+                                                          SessionEventKind::cut}));
+}
+
 TEST(SessionEvents, AGraspOrExcessiveForceAlreadyOnAtTheStartIsReported) {
   SessionEventDetector detector(1.5);
   std::vector<SessionEvent> events;

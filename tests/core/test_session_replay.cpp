@@ -52,7 +52,8 @@ std::vector<SimulationInput> every_kind_of_input() {
   cycle.servo_time_s = 12.345678901234567;
   SimulationInput untimed_cycle = input(SimulationInput::Kind::cycle);
   untimed_cycle.steps = 1;
-  return {tool, springs, cycle, no_tool, no_springs, untimed_cycle};
+  const SimulationInput take_out = input(SimulationInput::Kind::take_out_specimens);
+  return {tool, springs, cycle, take_out, no_tool, no_springs, untimed_cycle};
 }
 
 TEST(SessionLog, InputChunksReadBackExactly) {
@@ -104,7 +105,7 @@ TEST(SessionLog, ADamagedInputChunkIsRefusedNamingWhatIsWrong) {
   EXPECT_NE(decode_error(bytes).find("\"LSI1\""), std::string::npos) << decode_error(bytes);
   bytes = good;
   bytes.resize(bytes.size() - 3);
-  EXPECT_NE(decode_error(bytes).find("ends inside input 5"), std::string::npos)
+  EXPECT_NE(decode_error(bytes).find("ends inside input 6"), std::string::npos)
       << decode_error(bytes);
   bytes = good;
   bytes.push_back(0);
@@ -126,6 +127,14 @@ TEST(SessionLog, ADamagedInputChunkIsRefusedNamingWhatIsWrong) {
   bytes = encode_input_chunk(std::span(&cycle, 1));
   bytes[9] = 0;
   EXPECT_NE(decode_error(bytes).find("a cycle of 0 steps"), std::string::npos)
+      << decode_error(bytes);
+  // A take-out of specimens this version does not know (which: 0, every free body).
+  SimulationInput take_out;
+  take_out.kind = SimulationInput::Kind::take_out_specimens;
+  bytes = encode_input_chunk(std::span(&take_out, 1));
+  ASSERT_EQ(bytes.size(), 10u);
+  bytes[9] = 5;
+  EXPECT_NE(decode_error(bytes).find("takes out specimens 5"), std::string::npos)
       << decode_error(bytes);
 }
 

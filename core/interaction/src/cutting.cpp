@@ -46,6 +46,9 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
   if (!(settings.max_added_mass_fraction >= 0.0 && settings.max_added_mass_fraction <= 0.05))
     return out_of_range("added mass fraction", settings.max_added_mass_fraction,
                         "a value in [0, 0.05]");
+  if (!(settings.min_free_body_volume_m3 >= 0.0))  // infinity: every piece taken out
+    return out_of_range("smallest free body (m³)", settings.min_free_body_volume_m3,
+                        "a value >= 0 (infinity: take every freed piece out)");
   return std::nullopt;
 }
 
@@ -819,15 +822,20 @@ double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& 
 
 namespace {
 
+// A per-element (or per-node) array of the new model: entry i from entry origin[i] of the old
+// (left empty when empty).
+template <class Values, class Index>
+void take_from_origin(Values& values, const std::vector<Index>& origin) {
+  if (values.empty()) return;
+  Values kept(origin.size());
+  for (std::size_t i = 0; i < origin.size(); ++i) kept[i] = values[origin[i]];
+  values = std::move(kept);
+}
+
 // Each per-element array of the model (its material, shape and fibres; not the face marks) for the
 // elements of the new model, each from its element `origin[i]` of the old.
 void take_element_data(SimModel& m, const std::vector<TetIndex>& origin) {
-  auto take = [&](auto& per_element) {
-    if (per_element.empty()) return;
-    std::remove_reference_t<decltype(per_element)> kept(origin.size());
-    for (std::size_t i = 0; i < origin.size(); ++i) kept[i] = per_element[origin[i]];
-    per_element = std::move(kept);
-  };
+  auto take = [&](auto& per_element) { take_from_origin(per_element, origin); };
   for (auto& entry : m.dm_inverse) take(entry);
   take(m.rest_volume_m3);
   take(m.shear_modulus_pa);
@@ -1689,9 +1697,15 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   for (std::size_t n = 0; n < nodes_after_split; ++n)
     if (piece_volume[n] > 0.0 && (largest < 0 || piece_volume[n] > piece_volume[largest]))
       largest = static_cast<std::int32_t>(n);
-  auto keeps = [&](std::int32_t root) {
+  auto in_organ = [&](std::int32_t root) {
     return any_fixed ? piece_fixed[root] != 0 : root == largest;
   };
+  // A piece that came free stays as a body of its own unless it is a crumb.
+  auto keeps = [&](std::int32_t root) {
+    return in_organ(root) || piece_volume[root] >= settings.min_free_body_volume_m3;
+  };
+  // What was in the organ before this cut: what leaves it now is resected.
+  const std::vector<std::uint8_t> was_in_organ = organ_elements(model);
 
   // 6b. Flaps: an element the cut leaves joined to the rest through one face or none, with a
   // corner no other element holds. That corner carries a quarter of one small element's mass, and
@@ -1771,17 +1785,32 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
     if (any) return cut_along(model, state, surface, settings, after, front, &thinner);
   }
 
+  // A free body the merges left one element is a flap of its own: a crumb (a lone element's
+  // corners carry a quarter of its mass each and would set the explicit step).
+  std::vector<std::int32_t> unmerged(nodes_after_split, 0);
+  for (std::size_t e = 0; e < tets; ++e)
+    if (!merged[e]) ++unmerged[pieces.find(corner[0][e])];
+  auto stays = [&](std::int32_t root) {
+    return in_organ(root) || (keeps(root) && unmerged[root] >= 2);
+  };
+
   // 7. The new model: the kept elements (in their old order) and the nodes they use.
   std::vector<TetIndex> element_origin;
   element_origin.reserve(tets);
   for (std::size_t e = 0; e < tets; ++e) {
     if (merged[e]) continue;
-    if (keeps(pieces.find(corner[0][e]))) {
+    const std::int32_t piece = pieces.find(corner[0][e]);
+    const double volume_m3 = shape_of(corners_at(model, geometry.rest_m, e)).volume_m3;
+    if (was_in_organ[e] && !in_organ(piece)) report.resected_volume_m3 += volume_m3;
+    if (stays(piece)) {
       element_origin.push_back(static_cast<TetIndex>(e));
+      if (was_in_organ[e] && !in_organ(piece)) {
+        ++report.freed_elements;
+        report.freed_volume_m3 += volume_m3;
+      }
     } else {
       ++report.removed_elements;
-      report.resected_volume_m3 += shape_of(corners_at(model, geometry.rest_m, e)).volume_m3;
-      report.resected_mass_kg += geometry.element_mass_kg[e];
+      report.removed_mass_kg += geometry.element_mass_kg[e];
     }
   }
   if (element_origin.empty())
@@ -1804,13 +1833,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   SimModel& m = *next;
   m.node_count = kept_node_origin.size();
   m.tet_count = element_origin.size();
-  auto take = [&](auto& per_element) {
-    if (per_element.empty()) return;
-    std::remove_reference_t<decltype(per_element)> kept(element_origin.size());
-    for (std::size_t i = 0; i < element_origin.size(); ++i)
-      kept[i] = per_element[element_origin[i]];
-    per_element = std::move(kept);
-  };
+  auto take = [&](auto& per_element) { take_from_origin(per_element, element_origin); };
   for (int c = 0; c < 4; ++c) {
     m.corner[c].resize(element_origin.size());
     for (std::size_t i = 0; i < element_origin.size(); ++i)
@@ -1937,6 +1960,135 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     if (front.size() > 0) return cut_along(model, state, surface, settings, nullptr, &front);
   }
   return cut_along(model, state, surface, settings, nullptr);
+}
+
+}  // namespace liversim
+
+namespace liversim {
+
+namespace {
+
+// The model's connected pieces (elements joined through shared nodes): each node's piece root, and
+// per root whether it holds a fixed node and its rest volume.
+struct Pieces {
+  UnionFind joined;
+  std::vector<std::uint8_t> fixed;
+  std::vector<double> volume_m3;
+  std::int32_t organ_root = -1;  // of a model with no fixed node: the largest piece
+
+  explicit Pieces(const SimModel& model)
+      : joined(model.node_count), fixed(model.node_count, 0), volume_m3(model.node_count, 0.0) {
+    for (std::size_t e = 0; e < model.tet_count; ++e)
+      for (int c = 1; c < 4; ++c) joined.unite(model.corner[0][e], model.corner[c][e]);
+    bool any_fixed = false;
+    for (std::size_t n = 0; n < model.node_count; ++n)
+      if (model.is_fixed[n]) {
+        fixed[joined.find(static_cast<std::int32_t>(n))] = 1;
+        any_fixed = true;
+      }
+    for (std::size_t e = 0; e < model.tet_count; ++e)
+      volume_m3[joined.find(model.corner[0][e])] += model.rest_volume_m3[e];
+    if (any_fixed) return;
+    for (std::size_t n = 0; n < model.node_count; ++n)
+      if (volume_m3[n] > 0.0 && (organ_root < 0 || volume_m3[n] > volume_m3[organ_root]))
+        organ_root = static_cast<std::int32_t>(n);
+  }
+  std::int32_t of_element(const SimModel& model, std::size_t e) {
+    return joined.find(model.corner[0][e]);
+  }
+  bool in_organ(std::int32_t root) const {
+    return organ_root < 0 ? fixed[root] != 0 : root == organ_root;
+  }
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> organ_elements(const SimModel& model) {
+  Pieces pieces(model);
+  std::vector<std::uint8_t> organ(model.tet_count, 0);
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    organ[e] = pieces.in_organ(pieces.of_element(model, e)) ? 1 : 0;
+  return organ;
+}
+
+std::vector<FreeBody> free_bodies(const SimModel& model) {
+  Pieces pieces(model);
+  std::vector<FreeBody> bodies;
+  std::vector<std::int32_t> body_of_root(model.node_count, -1);
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const std::int32_t root = pieces.of_element(model, e);
+    if (pieces.in_organ(root)) continue;
+    if (body_of_root[root] < 0) {
+      body_of_root[root] = static_cast<std::int32_t>(bodies.size());
+      bodies.push_back({{}, pieces.volume_m3[root]});
+    }
+    bodies[body_of_root[root]].elements.push_back(static_cast<TetIndex>(e));
+  }
+  return bodies;
+}
+
+CutResult take_out_body(const SimModel& model, const SimState& state, TetIndex element) {
+  if (element < 0 || static_cast<std::size_t>(element) >= model.tet_count)
+    throw std::invalid_argument("take_out_body: element " + std::to_string(element) +
+                                " is not in the model of " + std::to_string(model.tet_count) +
+                                " elements");
+  Pieces pieces(model);
+  const std::int32_t body = pieces.of_element(model, static_cast<std::size_t>(element));
+  if (pieces.in_organ(body))
+    throw std::invalid_argument("take_out_body: element " + std::to_string(element) +
+                                " is in the organ, not in a free body");
+  CutResult result;
+  std::vector<TetIndex> element_origin;
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    if (pieces.of_element(model, e) == body) {
+      ++result.report.removed_elements;
+    } else {
+      element_origin.push_back(static_cast<TetIndex>(e));
+    }
+  }
+  std::vector<NodeIndex> new_index(model.node_count, -1), node_origin;
+  for (std::size_t n = 0; n < model.node_count; ++n)
+    if (pieces.joined.find(static_cast<std::int32_t>(n)) != body) {
+      new_index[n] = static_cast<NodeIndex>(node_origin.size());
+      node_origin.push_back(static_cast<NodeIndex>(n));
+    } else {  // the body's nodes are its own: their mass (added mass too) leaves with it
+      result.report.removed_mass_kg += model.lumped_mass_kg[n];
+    }
+  result.report.removed_nodes = model.node_count - node_origin.size();
+
+  auto next = std::make_shared<SimModel>(model);
+  SimModel& m = *next;
+  m.node_count = node_origin.size();
+  m.tet_count = element_origin.size();
+  for (int c = 0; c < 4; ++c) {
+    m.corner[c].resize(m.tet_count);
+    for (std::size_t i = 0; i < m.tet_count; ++i)
+      m.corner[c][i] = new_index[model.corner[c][element_origin[i]]];
+  }
+  take_element_data(m, element_origin);
+  take_from_origin(m.cut_face_mask, element_origin);
+  take_from_origin(m.boundary_face_mask, element_origin);
+  take_from_origin(m.element_mass_kg, element_origin);
+  take_from_origin(m.is_fixed, node_origin);
+  take_from_origin(m.node_added_mass_kg, node_origin);
+  m.rest_position_m.resize(m.node_count);
+  NodeArray position, velocity;
+  position.resize(m.node_count);
+  velocity.resize(m.node_count);
+  for (std::size_t i = 0; i < m.node_count; ++i) {
+    m.rest_position_m.set(i, model.rest_position_m.at(node_origin[i]));
+    position.set(i, state.position_m.at(node_origin[i]));
+    velocity.set(i, state.velocity_m_per_s.at(node_origin[i]));
+  }
+  m.added_mass_kg = 0.0;
+  for (double kg : m.node_added_mass_kg) m.added_mass_kg += kg;
+  lump_masses(m);
+  result.state =
+      carried_state(m, state, std::move(position), std::move(velocity), element_origin, true);
+  result.model = std::move(next);
+  result.node_origin = std::move(node_origin);
+  result.element_origin = std::move(element_origin);
+  return result;
 }
 
 }  // namespace liversim

@@ -100,6 +100,11 @@ constexpr MetricInfo kMetrics[] = {
     {"lesion_breached", "", "1 when the cut entered the lesion, else 0"},
     {"plane_deviation_mm", "mm", "mean distance of the cut from the planned plane"},
     {"task_success", "", "1 when the task's goal was reached, else 0"},
+    {"specimen_volume_mm3", "mm³", "volume of the specimens (pieces cut free, kept as bodies)"},
+    {"specimen_contains_lesion", "", "1 when the lesion is whole in one specimen, else 0"},
+    {"specimen_margin_mm", "mm", "least distance from the specimen's cut faces to the lesion"},
+    {"specimen_r0", "",
+     "1 when the specimen holds the whole lesion with the task's margin, else 0"},
 };
 
 // ---- Reading: a cursor over one JSON object that knows its path and collects errors.

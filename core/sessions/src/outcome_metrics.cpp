@@ -41,6 +41,10 @@ std::vector<Triangle> outer_surface_at_rest_m(const SimModel& model) {
   return triangles;
 }
 
+std::vector<SpecimenOutcome> measure_specimens(const SimModel& final_model,
+                                               const OutcomeTracker& tracker,
+                                               const Scenario& scenario, double spacing_m);
+
 }  // namespace
 
 Ellipsoid lesion_ellipsoid(const LesionSpec& lesion) {
@@ -200,6 +204,7 @@ OutcomeMetrics compute_outcome_metrics(const SimModel& initial_model, const SimM
   if (scenario == nullptr) return m;
 
   const std::vector<Triangle> cut_surface = cut_surface_at_rest_m(final_model);
+  const std::vector<std::uint8_t> organ = organ_elements(final_model);
   const double spacing_m = settings.margin_sample_spacing_mm * 1e-3;
   for (std::size_t i = 0; i < scenario->lesions.size(); ++i) {
     LesionOutcome lesion;
@@ -208,11 +213,14 @@ OutcomeMetrics compute_outcome_metrics(const SimModel& initial_model, const SimM
     const auto region = static_cast<std::int32_t>(i + 1);
     const bool initially_there = std::find(initial_model.region.begin(), initial_model.region.end(),
                                            region) != initial_model.region.end();
-    lesion.removed = initially_there &&
-                     std::find(final_model.region.begin(), final_model.region.end(), region) ==
-                         final_model.region.end();
+    // Out of the organ: taken out, or in a free body (a specimen still in the field).
+    bool in_organ = false;
+    for (std::size_t e = 0; e < final_model.tet_count && !in_organ; ++e)
+      in_organ = organ[e] && final_model.region[e] == region;
+    lesion.removed = initially_there && !in_organ;
     m.lesions.push_back(lesion);
   }
+  m.specimens = measure_specimens(final_model, tracker, *scenario, spacing_m);
   const TaskSpec& task = scenario->task;
   if (task.planned_plane)
     if (const auto deviation = mean_plane_distance_m(cut_surface, *task.planned_plane))
@@ -271,9 +279,112 @@ std::vector<MetricValue> outcome_metric_values(const OutcomeMetrics& m, const Sc
     values.push_back({"lesion_margin_mm", graded->margin_m * 1e3});
     values.push_back({"lesion_breached", graded->breached ? 1.0 : 0.0});
   }
+  append_specimen_values(m, scenario, values);
   if (m.plane_deviation_mm) values.push_back({"plane_deviation_mm", *m.plane_deviation_mm});
   if (m.task_success) values.push_back({"task_success", *m.task_success ? 1.0 : 0.0});
   return values;
+}
+
+namespace {
+
+// The lesion of each region (regions 1, 2, … are the scenario's lesions in order), or none.
+const LesionSpec* lesion_of_region(const Scenario& scenario, std::int32_t region) {
+  if (region < 1 || static_cast<std::size_t>(region) > scenario.lesions.size()) return nullptr;
+  return &scenario.lesions[static_cast<std::size_t>(region - 1)];
+}
+
+std::vector<Triangle> cut_faces_of(const Specimen& specimen) {
+  std::vector<Triangle> triangles;
+  for (std::size_t e = 0; e < specimen.rest_corners_m.size(); ++e)
+    for (int face = 0; face < 4; ++face)
+      if (specimen.cut_face_mask[e] & (1u << face)) {
+        Triangle t;
+        for (int k = 0; k < 3; ++k) t[k] = specimen.rest_corners_m[e][kTetFace[face][k]];
+        triangles.push_back(t);
+      }
+  return triangles;
+}
+
+std::vector<SpecimenOutcome> measure_specimens(const SimModel& final_model,
+                                               const OutcomeTracker& tracker,
+                                               const Scenario& scenario, double spacing_m) {
+  std::vector<Specimen> specimens = tracker.specimens_taken_out();
+  const std::size_t taken_out = specimens.size();
+  for (const FreeBody& body : free_bodies(final_model))
+    specimens.push_back(specimen_of(final_model, body.elements));
+  // Where each lesion's elements are: the organ, and each specimen.
+  const std::size_t lesions = scenario.lesions.size();
+  std::vector<std::size_t> in_organ(lesions, 0);
+  const std::vector<std::uint8_t> organ = organ_elements(final_model);
+  for (std::size_t e = 0; e < final_model.tet_count; ++e)
+    if (organ[e] && lesion_of_region(scenario, final_model.region[e]))
+      ++in_organ[static_cast<std::size_t>(final_model.region[e] - 1)];
+  std::vector<std::vector<std::size_t>> in_specimen(specimens.size(),
+                                                    std::vector<std::size_t>(lesions, 0));
+  for (std::size_t s = 0; s < specimens.size(); ++s)
+    for (const std::int32_t region : specimens[s].region)
+      if (lesion_of_region(scenario, region))
+        ++in_specimen[s][static_cast<std::size_t>(region - 1)];
+
+  std::vector<SpecimenOutcome> outcomes;
+  for (std::size_t s = 0; s < specimens.size(); ++s) {
+    SpecimenOutcome outcome;
+    outcome.volume_mm3 = specimens[s].rest_volume_m3 * 1e9;
+    outcome.taken_out = s < taken_out;
+    const std::vector<Triangle> cut_faces = cut_faces_of(specimens[s]);
+    for (std::size_t l = 0; l < lesions; ++l) {
+      if (in_specimen[s][l] == 0) continue;
+      SpecimenLesion lesion;
+      lesion.name = scenario.lesions[l].name;
+      std::size_t elsewhere = in_organ[l];
+      for (std::size_t other = 0; other < specimens.size(); ++other)
+        if (other != s) elsewhere += in_specimen[other][l];
+      lesion.whole = elsewhere == 0;
+      lesion.margin = lesion_margin(cut_faces, lesion_ellipsoid(scenario.lesions[l]), spacing_m);
+      outcome.lesions.push_back(lesion);
+    }
+    outcomes.push_back(std::move(outcome));
+  }
+  return outcomes;
+}
+
+}  // namespace
+
+void append_specimen_values(const OutcomeMetrics& m, const Scenario* scenario,
+                            std::vector<MetricValue>& values) {
+  if (scenario == nullptr) return;
+  double volume_mm3 = 0.0;
+  for (const SpecimenOutcome& specimen : m.specimens) volume_mm3 += specimen.volume_mm3;
+  if (!m.specimens.empty()) values.push_back({"specimen_volume_mm3", volume_mm3});
+  if (scenario->lesions.empty()) return;
+  // Each lesion: the specimen holding it whole, if any.
+  auto whole_in_specimen = [&](const std::string& name) -> const SpecimenLesion* {
+    for (const SpecimenOutcome& specimen : m.specimens)
+      for (const SpecimenLesion& lesion : specimen.lesions)
+        if (lesion.name == name && lesion.whole) return &lesion;
+    return nullptr;
+  };
+  const std::string& task_lesion = scenario->task.lesion;
+  bool contains = true;
+  std::optional<LesionMargin> graded;
+  for (const LesionSpec& spec : scenario->lesions) {
+    const bool graded_lesion = task_lesion.empty() || spec.name == task_lesion;
+    const SpecimenLesion* lesion = whole_in_specimen(spec.name);
+    if (graded_lesion) contains = contains && lesion != nullptr;
+    if (lesion == nullptr || !lesion->margin) continue;
+    values.push_back({"specimen_margin_mm:" + spec.name, lesion->margin->margin_m * 1e3});
+    if (!graded_lesion) continue;
+    if (!graded) graded = lesion->margin;
+    graded->margin_m = std::min(graded->margin_m, lesion->margin->margin_m);
+    graded->breached = graded->breached || lesion->margin->breached;
+  }
+  values.push_back({"specimen_contains_lesion", contains ? 1.0 : 0.0});
+  if (contains && graded) values.push_back({"specimen_margin_mm", graded->margin_m * 1e3});
+  if (scenario->task.kind == TaskKind::resect_lesion)
+    values.push_back({"specimen_r0", contains && graded && !graded->breached &&
+                                             graded->margin_m * 1e3 >= scenario->task.margin_mm
+                                         ? 1.0
+                                         : 0.0});
 }
 
 }  // namespace liversim

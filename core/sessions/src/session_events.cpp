@@ -20,14 +20,24 @@ SessionEventDetector::SessionEventDetector(double safe_force_n, double rearm_fra
 
 void SessionEventDetector::observe(double time_s, const SimulationObservation& now,
                                    std::vector<SessionEvent>& out) {
-  const SimulationObservation before =
-      first_ ? SimulationObservation{false, now.topology_version, 0.0, now.rollbacks,
-                                     now.resected_volume_m3}
-             : last_;
+  const SimulationObservation before = first_ ? SimulationObservation{false,
+                                                                      now.topology_version,
+                                                                      0.0,
+                                                                      now.rollbacks,
+                                                                      now.resected_volume_m3,
+                                                                      now.specimens_taken_out,
+                                                                      now.specimens_taken_out_m3}
+                                              : last_;
   first_ = false;
   if (now.grasping != before.grasping)
     out.push_back({time_s, now.grasping ? SessionEventKind::grasp : SessionEventKind::release, ""});
-  if (now.topology_version != before.topology_version)
+  // A take-out changes the model too: a cut is a change beyond them.
+  const int taken_out = now.specimens_taken_out - before.specimens_taken_out;
+  if (taken_out > 0)
+    out.push_back(
+        {time_s, SessionEventKind::specimen_removed,
+         text((now.specimens_taken_out_m3 - before.specimens_taken_out_m3) * 1e9, "mm3")});
+  if (now.topology_version - before.topology_version > static_cast<std::uint64_t>(taken_out))
     out.push_back(
         {time_s, SessionEventKind::cut,
          "resected " + text((now.resected_volume_m3 - before.resected_volume_m3) * 1e9, "mm3")});

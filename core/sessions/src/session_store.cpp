@@ -9,7 +9,7 @@ namespace liversim {
 
 namespace {
 
-constexpr std::array<std::string_view, 12> kEventNames = {"grasp",
+constexpr std::array<std::string_view, 13> kEventNames = {"grasp",
                                                           "release",
                                                           "cut",
                                                           "excessive_force",
@@ -20,7 +20,8 @@ constexpr std::array<std::string_view, 12> kEventNames = {"grasp",
                                                           "lesion_marked",
                                                           "integrator_changed",
                                                           "material_changed",
-                                                          "gravity_changed"};
+                                                          "gravity_changed",
+                                                          "specimen_removed"};
 
 // Layout 1: "LSF1", the frame count (u32), then one column per quantity, frame by frame: time,
 // position x, y, z, velocity x, y, z, force x, y, z (IEEE doubles), buttons (u32). Columns keep
@@ -274,6 +275,9 @@ std::vector<std::uint8_t> encode_input_chunk(std::span<const SimulationInput> in
         out.u8(input.check_energy ? 1 : 0);
         out.f64(input.servo_time_s);
         break;
+      case SimulationInput::Kind::take_out_specimens:
+        out.u8(0);  // which: every free body (the only choice so far)
+        break;
     }
   }
   return std::move(out.bytes());
@@ -330,6 +334,13 @@ std::vector<SimulationInput> decode_input_chunk(std::span<const std::uint8_t> by
                              " steps");
         input.check_energy = in.u8() != 0;
         input.servo_time_s = in.f64();
+        break;
+      case 3:
+        input.kind = SimulationInput::Kind::take_out_specimens;
+        if (const std::uint8_t which = in.u8(); which != 0)
+          throw StorageError("input " + std::to_string(in.input) +
+                             " of an input chunk takes out specimens " + std::to_string(which) +
+                             ", which is none this version knows (0: every free body)");
         break;
       default:
         throw StorageError("input " + std::to_string(in.input) + " of an input chunk has kind " +

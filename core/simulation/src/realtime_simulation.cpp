@@ -95,6 +95,16 @@ RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
   pending_springs_.reserve(options_.spring_capacity);
   active_springs_.reserve(options_.spring_capacity);
   checkpoint_ = make_checkpoint(*model_);
+  if (model_->node_count > 0) {
+    field_min_m_ = field_max_m_ = model_->rest_position_m.at(0);
+    for (std::size_t n = 1; n < model_->node_count; ++n) {
+      field_min_m_ = field_min_m_.cwiseMin(model_->rest_position_m.at(n));
+      field_max_m_ = field_max_m_.cwiseMax(model_->rest_position_m.at(n));
+    }
+    field_min_m_.array() -= kFieldMarginM;
+    field_max_m_.array() += kFieldMarginM;
+  }
+  free_bodies_ = free_bodies(*model_);
 }
 
 RealtimeSimulation::~RealtimeSimulation() {
@@ -204,15 +214,25 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     trace_->push(record);
   };
   if (!cut.cut()) return trace_cut(false);
+  const bool parted = cut.report.separated_faces > 0;
+  resected_volume_m3_ += cut.report.resected_volume_m3;
+  swap_in(std::move(cut));
+  trace_cut(parted);
+}
+
+void RealtimeSimulation::swap_in(CutResult change, std::span<const TetIndex> body) {
   {
     std::lock_guard lock(outcome_mutex_);
     if (outcome_) {
-      outcome_->tracker.carry_over(cut);
-      outcome_->model = cut.model;
+      if (body.empty())
+        outcome_->tracker.carry_over(change);
+      else
+        outcome_->tracker.take_out(*model_, body, change);
+      outcome_->model = change.model;
     }
   }
-  model_ = std::move(cut.model);
-  state_ = std::move(cut.state);
+  model_ = std::move(change.model);
+  state_ = std::move(change.state);
   checkpoint_ = make_checkpoint(*model_);
   const BoundarySurface surface = boundary_surface(*model_);
   tools_.emplace(*model_, surface, contact_settings_, grasp_settings_);
@@ -224,8 +244,37 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   }
   active_springs_.clear();
   ++topology_version_;
-  resected_volume_m3_ += cut.report.resected_volume_m3;
-  trace_cut(cut.report.separated_faces > 0);
+  free_bodies_ = free_bodies(*model_);
+}
+
+bool RealtimeSimulation::take_out_free_bodies(bool all) {
+  bool any = false;
+  for (bool again = true; again;) {
+    again = false;
+    for (const FreeBody& body : free_bodies_) {
+      if (!all) {  // the centroid of its elements' centroids, by volume
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        double volume = 0.0;
+        for (const TetIndex e : body.elements) {
+          Eigen::Vector3d middle = Eigen::Vector3d::Zero();
+          for (int c = 0; c < 4; ++c) middle += state_.position_m.at(model_->corner[c][e]);
+          centroid += 0.25 * model_->rest_volume_m3[e] * middle;
+          volume += model_->rest_volume_m3[e];
+        }
+        centroid /= volume;
+        if ((centroid.array() >= field_min_m_.array()).all() &&
+            (centroid.array() <= field_max_m_.array()).all())
+          continue;
+      }
+      const std::vector<TetIndex> elements = body.elements;  // swap_in refreshes the list
+      ++specimens_taken_out_;
+      specimens_taken_out_m3_ += body.rest_volume_m3;
+      swap_in(take_out_body(*model_, state_, elements.front()), elements);
+      any = again = true;
+      break;
+    }
+  }
+  return any;
 }
 
 void RealtimeSimulation::trace_loop(SpscRing<LoopRecord>* trace) {
@@ -363,6 +412,11 @@ void RealtimeSimulation::take_inputs() {
       if (!device_tool_) take_tool(pending_tool_);
     }
   }
+  if (take_out_requested_.exchange(false)) {
+    if (logging_inputs_.load(std::memory_order_relaxed))
+      log_input({SimulationInput::Kind::take_out_specimens, std::nullopt, {}, 0, false});
+    take_out_free_bodies(true);
+  }
   ServoFrame frame;
   if (haptic_servo_ && haptic_servo_->newest_frame(frame)) {
     device_sample_ = frame.sample;
@@ -467,6 +521,7 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   if (guarded.gave_up) halted_ = true;
   if (cutting_ && tool_acts && active_tool_->kind == ToolKind::scalpel && !guarded.gave_up)
     cut_with_scalpel(*active_tool_);
+  if (!free_bodies_.empty() && !guarded.gave_up) take_out_free_bodies(false);
   return guarded;
 }
 
@@ -523,6 +578,9 @@ void RealtimeSimulation::replay(std::span<const SimulationInput> inputs,
                                         std::to_string(model_->node_count) + " nodes");
         active_springs_.assign(input.springs.begin(), input.springs.end());
         break;
+      case SimulationInput::Kind::take_out_specimens:
+        take_out_free_bodies(true);
+        break;
       case SimulationInput::Kind::cycle: {
         if (halted_.load()) break;
         const std::uint64_t topology_before = topology_version_;
@@ -564,6 +622,9 @@ void RealtimeSimulation::publish_cycle() {
   out.model = model_;
   out.topology_version = topology_version_;
   out.resected_volume_m3 = resected_volume_m3_;
+  out.specimens_taken_out = specimens_taken_out_;
+  out.specimens_taken_out_m3 = specimens_taken_out_m3_;
+  out.free_bodies = static_cast<int>(free_bodies_.size());
   snapshots_.publish();
 }
 

@@ -65,10 +65,31 @@ void OutcomeTracker::carry_over(const CutResult& cut) {
   }
 }
 
+Specimen specimen_of(const SimModel& model, std::span<const TetIndex> elements) {
+  Specimen specimen;
+  specimen.rest_corners_m.reserve(elements.size());
+  for (const TetIndex e : elements) {
+    std::array<Eigen::Vector3d, 4> corners;
+    for (int c = 0; c < 4; ++c) corners[c] = model.rest_position_m.at(model.corner[c][e]);
+    specimen.rest_corners_m.push_back(corners);
+    specimen.region.push_back(model.region[e]);
+    specimen.cut_face_mask.push_back(model.cut_face_mask.empty() ? 0 : model.cut_face_mask[e]);
+    specimen.rest_volume_m3 += model.rest_volume_m3[e];
+  }
+  return specimen;
+}
+
+void OutcomeTracker::take_out(const SimModel& model, std::span<const TetIndex> body,
+                              const CutResult& removal) {
+  specimens_.push_back(specimen_of(model, body));
+  carry_over(removal);
+}
+
 double OutcomeTracker::damaged_volume_m3(const SimModel& model) const {
+  const std::vector<std::uint8_t> organ = organ_elements(model);  // not in specimens
   double volume = 0.0;
   for (std::size_t e = 0; e < model.tet_count && e < damaged_.size(); ++e)
-    if (damaged_[e]) volume += model.rest_volume_m3[e];
+    if (damaged_[e] && organ[e]) volume += model.rest_volume_m3[e];
   return volume;
 }
 

@@ -753,6 +753,12 @@ std::optional<Eigen::Vector3d> Workstation::mark_lesion_under_tool() {
   return rest_m;
 }
 
+int Workstation::take_out_specimens() {
+  const int bodies = simulation_->snapshot().free_bodies;
+  if (bodies > 0) simulation_->take_out_specimens();
+  return bodies;
+}
+
 void Workstation::compute_session_metrics(std::int64_t session,
                                           std::optional<OutcomeTracking> outcome,
                                           const WorkspaceMapping& mapping) {

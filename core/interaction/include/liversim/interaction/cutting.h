@@ -17,7 +17,9 @@
 // mesh's smallest element. Only where neither works does an element the surface passes through go
 // whole to the side of its centroid. A node whose parted surroundings would not be one manifold fan
 // keeps its faces joined (a small bridge the next stroke cuts), so the surface stays manifold.
-// Pieces that come free are taken out and their volume counted as resected.
+// A piece that comes free stays as a body of its own (a specimen: it deforms, falls under gravity
+// and can be grasped and lifted out) unless it is a crumb smaller than min_free_body_volume_m3,
+// which is taken out; either way its volume counts as resected. take_out_body removes a free body.
 //
 // The model stays constant between cuts: a cut makes a new model and state from the old ones.
 
@@ -72,6 +74,9 @@ struct CuttingSettings {
   // The most mass a cut may add (as a fraction of the tissue's) so that its small parts do not
   // lower the explicit step (scale_masses_to_frequency); past it the step falls instead.
   double max_added_mass_fraction = 0.005;
+  // A piece that comes free stays as a body of its own when its rest volume is at least this (a
+  // specimen); smaller pieces (crumbs) are taken out at once (infinity: every piece is taken out).
+  double min_free_body_volume_m3 = 1e-6;
 };
 
 // The problem with the settings, if any (a message naming the setting, its value and what is
@@ -124,10 +129,16 @@ struct CutReport {
   std::size_t elements_refined = 0;     // edges bisected to refine the mesh around the sweep
   std::size_t separated_faces = 0;
   std::size_t duplicated_nodes = 0;  // node copies made
-  std::size_t removed_elements = 0;  // in pieces that came free
+  // Pieces that came free and were taken out (crumbs under min_free_body_volume_m3).
+  std::size_t removed_elements = 0;
   std::size_t removed_nodes = 0;
-  double resected_volume_m3 = 0.0;  // rest volume of those pieces
-  double resected_mass_kg = 0.0;
+  double removed_mass_kg = 0.0;
+  // Pieces that came free and stay as bodies of their own (free_bodies).
+  std::size_t freed_elements = 0;
+  double freed_volume_m3 = 0.0;
+  // Rest volume of the organ this cut parted from it, crumbs and bodies alike (what a body already
+  // free loses to a cut is not counted again).
+  double resected_volume_m3 = 0.0;
   // Flaps the cut left hanging by one face or none, with a corner of their own: merged into a
   // neighbour that takes their mass (cut_tissue step 6b); their rest volume.
   std::size_t merged_elements = 0;
@@ -187,6 +198,22 @@ LocalMode local_top_mode(const SimModel& model, const std::vector<NodeIndex>& no
 double scale_masses_to_frequency(SimModel& model, const std::vector<NodeIndex>& nodes,
                                  double ceiling_rad_per_s, double max_added_mass_fraction,
                                  NodeArray* velocity_m_per_s = nullptr);
+
+// The bodies a cut freed: the model's connected pieces that hold no fixed node (of a model with
+// none, every piece but the largest, the organ). Each its elements, ascending, and rest volume.
+struct FreeBody {
+  std::vector<TetIndex> elements;
+  double rest_volume_m3 = 0.0;
+};
+std::vector<FreeBody> free_bodies(const SimModel& model);
+// Per element: 1 in the organ (not in a free body).
+std::vector<std::uint8_t> organ_elements(const SimModel& model);
+
+// The model and state without the free body holding `element` (its nodes and elements; the others
+// keep their order, mass, added mass and history; the stable step stays, as removing a body that
+// shares no node with the rest leaves the rest's frequencies as they were). The report counts it as
+// removed (not resected again). Throws std::invalid_argument when `element` is not in a free body.
+CutResult take_out_body(const SimModel& model, const SimState& state, TetIndex element);
 
 // The mesh of a model (rest positions, elements, regions), e.g. to extract its surface.
 TetMesh model_mesh(const SimModel& model);

@@ -17,7 +17,9 @@
 namespace liversim {
 
 struct SimulationInput {
-  enum class Kind : std::uint8_t { tool, springs, cycle };
+  // take_out_specimens: every free body (cutting.h) taken out of the field (Session ▸ Remove
+  // Specimen).
+  enum class Kind : std::uint8_t { tool, springs, cycle, take_out_specimens };
   Kind kind = Kind::cycle;
   std::optional<Tool> tool;         // tool: the tool from then on (none: taken away)
   std::vector<NodeSpring> springs;  // springs: the set springs from then on

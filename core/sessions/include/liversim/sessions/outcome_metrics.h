@@ -78,10 +78,25 @@ struct LesionOutcome {
   bool removed = false;                // none of its elements remain in the organ
 };
 
+// A specimen (a piece a cut freed, taken out or still in the field) and each lesion with tissue in
+// it: whether the whole lesion is in it (none of the lesion's elements anywhere else), and the
+// least distance from the lesion to the specimen's cut faces at rest (breached: they meet it).
+struct SpecimenLesion {
+  std::string name;
+  bool whole = false;
+  std::optional<LesionMargin> margin;
+};
+struct SpecimenOutcome {
+  double volume_mm3 = 0.0;  // at rest
+  bool taken_out = false;   // out of the field; else still in it at the end
+  std::vector<SpecimenLesion> lesions;
+};
+
 struct OutcomeMetrics {
   double tissue_damage_mm3 = 0.0;
   double resected_volume_mm3 = 0.0;
   std::vector<LesionOutcome> lesions;        // in the scenario's order
+  std::vector<SpecimenOutcome> specimens;    // taken out in order, then those still in the field
   std::optional<double> plane_deviation_mm;  // with a planned plane and a cut
   double lift_mm = 0.0;                      // retraction: the largest lift of the grasp point
   std::optional<bool> task_success;          // none without a scenario
@@ -98,9 +113,16 @@ OutcomeMetrics compute_outcome_metrics(const SimModel& initial_model, const SimM
 
 // Under their gradable names (gradable_metrics()): the task's lesion (or, with none named, the
 // least margin and any breach over all lesions) as lesion_margin_mm and lesion_breached, and each
-// lesion again as "lesion_margin_mm:NAME" and "lesion_breached:NAME". Metrics that are undefined
-// (no cut: no margin or plane deviation) are left out.
+// lesion again as "lesion_margin_mm:NAME" and "lesion_breached:NAME". The specimen: its volume
+// (all specimens), whether the task's lesion (with none named: every lesion) is whole in one
+// (specimen_contains_lesion), its margin there (specimen_margin_mm, and per lesion
+// "specimen_margin_mm:NAME"), and for a resection task whether that is R0 (specimen_r0: whole, not
+// breached, margin at least the task's). Metrics that are undefined (no cut: no margin or plane
+// deviation; no lesion whole in a specimen: no specimen margin) are left out.
 std::vector<MetricValue> outcome_metric_values(const OutcomeMetrics& metrics,
                                                const Scenario* scenario);
+// The specimen's of them.
+void append_specimen_values(const OutcomeMetrics& metrics, const Scenario* scenario,
+                            std::vector<MetricValue>& values);
 
 }  // namespace liversim

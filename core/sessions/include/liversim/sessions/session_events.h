@@ -1,7 +1,8 @@
 #pragma once
 // The events of a session that the simulation shows (grasp, release, cut, excessive force,
-// simulation recovery), found by comparing what it showed at successive display frames. Lesion
-// breaches and device faults are recorded where they are known (a cut's geometry, the servo).
+// simulation recovery, a specimen taken out), found by comparing what it showed at successive
+// display frames. Lesion breaches and device faults are recorded where they are known (a cut's
+// geometry, the servo).
 
 #include "liversim/sessions/session_store.h"
 
@@ -17,6 +18,10 @@ struct SimulationObservation {
   double tool_force_n = 0.0;           // |force of the tissue on the tool|
   int rollbacks = 0;                   // the guard's recoveries since the start
   double resected_volume_m3 = 0.0;     // since the start
+  // Free bodies taken out of the field since the start (each also raises topology_version), and
+  // their rest volume.
+  int specimens_taken_out = 0;
+  double specimens_taken_out_m3 = 0.0;
 };
 
 class SessionEventDetector {

@@ -64,6 +64,9 @@ enum class SessionEventKind {
   material_changed,
   // Gravity was switched on or off (detail: describe_gravity); a replay stops there too.
   gravity_changed,
+  // A free body was taken out of the field: lifted out, or Session ▸ Remove Specimen (detail: its
+  // rest volume in mm³).
+  specimen_removed,
 };
 std::string_view session_event_name(SessionEventKind kind);
 std::optional<SessionEventKind> session_event_kind(std::string_view name);

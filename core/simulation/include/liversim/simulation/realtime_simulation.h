@@ -59,7 +59,12 @@ struct SimulationSnapshot {
   // reader rebuilds what it draws from the mesh when the version changes.
   std::shared_ptr<const SimModel> model;
   std::uint64_t topology_version = 0;
-  double resected_volume_m3 = 0.0;  // taken out by cuts since the start
+  double resected_volume_m3 = 0.0;  // parted from the organ by cuts since the start
+  // Free bodies (cutting.h) taken out of the field since the start, and their rest volume.
+  int specimens_taken_out = 0;
+  double specimens_taken_out_m3 = 0.0;
+  // Free bodies in the model now (pieces a cut freed, still in the field).
+  int free_bodies = 0;
 };
 
 struct RealtimeStats {
@@ -221,6 +226,12 @@ class RealtimeSimulation {
   // after enable_tools.
   void enable_cutting(CuttingSettings settings = {});
   bool cutting_enabled() const { return cutting_.has_value(); }
+  // A free body (a piece a cut freed, cutting.h) leaves the simulation once its centroid is
+  // farther than kFieldMarginM outside the organ's box at rest (lifted out of the field), or, from
+  // any thread, at the next cycle after take_out_specimens (Session ▸ Remove Specimen: every free
+  // body). Each is kept by the outcome tracker as a specimen (OutcomeTracker::specimens_taken_out).
+  static constexpr double kFieldMarginM = 0.03;
+  void take_out_specimens() { take_out_requested_ = true; }
   // The tool's kind, pose and jaws from any thread (nothing: no tool in the scene); the newest
   // is used from the next cycle on.
   void set_tool(const std::optional<Tool>& tool);
@@ -319,6 +330,18 @@ class RealtimeSimulation {
   double blade_time_s_ = -1.0;  // when blade_middle_m_ was; < 0: not yet
   std::uint64_t topology_version_ = 0;
   double resected_volume_m3_ = 0.0;
+  // The field: the organ's box at rest, kFieldMarginM larger; the free bodies now (refreshed when
+  // the model changes) and those taken out.
+  Eigen::Vector3d field_min_m_ = Eigen::Vector3d::Zero(), field_max_m_ = Eigen::Vector3d::Zero();
+  std::vector<FreeBody> free_bodies_;
+  int specimens_taken_out_ = 0;
+  double specimens_taken_out_m3_ = 0.0;
+  std::atomic<bool> take_out_requested_{false};
+  // A cut's or a take-out's new model and state swapped in (tools, springs and tracking follow);
+  // `body`: the free body a take-out removed (kept as a specimen).
+  void swap_in(CutResult change, std::span<const TetIndex> body = {});
+  // Free bodies out of the field (or all of them) taken out; true if any was.
+  bool take_out_free_bodies(bool all);
   IntegratorKind integrator_kind_;  // the model's, fixed: stats() reads it from any thread
   // Extends the stroke with the scalpel's edge, cuts, and swaps in the cut model and state.
   void cut_with_scalpel(const Tool& scalpel);

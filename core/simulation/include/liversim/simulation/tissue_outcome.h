@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -31,6 +32,17 @@ struct DamageStrains {
 bool strained_beyond(const Eigen::Matrix3d& deformation_gradient, double tension_strain,
                      double compression_strain);
 
+// A free body as a specimen: its elements at rest (corners), their regions and faces made by cuts
+// (bit c: the face opposite corner c), what the specimen's measure needs
+// (sessions/outcome_metrics.h) once the body is gone from the model.
+struct Specimen {
+  std::vector<std::array<Eigen::Vector3d, 4>> rest_corners_m;
+  std::vector<std::int32_t> region;
+  std::vector<std::uint8_t> cut_face_mask;
+  double rest_volume_m3 = 0.0;
+};
+Specimen specimen_of(const SimModel& model, std::span<const TetIndex> elements);
+
 // Follows a session's simulation for what its end alone cannot tell: which tissue was ever
 // strained past the damage strain, how far the retraction point was lifted, what cuts took out.
 // Observed once per published simulation cycle (not per step); observe() allocates nothing.
@@ -45,11 +57,17 @@ class OutcomeTracker {
   // After a cut replaced the model: damage follows each element's origin; the node followed for
   // the lift, its first copy; the resected volume adds up.
   void carry_over(const CutResult& cut);
+  // A free body of `model` taken out of the field (`removal`: take_out_body's result): kept as a
+  // specimen, then carried over as a cut.
+  void take_out(const SimModel& model, std::span<const TetIndex> body, const CutResult& removal);
 
-  // Rest volume of the model's elements that were ever damaged (taken-out pieces no longer count).
+  // Rest volume of the organ's elements that were ever damaged (pieces cut free, taken out or
+  // not, no longer count).
   double damaged_volume_m3(const SimModel& model) const;
   double resected_volume_m3() const { return resected_volume_m3_; }
   double largest_lift_m() const { return largest_lift_m_; }
+  // The free bodies taken out so far, in order.
+  const std::vector<Specimen>& specimens_taken_out() const { return specimens_; }
   const DamageStrains& damage() const { return damage_; }
   // Per element of the current model: ever damaged.
   std::span<const std::uint8_t> damaged() const { return damaged_; }
@@ -60,6 +78,7 @@ class OutcomeTracker {
   double resected_volume_m3_ = 0.0;
   std::optional<NodeIndex> lift_node_;
   double largest_lift_m_ = 0.0;
+  std::vector<Specimen> specimens_;
 };
 
 // A session's outcome tracking as it stands: the tracker, the model its elements belong to (the

@@ -261,6 +261,11 @@ class Workstation {
   // Palpation: the rest point of the liver under the tool as the trainee's mark of the lesion (a
   // lesion_marked event). None without a session or a tool in the scene.
   std::optional<Eigen::Vector3d> mark_lesion_under_tool();
+  // Session ▸ Remove Specimen: every free body (a piece a cut freed) is taken out of the field at
+  // the simulation's next cycle, kept as a specimen of the session and logged as its input, so
+  // that a replay takes it out at the same step. The number of free bodies in the field now (0:
+  // nothing to take out, nothing asked).
+  int take_out_specimens();
   // Sessions whose metrics are being computed.
   int pending_metrics() const { return pending_metrics_; }
   // Waits for the metrics being computed and reports them.
