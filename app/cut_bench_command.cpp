@@ -211,8 +211,9 @@ std::function<std::optional<int>()> add_cut_bench_command(CLI::App& app) {
       "run, every second and every cut update as they came; writes cutting-live.md");
   auto* trajectory = command->add_option(
       "--trajectory", live->trajectory,
-      "--live: the scripted device's trajectory (device mm: time_s x_mm y_mm z_mm buttons; the "
-      "first button arms the blade)");
+      "--live: the scripted device's trajectory (device mm: time_s x_mm y_mm z_mm buttons "
+      "[tool]; the first button arms the blade or closes the forceps; the hand holds the scalpel "
+      "until the tool column says otherwise)");
   command->add_option("--scenario", live->scenario,
                       "--live: the scenario to cut (default: free practice at --tets)");
   return [command, options, live, live_asked, trajectory]() -> std::optional<int> {

@@ -8,6 +8,7 @@
 #include "liversim/meshing/default_scene.h"
 #include "liversim/scenario/scenario.h"
 #include "liversim/simulation/realtime_simulation.h"
+#include "liversim/station/scripted_tools.h"
 #include "liversim/station/workstation.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "record_command.h"
@@ -59,9 +60,13 @@ std::string ms_text(double seconds) {
 int run_live_cut_bench(const LiveCutBenchOptions& o) {
   std::vector<TrajectoryPoint> script;
   std::optional<OpenedScenario> scenario;
+  std::optional<ScriptedTools> tools;  // the scalpel, unless the trajectory's tool column says
   try {
-    script = load_trajectory(o.trajectory);
+    TrajectoryFile file = read_trajectory_file(o.trajectory);
+    script = std::move(file.points);
     scenario = open_scenario_to_run(o.scenario);
+    tools.emplace(ToolKind::scalpel, std::move(file.tool_changes),
+                  scenario ? scenario->scenario.tools : std::vector<ToolKind>{});
   } catch (const std::exception& e) {
     return fail(e.what());
   }
@@ -84,8 +89,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   const Eigen::Quaterniond view_axes = opening_view_device_axes();
   StationListener listener;
   listener.device_tool = [&]() -> std::optional<DeviceToolSettings> {
+    if (!tools->held()) return std::nullopt;
     DeviceToolSettings held;
-    held.kind = ToolKind::scalpel;
+    held.kind = *tools->held();
     held.orientation = tool_orientation_from_view(view_axes);
     return held;
   };
@@ -120,6 +126,7 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   const double begin_s = servo.now_s();
   while (servo.now_s() - begin_s < duration_s && fault.empty()) {
     std::this_thread::sleep_for(std::chrono::duration<double>(kFramePeriodS));
+    tools->advance(servo.now_s() - begin_s, servo.now_s(), *station);
     station->frame();
     for (LoopRecord record; trace.pop(record);) records.push_back(record);
   }

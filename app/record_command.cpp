@@ -5,6 +5,7 @@
 #include "liversim/haptics/haptics.h"
 #include "liversim/meshing/default_scene.h"
 #include "liversim/scenario/scenario.h"
+#include "liversim/station/scripted_tools.h"
 #include "liversim/station/workstation.h"
 #include "liversim/storage/sqlite_session_store.h"
 
@@ -124,11 +125,14 @@ int record(const RecordOptions& options) {
   // Input first (a bad file is said before anything slow), then the database, then the scene.
   std::vector<TrajectoryPoint> script;
   std::optional<OpenedScenario> scenario;
-  std::optional<ToolKind> tool;
+  std::optional<ScriptedTools> tools;  // --tool, then the trajectory's tool column
   try {
-    script = load_trajectory(options.trajectory);  // its errors name the file and the line
+    TrajectoryFile file = read_trajectory_file(options.trajectory);  // errors name file and line
+    script = std::move(file.points);
     scenario = open_scenario_to_run(options.scenario);
-    tool = held_tool(options, scenario ? &scenario->scenario : nullptr);
+    const Scenario* allowed = scenario ? &scenario->scenario : nullptr;
+    tools.emplace(held_tool(options, allowed), std::move(file.tool_changes),
+                  allowed ? allowed->tools : std::vector<ToolKind>{});
   } catch (const std::exception& e) {
     return fail(e.what());
   }
@@ -155,9 +159,9 @@ int record(const RecordOptions& options) {
   std::optional<SessionMetricsOutcome> metrics;
   StationListener listener;
   listener.device_tool = [&]() -> std::optional<DeviceToolSettings> {
-    if (!tool) return std::nullopt;
+    if (!tools->held()) return std::nullopt;
     DeviceToolSettings held;
-    held.kind = *tool;
+    held.kind = *tools->held();
     held.orientation = tool_orientation_from_view(view_axes);
     return held;
   };
@@ -200,7 +204,8 @@ int record(const RecordOptions& options) {
   std::cout << "recording session " << session << " to " << options.database.string() << ": "
             << (station->scenario() ? station->scenario()->scenario.title : "Free practice") << " ("
             << station->setup().mesh.tet_count() << " tetrahedra), " << station->device_name()
-            << ", tool " << options.tool << ", " << number(duration_s) << " s" << std::endl;
+            << ", tool " << (tools->held() ? tool_name(*tools->held()) : "hand") << ", "
+            << number(duration_s) << " s" << std::endl;
   ServoLoop& servo = *station->servo();
   const double begin_s = servo.now_s();
   double next_progress_s = begin_s + options.progress_s.value_or(INFINITY);
@@ -211,6 +216,7 @@ int record(const RecordOptions& options) {
     stop_signal =
         wait_for_stop_signal(stop_signals, std::min(kFramePeriodS, duration_s - (now_s - begin_s)));
     if (stop_signal != 0) break;
+    tools->advance(servo.now_s() - begin_s, servo.now_s(), *station);  // the script's tools
     station->frame();
     if (failure) break;
     if (!device_fault.empty()) {
@@ -286,7 +292,9 @@ std::function<std::optional<int>()> add_record_command(CLI::App& app) {
   command
       ->add_option("--trajectory", options->trajectory,
                    "Trajectory the scripted device plays, in device millimetres (a line per "
-                   "point: time_s x_mm y_mm z_mm buttons); it holds its last point after the end")
+                   "point: time_s x_mm y_mm z_mm buttons [tool]; a tool, hand, probe, forceps or "
+                   "scalpel, is what the hand holds from that point on); it holds its last point "
+                   "after the end")
       ->required();
   command
       ->add_option("--database", options->database, "Sessions database (.sqlite), created if new")
@@ -302,9 +310,11 @@ std::function<std::optional<int>()> add_record_command(CLI::App& app) {
                    "and VmHWM in MiB")
       ->check(CLI::PositiveNumber);
   command
-      ->add_option("--tool", options->tool,
-                   "Tool the device holds: hand (none, the workstation's default), probe, "
-                   "forceps or scalpel; its first button closes the forceps or arms the scalpel")
+      ->add_option(
+          "--tool", options->tool,
+          "Tool the device holds: hand (none, the workstation's default), probe, "
+          "forceps or scalpel, until the trajectory's tool column says otherwise; its first "
+          "button closes the forceps or arms the scalpel")
       ->capture_default_str();
   return [options, command, tets]() -> std::optional<int> {
     if (!command->parsed()) return std::nullopt;

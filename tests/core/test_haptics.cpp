@@ -470,11 +470,29 @@ TEST(Trajectory, FilesRoundTripAndBadLinesAreNamed) {
             std::string::npos);
   EXPECT_NE(problem_with("0 0 0 0 0\n0 1 1 1 0\n").find(":2: time 0"), std::string::npos);
   EXPECT_NE(problem_with("0 0 0 nan 0\n").find("not finite"), std::string::npos);
-  EXPECT_NE(problem_with("0 0 0 0 0 7\n").find("more than five"), std::string::npos);
+  EXPECT_NE(problem_with("0 0 0 0 0 scalpel 7\n").find("more than six fields ('7')"),
+            std::string::npos);
+  EXPECT_NE(problem_with("0 0 0 0 0 7\n").find("'7' is no tool"), std::string::npos);
+  EXPECT_NE(problem_with("0 0 0 0 0 " + std::string(5000, 'x') + "\n").find("'xxx"),
+            std::string::npos);
+  EXPECT_LT(problem_with("0 0 0 0 0 " + std::string(5000, 'x') + "\n").size(), 300u);
   EXPECT_NE(problem_with("0 0 0 0 1.5\n").find("buttons 1.5"), std::string::npos);
   EXPECT_NE(problem_with("0 0 0x1 0 0\n").find("'0x1' is not a number"), std::string::npos);
   EXPECT_NE(problem_with("# nothing\n").find("no trajectory points"), std::string::npos);
   EXPECT_THROW(load_trajectory(dir / "missing.txt"), std::runtime_error);
+
+  // The tool column: what the hand holds from that point on; old five-column files still read.
+  std::ofstream(dir / "tools.txt") << "0 0 0 0 0 scalpel\n1 0 0 -5 1\n2 0 0 0 0 forceps\n"
+                                      "3 0 0 0 1\n4 0 0 0 0 hand\n";
+  const TrajectoryFile with_tools = read_trajectory_file(dir / "tools.txt");
+  ASSERT_EQ(with_tools.points.size(), 5u);
+  ASSERT_EQ(with_tools.tool_changes.size(), 3u);
+  EXPECT_EQ(with_tools.tool_changes[0].time_s, 0.0);
+  EXPECT_EQ(with_tools.tool_changes[0].tool, "scalpel");
+  EXPECT_EQ(with_tools.tool_changes[1].time_s, 2.0);
+  EXPECT_EQ(with_tools.tool_changes[1].tool, "forceps");
+  EXPECT_EQ(with_tools.tool_changes[2].tool, "hand");
+  EXPECT_TRUE(read_trajectory_file(dir / "path.txt").tool_changes.empty());
   std::filesystem::remove_all(dir);
 }
 

@@ -121,6 +121,40 @@ TEST(CliRecord, RecordsACompleteSessionWithEveryServoFrameItsInputLogAndItsMetri
         << expected;
 }
 
+// The trajectory's tool column puts tools in the hand at its times, as the Tool panel does: each
+// a tool_selected event, in order (the --tool given is held only until the first).
+TEST(CliRecord, TheTrajectorysToolColumnChangesTheToolAtItsTimes) {
+  const fs::path folder = fresh_folder("tools");
+  const fs::path database = folder / "sessions.sqlite";
+  const fs::path trajectory = folder / "tools.txt";
+  std::ofstream(trajectory) << "0 0 0 0 0 forceps\n0.5 0 0 -5 0\n0.8 0 0 0 0 scalpel\n"
+                               "1.2 0 0 0 0 hand\n2 0 0 0 0\n";
+  const pid_t cli = spawn(record_arguments(trajectory, database, 1.6), folder);
+  ASSERT_GT(cli, 0);
+  ASSERT_EQ(wait_for(cli), 0) << read_text(folder / "stderr.txt");
+  EXPECT_NE(read_text(folder / "stdout.txt").find("tool forceps"), std::string::npos)
+      << read_text(folder / "stdout.txt");
+  SqliteSessionStore store(database, SqliteSessionStore::Access::read_only);
+  std::vector<std::string> chosen;
+  for (const SessionEvent& event : store.events(store.sessions().at(0).id))
+    if (event.kind == SessionEventKind::tool_selected) chosen.push_back(event.detail);
+  EXPECT_EQ(chosen, (std::vector<std::string>{"forceps", "scalpel", "hand"}));
+
+  // A tool the scenario does not allow is refused before anything runs.
+  std::ofstream(trajectory) << "0 0 0 0 0 scalpel\n1 0 0 0 0 hand\n";
+  const fs::path palpation =
+      fs::path(LIVERSIM_TEST_DATA_DIR) / ".." / ".." / "scenarios" / "palpation-hidden-lesion.json";
+  const pid_t refused =
+      spawn({LIVERSIM_CLI, "record", "--scenario", palpation.string(), "--trajectory",
+             trajectory.string(), "--database", (folder / "refused.sqlite").string()},
+            folder);
+  ASSERT_GT(refused, 0);
+  EXPECT_EQ(wait_for(refused), 2);
+  EXPECT_NE(read_text(folder / "stderr.txt").find("scalpel, is not a tool the scenario allows"),
+            std::string::npos)
+      << read_text(folder / "stderr.txt");
+}
+
 TEST(CliRecordCrash, KilledMidSessionItLosesNothingCommittedAndTheNextRunRecovers) {
   const fs::path folder = fresh_folder("killed");
   const fs::path database = folder / "sessions.sqlite";

@@ -47,10 +47,22 @@ Eigen::Vector3d ManualDevice::last_force_n() {
   return force_.front();
 }
 
+namespace {
+// A word of a file as a message shows it: at most 40 characters.
+std::string shown_word(const std::string& word) {
+  return word.size() > 40 ? word.substr(0, 37) + "..." : word;
+}
+}  // namespace
+
 std::vector<TrajectoryPoint> load_trajectory(const std::filesystem::path& file) {
+  return read_trajectory_file(file).points;
+}
+
+TrajectoryFile read_trajectory_file(const std::filesystem::path& file) {
   std::ifstream in(file);
   if (!in) throw std::runtime_error("cannot read the trajectory file " + file.string());
-  std::vector<TrajectoryPoint> points;
+  TrajectoryFile read;
+  std::vector<TrajectoryPoint>& points = read.points;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
@@ -60,10 +72,13 @@ std::vector<TrajectoryPoint> load_trajectory(const std::filesystem::path& file) 
     if (words.empty()) continue;  // blank or comment
     auto problem = [&](const std::string& what) {
       return std::runtime_error(file.string() + ":" + std::to_string(number) + ": " + what +
-                                " (expected: time_s x_mm y_mm z_mm buttons)");
+                                " (expected: time_s x_mm y_mm z_mm buttons [tool])");
     };
     if (words.size() < 5) throw problem("not five numbers");
-    if (words.size() > 5) throw problem("more than five fields ('" + words[5] + "')");
+    if (words.size() > 6) throw problem("more than six fields ('" + shown_word(words[6]) + "')");
+    if (words.size() == 6 && std::find(kTrajectoryTools.begin(), kTrajectoryTools.end(),
+                                       words[5]) == kTrajectoryTools.end())
+      throw problem("'" + shown_word(words[5]) + "' is no tool: hand, probe, forceps or scalpel");
     double numbers[5];
     for (int i = 0; i < 5; ++i) {
       const std::string& word = words[i];
@@ -84,9 +99,10 @@ std::vector<TrajectoryPoint> load_trajectory(const std::filesystem::path& file) 
                     std::to_string(points.back().time_s) + " s");
     point.buttons = static_cast<std::uint32_t>(buttons);
     points.push_back(point);
+    if (words.size() == 6) read.tool_changes.push_back({point.time_s, words[5]});
   }
   if (points.empty()) throw std::runtime_error(file.string() + ": no trajectory points");
-  return points;
+  return read;
 }
 
 void save_trajectory(const std::filesystem::path& file,

@@ -7,9 +7,11 @@
 #include "liversim/haptics/servo_loop.h"
 #include "liversim/haptics/triple_buffer.h"
 
+#include <array>
 #include <filesystem>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace liversim {
@@ -53,9 +55,25 @@ struct TrajectoryPoint {
   std::uint32_t buttons = 0;
 };
 
-// A trajectory file: one point per line, `time_s x_mm y_mm z_mm buttons`, whitespace-separated,
-// times strictly increasing; `#` starts a comment. Throws std::runtime_error naming the file, the
-// line and what is wrong.
+// What the hand holds from a time on, as a trajectory file says: one of kTrajectoryTools.
+struct TrajectoryToolChange {
+  double time_s = 0.0;
+  std::string tool;
+};
+inline constexpr std::array<std::string_view, 4> kTrajectoryTools = {"hand", "probe", "forceps",
+                                                                     "scalpel"};
+struct TrajectoryFile {
+  std::vector<TrajectoryPoint> points;
+  std::vector<TrajectoryToolChange> tool_changes;  // in time order; empty: the tool is not set
+};
+
+// A trajectory file: one point per line, `time_s x_mm y_mm z_mm buttons [tool]`,
+// whitespace-separated, times strictly increasing; `#` starts a comment. The optional tool (hand,
+// probe, forceps or scalpel) is what the hand holds from that point on, which the one playing the
+// trajectory puts in it (liversim-cli record). Throws std::runtime_error naming the file, the line
+// and what is wrong.
+TrajectoryFile read_trajectory_file(const std::filesystem::path& file);
+// Its points alone.
 std::vector<TrajectoryPoint> load_trajectory(const std::filesystem::path& file);
 void save_trajectory(const std::filesystem::path& file, const std::vector<TrajectoryPoint>& points);
 
