@@ -138,6 +138,11 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   // The mass the cuts added to keep the step (selective mass scaling), against the tissue's.
   const double added_mass_kg = end_model ? end_model->added_mass_kg : 0.0;
   const double tissue_kg = end_model ? tissue_mass_kg(*end_model) : 0.0;
+  // The pieces the cuts freed and left in the field (specimens), and their volume.
+  const std::vector<FreeBody> bodies =
+      end_model ? free_bodies(*end_model) : std::vector<FreeBody>{};
+  double bodies_m3 = 0.0;
+  for (const FreeBody& body : bodies) bodies_m3 += body.rest_volume_m3;
   station.reset();
   fs::remove(database);
   if (!fault.empty()) return fail("the scripted device stopped: " + fault);
@@ -234,7 +239,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << added_mass_kg * 1e3 << " g, " << std::setprecision(3)
       << (tissue_kg > 0.0 ? 100.0 * added_mass_kg / tissue_kg : 0.0) << " % of the tissue's "
       << std::setprecision(0) << tissue_kg * 1e3 << " g (bound: " << std::setprecision(1)
-      << 100.0 * CuttingSettings{}.max_added_mass_fraction << " %).\n";
+      << 100.0 * CuttingSettings{}.max_added_mass_fraction << " %). Pieces cut free and left in "
+      << "the field: " << bodies.size() << " (" << std::setprecision(1) << bodies_m3 * 1e6
+      << " cm³).\n";
   if (trace.dropped() > 0)
     doc << "\n" << trace.dropped() << " records of the loop were dropped (the ring was full).\n";
 
