@@ -2,6 +2,8 @@
 // recorder killed with SIGKILL mid-session (nothing committed is lost, the next run recovers); a
 // real full disk (a tiny tmpfs in a user and mount namespace); the database's file system turning
 // read-only mid-session. Runs the real binary; needs no display.
+#include "liversim/scenario/scenario.h"
+#include "liversim/sessions/grading.h"
 #include "liversim/sessions/session_replay.h"
 #include "liversim/storage/sqlite_session_store.h"
 #include "process_faults.h"
@@ -153,6 +155,52 @@ TEST(CliRecord, TheTrajectorysToolColumnChangesTheToolAtItsTimes) {
   EXPECT_NE(read_text(folder / "stderr.txt").find("scalpel, is not a tool the scenario allows"),
             std::string::npos)
       << read_text(folder / "stderr.txt");
+}
+
+// The shipped wedge resection (its lesion where the scenario puts it), cut through the tumour by
+// a script: the session records the breach, and the scenario's rubric fails it (issue 42, item 6).
+TEST(CliRecord, TheWedgeResectionCutTooCloseBreachesTheTumourAndFails) {
+  const fs::path folder = fresh_folder("too-close");
+  const fs::path database = folder / "sessions.sqlite";
+  const fs::path root = fs::path(LIVERSIM_TEST_DATA_DIR) / ".." / "..";
+  const pid_t cli = spawn(
+      {LIVERSIM_CLI, "record", "--scenario",
+       (root / "scenarios" / "wedge-resection-peripheral-tumour.json").string(), "--trajectory",
+       (fs::path(LIVERSIM_TEST_DATA_DIR) / "trajectories" / "wedge-resection-too-close.txt")
+           .string(),
+       "--database", database.string()},
+      folder);
+  ASSERT_GT(cli, 0);
+  ASSERT_EQ(wait_for(cli), 0) << read_text(folder / "stderr.txt");
+  SqliteSessionStore store(database, SqliteSessionStore::Access::read_only);
+  const std::int64_t session = store.sessions().at(0).id;
+  auto metric = [&](const std::string& name) -> std::optional<double> {
+    for (const MetricValue& m : store.metrics(session))
+      if (m.name == name) return m.value;
+    return std::nullopt;
+  };
+  EXPECT_EQ(metric("lesion_breached"), 1.0);
+  EXPECT_EQ(metric("lesion_margin_mm"), 0.0);
+  EXPECT_EQ(metric("specimen_contains_lesion"), 0.0);
+  EXPECT_EQ(metric("task_success"), 0.0);
+  bool breach_event = false;
+  for (const SessionEvent& event : store.events(session))
+    breach_event |= event.kind == SessionEventKind::lesion_breach;
+  EXPECT_TRUE(breach_event);
+  // The scenario's rubric: the breach and margin criteria fail.
+  const ScenarioReading scenario = read_scenario(store.scenario_text(session));
+  ASSERT_TRUE(scenario.scenario);
+  const RubricResult graded =
+      grade_against_rubric(scenario.scenario->rubric, store.metrics(session));
+  int failed = 0;
+  for (const CriterionResult& criterion : graded.criteria) {
+    const std::string& name = criterion.criterion.metric;
+    if (name == "lesion_breached" || name == "lesion_margin_mm") {
+      EXPECT_FALSE(criterion.passed) << name;
+      ++failed;
+    }
+  }
+  EXPECT_EQ(failed, 2);
 }
 
 TEST(CliRecordCrash, KilledMidSessionItLosesNothingCommittedAndTheNextRunRecovers) {
