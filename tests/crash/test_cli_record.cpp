@@ -159,7 +159,9 @@ TEST(CliRecord, TheTrajectorysToolColumnChangesTheToolAtItsTimes) {
 
 // The shipped wedge resection (its lesion where the scenario puts it), cut through the tumour by
 // a script: the session records the breach, and the scenario's rubric fails it (issue 42, item 6).
-TEST(CliRecord, TheWedgeResectionCutTooCloseBreachesTheTumourAndFails) {
+// Not a CliRecord test: those also run under the sanitizers, where a 5406-element liver cannot
+// keep up with the script's clock.
+TEST(CliResection, TheWedgeResectionCutTooCloseBreachesTheTumourAndFails) {
   const fs::path folder = fresh_folder("too-close");
   const fs::path database = folder / "sessions.sqlite";
   const fs::path root = fs::path(LIVERSIM_TEST_DATA_DIR) / ".." / "..";
