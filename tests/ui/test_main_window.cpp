@@ -19,6 +19,7 @@
 #include <QRadioButton>
 #include <QSettings>
 #include <QSignalSpy>
+#include <QStatusBar>
 #include <QTemporaryDir>
 #include <QTest>
 #include <algorithm>
@@ -38,6 +39,7 @@
 #include "main_window.h"
 #include "mouse_tool_control.h"
 #include "render/liver_scene.h"
+#include "simulation_status.h"
 #include "tool_panel.h"
 #include "viewport_input.h"
 #include "vtk_viewport.h"
@@ -472,6 +474,31 @@ TEST_F(MainWindowTest, TheScalpelDrawnAcrossTheLiverCutsIt) {
   EXPECT_EQ(after.position_m.size(), after.model->node_count);
   EXPECT_FALSE(window_->simulation().stats().halted);
   EXPECT_GT(countDifferentPixels(before, cutting), 100) << "neither the scalpel nor the cut shows";
+}
+
+// Session ▸ Remove Specimen with no piece cut free says so, and takes nothing (issue 42, item 5);
+// the status line counts pieces cut free and specimens taken out, in the trainee's words.
+TEST_F(MainWindowTest, RemoveSpecimenSaysWhenNoPieceIsFreeAndTheStatusLineCountsThem) {
+  QAction* remove = window_->findChild<QAction*>("removeSpecimenAction");
+  ASSERT_NE(remove, nullptr);
+  const std::uint64_t topology = window_->simulation().snapshot().topology_version;
+  remove->trigger();
+  EXPECT_TRUE(window_->statusBar()->currentMessage().contains("no specimen to remove"))
+      << window_->statusBar()->currentMessage().toStdString();
+  ASSERT_TRUE(waitSimulated(0.05));
+  EXPECT_EQ(window_->simulation().snapshot().topology_version, topology);
+  EXPECT_EQ(window_->simulation().snapshot().specimens_taken_out, 0);
+
+  SimulationStatus status;
+  status.freeBodies = 2;
+  status.specimensTakenOut = 1;
+  const QString text = simulationStatusText(status);
+  // (Plural forms come from the translations the workstation installs; a test has none.)
+  EXPECT_TRUE(text.contains("| 2 piece") &&
+              text.contains("cut free: lift out or Session ▸ Remove Specimen"))
+      << text.toStdString();
+  EXPECT_TRUE(text.contains("| 1 specimen")) << text.toStdString();
+  EXPECT_FALSE(simulationStatusText(SimulationStatus{}).contains("cut free"));
 }
 
 // With the mouse the scalpel's depth is set by the wheel while the button is down (issue 42, item
