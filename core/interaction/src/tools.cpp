@@ -1,5 +1,6 @@
 #include "liversim/interaction/tools.h"
 
+#include "liversim/interaction/cutting.h"
 #include "liversim/interaction/grab.h"
 
 #include <algorithm>
@@ -187,7 +188,8 @@ SegmentTriangleClosest segment_triangle_closest(const Eigen::Vector3d& a, const 
 std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
                                 const NodeArray& position, std::span<const Capsule> parts,
                                 const ContactSettings& settings, ContactScratch& scratch,
-                                std::vector<NodeSpring>& springs, std::span<PartContact> per_part) {
+                                std::vector<NodeSpring>& springs, std::span<PartContact> per_part,
+                                std::span<const std::uint8_t> cut_triangle) {
   const double omega_sq = std::pow(2.0 * std::numbers::pi * settings.frequency_hz, 2);
   scratch.resize(model.node_count);
   for (PartContact& met : per_part) met = {};
@@ -250,6 +252,7 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
           met.touched_from = std::min(met.touched_from, s);
           met.touched_to = std::max(met.touched_to, s);
           met.pierced |= closest.distance == 0.0;
+          met.touched_cut_face |= t < cut_triangle.size() && cut_triangle[t] != 0;
         });
   }
   // One spring per node, giving its summed force at `position` with its summed stiffness.
@@ -283,6 +286,7 @@ ToolInteraction::ToolInteraction(const SimModel& model, const BoundarySurface& s
         "grasp settings are invalid: expected radius > 0, stiffness > 0 and the closing opening "
         "below the releasing one");
   const std::size_t nodes = surface.nodes.size();
+  cut_triangle_ = cut_face_flags(model, surface);
   springs_.reserve(2 * nodes);  // a hold and a contact spring per node at most
   grasp_.nodes.reserve(nodes);
   grasp_.offset_in_tool_m.reserve(nodes);
@@ -350,10 +354,10 @@ std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const Node
   // A cutting scalpel passes: its blade and, deeper than the blade, its shaft part the tissue
   // instead (cutting_edge_m).
   if (blade_cuts && tool.kind == ToolKind::scalpel) count = 0;
-  contact_count_ =
-      add_contact_springs(*model_, bvh_, position, std::span<const Capsule>(parts.data(), count),
-                          contact_, contact_scratch_, springs_,
-                          std::span<PartContact>(part_contact_.data(), part_contact_.size()));
+  contact_count_ = add_contact_springs(
+      *model_, bvh_, position, std::span<const Capsule>(parts.data(), count), contact_,
+      contact_scratch_, springs_,
+      std::span<PartContact>(part_contact_.data(), part_contact_.size()), cut_triangle_);
   return springs_;
 }
 

@@ -164,7 +164,8 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
     if (!blade.touched()) return;
     const RegionMaterial& pressed =
         model_->regions[static_cast<std::size_t>(std::max(0, blade.region))];
-    if (!blade.pierced &&
+    // Put into a cut it made (touching a cut face), it is in its groove: it cuts on at once.
+    if (!blade.pierced && !blade.touched_cut_face &&
         blade.force_on_part_n.norm() <
             pressed.fracture_toughness_j_per_m2 * blade_edge_in_contact_m(blade, scalpel.geometry))
       return;

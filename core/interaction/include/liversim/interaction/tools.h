@@ -127,7 +127,8 @@ struct ContactScratch {
 struct PartContact {
   Eigen::Vector3d force_on_part_n = Eigen::Vector3d::Zero();
   double touched_from = 1.0, touched_to = 0.0;  // from > to: it touched nothing
-  bool pierced = false;  // its axis passes through a face: it is through the surface
+  bool pierced = false;           // its axis passes through a face: it is through the surface
+  bool touched_cut_face = false;  // a face it touched was made by a cut: it is in a cut
   // The region (SimModel::regions) of the element whose face pushed it hardest, and that push
   // (N); -1 when the surface does not say which element a face bounds.
   std::int32_t region = -1;
@@ -143,7 +144,8 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
                                 const NodeArray& position, std::span<const Capsule> parts,
                                 const ContactSettings& settings, ContactScratch& scratch,
                                 std::vector<NodeSpring>& springs,
-                                std::span<PartContact> per_part = {});
+                                std::span<PartContact> per_part = {},
+                                std::span<const std::uint8_t> cut_triangle = {});
 
 // The forceps' hold on the tissue: the surface nodes near the jaws when they closed,
 // carried rigidly with the tool from then on. Empty: no hold.
@@ -217,6 +219,7 @@ class ToolInteraction {
   ForcepsGrasp grasp_;
   std::vector<double> grasp_weight_;
   std::vector<std::uint8_t> node_mark_;
+  std::vector<std::uint8_t> cut_triangle_;  // per surface triangle: made by a cut
   ContactScratch contact_scratch_;
   std::vector<NodeSpring> springs_;
   std::array<PartContact, 3> part_contact_;
