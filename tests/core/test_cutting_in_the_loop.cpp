@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -313,6 +314,29 @@ TEST(LoopStep, ACuttingScalpelTakesOneForceEvaluationPerLoopStep) {
   EXPECT_LE(evaluations, loop_steps + loop_steps / 20);
 }
 
+// A block (its mesh's regions, each of the toughness given, J/m²) held at its base, in the
+// real-time loop with its tools and cutting on.
+struct BlockInTheLoop {
+  std::shared_ptr<const SimModel> model;
+  std::unique_ptr<RealtimeSimulation> simulation;
+};
+BlockInTheLoop block_in_the_loop(const TetMesh& mesh, const std::vector<double>& toughness) {
+  ModelOptions options;
+  options.regions.assign(toughness.size(), RegionMaterial{});
+  for (std::size_t r = 0; r < toughness.size(); ++r)
+    options.regions[r].fracture_toughness_j_per_m2 = toughness[r];
+  options.mass_damping_per_s = 30.0;
+  for (std::size_t n = 0; n < mesh.node_count(); ++n)
+    if (mesh.rest_position_m.z[n] < 1e-9) options.fixed_nodes.push_back(static_cast<NodeIndex>(n));
+  BlockInTheLoop block;
+  block.model = std::make_shared<const SimModel>(build_model(mesh, options));
+  block.simulation =
+      std::make_unique<RealtimeSimulation>(block.model, make_rest_state(*block.model));
+  block.simulation->enable_tools(extract_surface(mesh));
+  block.simulation->enable_cutting();
+  return block;
+}
+
 // A blade you feel (issue 42, item 4): drawn straight through a block, a cutting blade is held back
 // by the toughness times its edge in the tissue, against its motion. The block (6 × 5 × 4 cm,
 // fixed at its base) is two layers: the top centimetre of toughness 400 J/m², the rest 200 J/m²
@@ -331,17 +355,9 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
     for (NodeIndex n : mesh.tet(e)) z += 0.25 * mesh.rest_position_m.z[n];
     mesh.region[e] = z > kLayerM ? 1 : 0;
   }
-  ModelOptions options;
-  options.regions = {RegionMaterial{}, RegionMaterial{}};
-  options.regions[0].fracture_toughness_j_per_m2 = 200.0;
-  options.regions[1].fracture_toughness_j_per_m2 = 400.0;
-  options.mass_damping_per_s = 30.0;
-  for (std::size_t n = 0; n < mesh.node_count(); ++n)
-    if (mesh.rest_position_m.z[n] < 1e-9) options.fixed_nodes.push_back(static_cast<NodeIndex>(n));
-  const auto model = std::make_shared<const SimModel>(build_model(mesh, options));
-  RealtimeSimulation simulation(model, make_rest_state(*model));
-  simulation.enable_tools(extract_surface(mesh));
-  simulation.enable_cutting();
+  BlockInTheLoop block = block_in_the_loop(mesh, {200.0, 400.0});
+  const std::shared_ptr<const SimModel>& model = block.model;
+  RealtimeSimulation& simulation = *block.simulation;
 
   Tool scalpel;
   scalpel.kind = ToolKind::scalpel;
@@ -398,16 +414,10 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
 // tissue (there, pressed in, it pushes the tissue until it does).
 TEST(BladeEntry, PutBackIntoItsOwnCutTheBladeIsInAtOnce) {
   constexpr double kTopM = 0.04, kToughness = 400.0;
-  const TetMesh mesh = testing::block_mesh(6, 5, 4, {0.06, 0.05, kTopM});
-  ModelOptions options;
-  options.regions[0].fracture_toughness_j_per_m2 = kToughness;
-  options.mass_damping_per_s = 30.0;
-  for (std::size_t n = 0; n < mesh.node_count(); ++n)
-    if (mesh.rest_position_m.z[n] < 1e-9) options.fixed_nodes.push_back(static_cast<NodeIndex>(n));
-  const auto model = std::make_shared<const SimModel>(build_model(mesh, options));
-  RealtimeSimulation simulation(model, make_rest_state(*model));
-  simulation.enable_tools(extract_surface(mesh));
-  simulation.enable_cutting();
+  BlockInTheLoop block =
+      block_in_the_loop(testing::block_mesh(6, 5, 4, {0.06, 0.05, kTopM}), {kToughness});
+  const std::shared_ptr<const SimModel>& model = block.model;
+  RealtimeSimulation& simulation = *block.simulation;
   Tool scalpel;
   scalpel.kind = ToolKind::scalpel;
   const double blade_m = scalpel.geometry.blade_length_m;
