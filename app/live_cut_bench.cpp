@@ -65,8 +65,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
     TrajectoryFile file = read_trajectory_file(o.trajectory);
     script = std::move(file.points);
     scenario = open_scenario_to_run(o.scenario);
-    tools.emplace(ToolKind::scalpel, std::move(file.tool_changes),
-                  scenario ? scenario->scenario.tools : std::vector<ToolKind>{});
+    std::optional<AllowedTools> allowed;
+    if (scenario) allowed = AllowedTools{scenario->scenario.tools, o.scenario->string()};
+    tools.emplace(ToolKind::scalpel, file.tool_changes, allowed);
   } catch (const std::exception& e) {
     return fail(e.what());
   }

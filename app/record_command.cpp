@@ -98,25 +98,6 @@ int wait_for_stop_signal(const sigset_t& stop, double seconds) {
   return signal > 0 ? signal : 0;
 }
 
-// The tool the device holds (none: the hand), checked against the tools the scenario allows.
-std::optional<ToolKind> held_tool(const RecordOptions& options, const Scenario* scenario) {
-  if (options.tool == "hand") return std::nullopt;
-  const std::optional<ToolKind> kind = tool_kind(options.tool);
-  if (!kind)
-    throw std::invalid_argument("--tool " + options.tool +
-                                " is unknown: expected hand, probe, forceps or scalpel");
-  if (scenario &&
-      std::find(scenario->tools.begin(), scenario->tools.end(), *kind) == scenario->tools.end()) {
-    std::string allowed;
-    for (const ToolKind tool : scenario->tools)
-      allowed += (allowed.empty() ? "" : ", ") + std::string(tool_name(tool));
-    throw std::invalid_argument("--tool " + options.tool + " is not a tool the scenario " +
-                                options.scenario->string() + " allows (it allows: hand" +
-                                (allowed.empty() ? "" : ", " + allowed) + ")");
-  }
-  return kind;
-}
-
 // A session recorded headless by the workstation's own station (core/station): the display frames
 // are this loop's, at the workstation's rate.
 int record(const RecordOptions& options) {
@@ -130,9 +111,9 @@ int record(const RecordOptions& options) {
     TrajectoryFile file = read_trajectory_file(options.trajectory);  // errors name file and line
     script = std::move(file.points);
     scenario = open_scenario_to_run(options.scenario);
-    const Scenario* allowed = scenario ? &scenario->scenario : nullptr;
-    tools.emplace(held_tool(options, allowed), std::move(file.tool_changes),
-                  allowed ? allowed->tools : std::vector<ToolKind>{});
+    std::optional<AllowedTools> allowed;
+    if (scenario) allowed = AllowedTools{scenario->scenario.tools, options.scenario->string()};
+    tools.emplace(tool_for_the_hand(options.tool, allowed, "--tool"), file.tool_changes, allowed);
   } catch (const std::exception& e) {
     return fail(e.what());
   }

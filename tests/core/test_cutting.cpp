@@ -684,8 +684,10 @@ TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
   const std::pair<double CuttingSettings::*, std::vector<double>> bad[] = {
       {&CuttingSettings::refine_edge_m, {-0.001, std::nan(""), INFINITY}},
       {&CuttingSettings::min_part_height_m, {0.0, -0.002, std::nan(""), INFINITY}},
-      {&CuttingSettings::max_added_mass_fraction, {-0.001, 0.5, std::nan("")}}};
-  const char* names[] = {"refinement edge", "smallest part height", "added mass fraction"};
+      {&CuttingSettings::max_added_mass_fraction, {-0.001, 0.5, std::nan("")}},
+      {&CuttingSettings::min_free_body_volume_m3, {-1e-6, -INFINITY, std::nan("")}}};
+  const char* names[] = {"refinement edge", "smallest part height", "added mass fraction",
+                         "smallest free body"};
   for (std::size_t k = 0; k < std::size(bad); ++k)
     for (double value : bad[k].second) {
       settings = {};
@@ -695,6 +697,9 @@ TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
       EXPECT_NE(problem->find(names[k]), std::string::npos) << *problem;
     }
   EXPECT_FALSE(validate(CuttingSettings{}).has_value());
+  settings = {};
+  settings.min_free_body_volume_m3 = INFINITY;  // every freed piece taken out: allowed
+  EXPECT_FALSE(validate(settings).has_value());
 }
 
 }  // namespace

@@ -152,7 +152,9 @@ TEST(CliRecord, TheTrajectorysToolColumnChangesTheToolAtItsTimes) {
             folder);
   ASSERT_GT(refused, 0);
   EXPECT_EQ(wait_for(refused), 2);
-  EXPECT_NE(read_text(folder / "stderr.txt").find("scalpel, is not a tool the scenario allows"),
+  EXPECT_NE(read_text(folder / "stderr.txt")
+                .find("tool at 0 s: scalpel is not a tool the scenario " + palpation.string() +
+                      " allows (it allows: hand, probe)"),
             std::string::npos)
       << read_text(folder / "stderr.txt");
 }

@@ -402,6 +402,47 @@ struct UnionFind {
   }
 };
 
+// A mesh's connected pieces (elements joined through shared nodes), over elements given by their
+// corners: each node's piece root, and per root whether it holds a fixed node and its rest volume.
+// The organ is the pieces holding a fixed node, or with none anywhere, the largest piece.
+struct Pieces {
+  const std::array<std::vector<NodeIndex>, 4>* corner;
+  UnionFind joined;
+  std::vector<std::uint8_t> fixed;
+  std::vector<double> volume_m3;
+  std::int32_t organ_root = -1;  // with no fixed node: the largest piece
+
+  // `is_fixed(n)` for each of the `nodes`; `volume_m3` per element.
+  template <class IsFixed>
+  Pieces(const std::array<std::vector<NodeIndex>, 4>& corners, std::size_t nodes,
+         const std::vector<double>& element_volume_m3, IsFixed is_fixed)
+      : corner(&corners), joined(nodes), fixed(nodes, 0), volume_m3(nodes, 0.0) {
+    const std::size_t tets = corners[0].size();
+    for (std::size_t e = 0; e < tets; ++e)
+      for (int c = 1; c < 4; ++c) joined.unite(corners[0][e], corners[c][e]);
+    bool any_fixed = false;
+    for (std::size_t n = 0; n < nodes; ++n)
+      if (is_fixed(n)) {
+        fixed[joined.find(static_cast<std::int32_t>(n))] = 1;
+        any_fixed = true;
+      }
+    for (std::size_t e = 0; e < tets; ++e)
+      volume_m3[joined.find(corners[0][e])] += element_volume_m3[e];
+    if (any_fixed) return;
+    for (std::size_t n = 0; n < nodes; ++n)
+      if (volume_m3[n] > 0.0 && (organ_root < 0 || volume_m3[n] > volume_m3[organ_root]))
+        organ_root = static_cast<std::int32_t>(n);
+  }
+  explicit Pieces(const SimModel& model)
+      : Pieces(model.corner, model.node_count, model.rest_volume_m3,
+               [&](std::size_t n) { return model.is_fixed[n] != 0; }) {}
+
+  std::int32_t of_element(std::size_t e) { return joined.find((*corner)[0][e]); }
+  bool in_organ(std::int32_t root) const {
+    return organ_root < 0 ? fixed[root] != 0 : root == organ_root;
+  }
+};
+
 // Whether the edge (n, m) lies on the boundary: a face holding it has no element across.
 bool edge_on_boundary(const SimModel& model, FaceNeighbours& neighbours, NodeIndex n, NodeIndex m) {
   bool boundary = false;
@@ -882,6 +923,18 @@ SimState carried_state(const SimModel& m, const SimState& old, NodeArray positio
   next.max_speed_m_per_s = old.max_speed_m_per_s;
   if (open_books) open_energy_books(m, next);
   return next;
+}
+
+// A cut's (or a take-out's) new model and its state from `old`, with the origins of its nodes and
+// elements, into `result`; the energy books open again.
+void complete(CutResult& result, std::shared_ptr<SimModel> next, const SimState& old,
+              NodeArray position_m, NodeArray velocity_m_per_s, std::vector<NodeIndex> node_origin,
+              std::vector<TetIndex> element_origin) {
+  result.state = carried_state(*next, old, std::move(position_m), std::move(velocity_m_per_s),
+                               element_origin, true);
+  result.model = std::move(next);
+  result.node_origin = std::move(node_origin);
+  result.element_origin = std::move(element_origin);
 }
 
 // A node made on the edge (a, b), a < b, at parameter s along it from a.
@@ -1680,29 +1733,12 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   // 6. Pieces: elements joined through shared nodes. Pieces holding a fixed node stay (all of
   // them: the surgeon's cut is not undone); without fixed nodes the largest stays.
   const std::size_t nodes_after_split = node_origin.size();
-  UnionFind pieces(nodes_after_split);
-  for (std::size_t e = 0; e < tets; ++e)
-    for (int c = 1; c < 4; ++c) pieces.unite(corner[0][e], corner[c][e]);
-  std::vector<double> piece_volume(nodes_after_split, 0.0);
-  std::vector<std::uint8_t> piece_fixed(nodes_after_split, 0);
-  for (std::size_t e = 0; e < tets; ++e)
-    piece_volume[pieces.find(corner[0][e])] += model.rest_volume_m3[e];
-  bool any_fixed = false;
-  for (std::size_t n = 0; n < nodes_after_split; ++n)
-    if (model.is_fixed[node_origin[n]]) {
-      piece_fixed[pieces.find(static_cast<std::int32_t>(n))] = 1;
-      any_fixed = true;
-    }
-  std::int32_t largest = -1;
-  for (std::size_t n = 0; n < nodes_after_split; ++n)
-    if (piece_volume[n] > 0.0 && (largest < 0 || piece_volume[n] > piece_volume[largest]))
-      largest = static_cast<std::int32_t>(n);
-  auto in_organ = [&](std::int32_t root) {
-    return any_fixed ? piece_fixed[root] != 0 : root == largest;
-  };
+  Pieces pieces(corner, nodes_after_split, model.rest_volume_m3,
+                [&](std::size_t n) { return model.is_fixed[node_origin[n]] != 0; });
+  auto in_organ = [&](std::int32_t root) { return pieces.in_organ(root); };
   // A piece that came free stays as a body of its own unless it is a crumb.
   auto keeps = [&](std::int32_t root) {
-    return in_organ(root) || piece_volume[root] >= settings.min_free_body_volume_m3;
+    return in_organ(root) || pieces.volume_m3[root] >= settings.min_free_body_volume_m3;
   };
   // What was in the organ before this cut: what leaves it now is resected.
   const std::vector<std::uint8_t> was_in_organ = organ_elements(model);
@@ -1728,7 +1764,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   for (bool merged_one = true; merged_one;) {
     merged_one = false;
     for (std::size_t e : cut_elements) {
-      if (merged[e] || !keeps(pieces.find(corner[0][e]))) continue;
+      if (merged[e] || !keeps(pieces.of_element(e))) continue;
       bool lone_corner = false, holds_fixed = false;
       std::optional<std::size_t> touching, across;
       for (int c = 0; c < 4; ++c) {
@@ -1789,7 +1825,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   // corners carry a quarter of its mass each and would set the explicit step).
   std::vector<std::int32_t> unmerged(nodes_after_split, 0);
   for (std::size_t e = 0; e < tets; ++e)
-    if (!merged[e]) ++unmerged[pieces.find(corner[0][e])];
+    if (!merged[e]) ++unmerged[pieces.of_element(e)];
   auto stays = [&](std::int32_t root) {
     return in_organ(root) || (keeps(root) && unmerged[root] >= 2);
   };
@@ -1799,7 +1835,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   element_origin.reserve(tets);
   for (std::size_t e = 0; e < tets; ++e) {
     if (merged[e]) continue;
-    const std::int32_t piece = pieces.find(corner[0][e]);
+    const std::int32_t piece = pieces.of_element(e);
     const double volume_m3 = shape_of(corners_at(model, geometry.rest_m, e)).volume_m3;
     if (was_in_organ[e] && !in_organ(piece)) report.resected_volume_m3 += volume_m3;
     if (stays(piece)) {
@@ -1934,11 +1970,8 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   scale_masses_to_frequency(m, around_cut, frequency_ceiling(model),
                             settings.max_added_mass_fraction, &velocity);
   report.added_mass_kg = m.added_mass_kg;
-  result.state =
-      carried_state(m, state, std::move(position), std::move(velocity), element_origin, true);
-  result.model = std::move(next);
-  result.node_origin = std::move(origin);
-  result.element_origin = std::move(element_origin);
+  complete(result, std::move(next), state, std::move(position), std::move(velocity),
+           std::move(origin), std::move(element_origin));
   return result;
 }
 
@@ -1962,52 +1995,11 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
   return cut_along(model, state, surface, settings, nullptr);
 }
 
-}  // namespace liversim
-
-namespace liversim {
-
-namespace {
-
-// The model's connected pieces (elements joined through shared nodes): each node's piece root, and
-// per root whether it holds a fixed node and its rest volume.
-struct Pieces {
-  UnionFind joined;
-  std::vector<std::uint8_t> fixed;
-  std::vector<double> volume_m3;
-  std::int32_t organ_root = -1;  // of a model with no fixed node: the largest piece
-
-  explicit Pieces(const SimModel& model)
-      : joined(model.node_count), fixed(model.node_count, 0), volume_m3(model.node_count, 0.0) {
-    for (std::size_t e = 0; e < model.tet_count; ++e)
-      for (int c = 1; c < 4; ++c) joined.unite(model.corner[0][e], model.corner[c][e]);
-    bool any_fixed = false;
-    for (std::size_t n = 0; n < model.node_count; ++n)
-      if (model.is_fixed[n]) {
-        fixed[joined.find(static_cast<std::int32_t>(n))] = 1;
-        any_fixed = true;
-      }
-    for (std::size_t e = 0; e < model.tet_count; ++e)
-      volume_m3[joined.find(model.corner[0][e])] += model.rest_volume_m3[e];
-    if (any_fixed) return;
-    for (std::size_t n = 0; n < model.node_count; ++n)
-      if (volume_m3[n] > 0.0 && (organ_root < 0 || volume_m3[n] > volume_m3[organ_root]))
-        organ_root = static_cast<std::int32_t>(n);
-  }
-  std::int32_t of_element(const SimModel& model, std::size_t e) {
-    return joined.find(model.corner[0][e]);
-  }
-  bool in_organ(std::int32_t root) const {
-    return organ_root < 0 ? fixed[root] != 0 : root == organ_root;
-  }
-};
-
-}  // namespace
-
 std::vector<std::uint8_t> organ_elements(const SimModel& model) {
   Pieces pieces(model);
   std::vector<std::uint8_t> organ(model.tet_count, 0);
   for (std::size_t e = 0; e < model.tet_count; ++e)
-    organ[e] = pieces.in_organ(pieces.of_element(model, e)) ? 1 : 0;
+    organ[e] = pieces.in_organ(pieces.of_element(e)) ? 1 : 0;
   return organ;
 }
 
@@ -2016,7 +2008,7 @@ std::vector<FreeBody> free_bodies(const SimModel& model) {
   std::vector<FreeBody> bodies;
   std::vector<std::int32_t> body_of_root(model.node_count, -1);
   for (std::size_t e = 0; e < model.tet_count; ++e) {
-    const std::int32_t root = pieces.of_element(model, e);
+    const std::int32_t root = pieces.of_element(e);
     if (pieces.in_organ(root)) continue;
     if (body_of_root[root] < 0) {
       body_of_root[root] = static_cast<std::int32_t>(bodies.size());
@@ -2033,14 +2025,14 @@ CutResult take_out_body(const SimModel& model, const SimState& state, TetIndex e
                                 " is not in the model of " + std::to_string(model.tet_count) +
                                 " elements");
   Pieces pieces(model);
-  const std::int32_t body = pieces.of_element(model, static_cast<std::size_t>(element));
+  const std::int32_t body = pieces.of_element(static_cast<std::size_t>(element));
   if (pieces.in_organ(body))
     throw std::invalid_argument("take_out_body: element " + std::to_string(element) +
                                 " is in the organ, not in a free body");
   CutResult result;
   std::vector<TetIndex> element_origin;
   for (std::size_t e = 0; e < model.tet_count; ++e) {
-    if (pieces.of_element(model, e) == body) {
+    if (pieces.of_element(e) == body) {
       ++result.report.removed_elements;
     } else {
       element_origin.push_back(static_cast<TetIndex>(e));
@@ -2083,11 +2075,8 @@ CutResult take_out_body(const SimModel& model, const SimState& state, TetIndex e
   m.added_mass_kg = 0.0;
   for (double kg : m.node_added_mass_kg) m.added_mass_kg += kg;
   lump_masses(m);
-  result.state =
-      carried_state(m, state, std::move(position), std::move(velocity), element_origin, true);
-  result.model = std::move(next);
-  result.node_origin = std::move(node_origin);
-  result.element_origin = std::move(element_origin);
+  complete(result, std::move(next), state, std::move(position), std::move(velocity),
+           std::move(node_origin), std::move(element_origin));
   return result;
 }
 

@@ -41,9 +41,66 @@ std::vector<Triangle> outer_surface_at_rest_m(const SimModel& model) {
   return triangles;
 }
 
+// The lesion of each region (regions 1, 2, … are the scenario's lesions in order), or none.
+const LesionSpec* lesion_of_region(const Scenario& scenario, std::int32_t region) {
+  if (region < 1 || static_cast<std::size_t>(region) > scenario.lesions.size()) return nullptr;
+  return &scenario.lesions[static_cast<std::size_t>(region - 1)];
+}
+
+std::vector<Triangle> cut_faces_of(const Specimen& specimen) {
+  std::vector<Triangle> triangles;
+  for (std::size_t e = 0; e < specimen.rest_corners_m.size(); ++e)
+    for (int face = 0; face < 4; ++face)
+      if (specimen.cut_face_mask[e] & (1u << face)) {
+        Triangle t;
+        for (int k = 0; k < 3; ++k) t[k] = specimen.rest_corners_m[e][kTetFace[face][k]];
+        triangles.push_back(t);
+      }
+  return triangles;
+}
+
 std::vector<SpecimenOutcome> measure_specimens(const SimModel& final_model,
                                                const OutcomeTracker& tracker,
-                                               const Scenario& scenario, double spacing_m);
+                                               const Scenario& scenario, double spacing_m) {
+  std::vector<Specimen> specimens = tracker.specimens_taken_out();
+  const std::size_t taken_out = specimens.size();
+  for (const FreeBody& body : free_bodies(final_model))
+    specimens.push_back(specimen_of(final_model, body.elements));
+  // Where each lesion's elements are: the organ, and each specimen.
+  const std::size_t lesions = scenario.lesions.size();
+  std::vector<std::size_t> in_organ(lesions, 0);
+  const std::vector<std::uint8_t> organ = organ_elements(final_model);
+  for (std::size_t e = 0; e < final_model.tet_count; ++e)
+    if (organ[e] && lesion_of_region(scenario, final_model.region[e]))
+      ++in_organ[static_cast<std::size_t>(final_model.region[e] - 1)];
+  std::vector<std::vector<std::size_t>> in_specimen(specimens.size(),
+                                                    std::vector<std::size_t>(lesions, 0));
+  for (std::size_t s = 0; s < specimens.size(); ++s)
+    for (const std::int32_t region : specimens[s].region)
+      if (lesion_of_region(scenario, region))
+        ++in_specimen[s][static_cast<std::size_t>(region - 1)];
+
+  std::vector<SpecimenOutcome> outcomes;
+  for (std::size_t s = 0; s < specimens.size(); ++s) {
+    SpecimenOutcome outcome;
+    outcome.volume_mm3 = specimens[s].rest_volume_m3 * 1e9;
+    outcome.taken_out = s < taken_out;
+    const std::vector<Triangle> cut_faces = cut_faces_of(specimens[s]);
+    for (std::size_t l = 0; l < lesions; ++l) {
+      if (in_specimen[s][l] == 0) continue;
+      SpecimenLesion lesion;
+      lesion.name = scenario.lesions[l].name;
+      std::size_t elsewhere = in_organ[l];
+      for (std::size_t other = 0; other < specimens.size(); ++other)
+        if (other != s) elsewhere += in_specimen[other][l];
+      lesion.whole = elsewhere == 0;
+      lesion.margin = lesion_margin(cut_faces, lesion_ellipsoid(scenario.lesions[l]), spacing_m);
+      outcome.lesions.push_back(lesion);
+    }
+    outcomes.push_back(std::move(outcome));
+  }
+  return outcomes;
+}
 
 }  // namespace
 
@@ -284,71 +341,6 @@ std::vector<MetricValue> outcome_metric_values(const OutcomeMetrics& m, const Sc
   if (m.task_success) values.push_back({"task_success", *m.task_success ? 1.0 : 0.0});
   return values;
 }
-
-namespace {
-
-// The lesion of each region (regions 1, 2, … are the scenario's lesions in order), or none.
-const LesionSpec* lesion_of_region(const Scenario& scenario, std::int32_t region) {
-  if (region < 1 || static_cast<std::size_t>(region) > scenario.lesions.size()) return nullptr;
-  return &scenario.lesions[static_cast<std::size_t>(region - 1)];
-}
-
-std::vector<Triangle> cut_faces_of(const Specimen& specimen) {
-  std::vector<Triangle> triangles;
-  for (std::size_t e = 0; e < specimen.rest_corners_m.size(); ++e)
-    for (int face = 0; face < 4; ++face)
-      if (specimen.cut_face_mask[e] & (1u << face)) {
-        Triangle t;
-        for (int k = 0; k < 3; ++k) t[k] = specimen.rest_corners_m[e][kTetFace[face][k]];
-        triangles.push_back(t);
-      }
-  return triangles;
-}
-
-std::vector<SpecimenOutcome> measure_specimens(const SimModel& final_model,
-                                               const OutcomeTracker& tracker,
-                                               const Scenario& scenario, double spacing_m) {
-  std::vector<Specimen> specimens = tracker.specimens_taken_out();
-  const std::size_t taken_out = specimens.size();
-  for (const FreeBody& body : free_bodies(final_model))
-    specimens.push_back(specimen_of(final_model, body.elements));
-  // Where each lesion's elements are: the organ, and each specimen.
-  const std::size_t lesions = scenario.lesions.size();
-  std::vector<std::size_t> in_organ(lesions, 0);
-  const std::vector<std::uint8_t> organ = organ_elements(final_model);
-  for (std::size_t e = 0; e < final_model.tet_count; ++e)
-    if (organ[e] && lesion_of_region(scenario, final_model.region[e]))
-      ++in_organ[static_cast<std::size_t>(final_model.region[e] - 1)];
-  std::vector<std::vector<std::size_t>> in_specimen(specimens.size(),
-                                                    std::vector<std::size_t>(lesions, 0));
-  for (std::size_t s = 0; s < specimens.size(); ++s)
-    for (const std::int32_t region : specimens[s].region)
-      if (lesion_of_region(scenario, region))
-        ++in_specimen[s][static_cast<std::size_t>(region - 1)];
-
-  std::vector<SpecimenOutcome> outcomes;
-  for (std::size_t s = 0; s < specimens.size(); ++s) {
-    SpecimenOutcome outcome;
-    outcome.volume_mm3 = specimens[s].rest_volume_m3 * 1e9;
-    outcome.taken_out = s < taken_out;
-    const std::vector<Triangle> cut_faces = cut_faces_of(specimens[s]);
-    for (std::size_t l = 0; l < lesions; ++l) {
-      if (in_specimen[s][l] == 0) continue;
-      SpecimenLesion lesion;
-      lesion.name = scenario.lesions[l].name;
-      std::size_t elsewhere = in_organ[l];
-      for (std::size_t other = 0; other < specimens.size(); ++other)
-        if (other != s) elsewhere += in_specimen[other][l];
-      lesion.whole = elsewhere == 0;
-      lesion.margin = lesion_margin(cut_faces, lesion_ellipsoid(scenario.lesions[l]), spacing_m);
-      outcome.lesions.push_back(lesion);
-    }
-    outcomes.push_back(std::move(outcome));
-  }
-  return outcomes;
-}
-
-}  // namespace
 
 void append_specimen_values(const OutcomeMetrics& m, const Scenario* scenario,
                             std::vector<MetricValue>& values) {

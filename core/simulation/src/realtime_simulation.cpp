@@ -95,15 +95,10 @@ RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
   pending_springs_.reserve(options_.spring_capacity);
   active_springs_.reserve(options_.spring_capacity);
   checkpoint_ = make_checkpoint(*model_);
-  if (model_->node_count > 0) {
-    field_min_m_ = field_max_m_ = model_->rest_position_m.at(0);
-    for (std::size_t n = 1; n < model_->node_count; ++n) {
-      field_min_m_ = field_min_m_.cwiseMin(model_->rest_position_m.at(n));
-      field_max_m_ = field_max_m_.cwiseMax(model_->rest_position_m.at(n));
-    }
-    field_min_m_.array() -= kFieldMarginM;
-    field_max_m_.array() += kFieldMarginM;
-  }
+  for (std::size_t n = 0; n < model_->node_count; ++n)
+    field_m_.extend(model_->rest_position_m.at(n));
+  field_m_.min().array() -= kFieldMarginM;
+  field_m_.max().array() += kFieldMarginM;
   free_bodies_ = free_bodies(*model_);
 }
 
@@ -262,10 +257,7 @@ bool RealtimeSimulation::take_out_free_bodies(bool all) {
           centroid += 0.25 * model_->rest_volume_m3[e] * middle;
           volume += model_->rest_volume_m3[e];
         }
-        centroid /= volume;
-        if ((centroid.array() >= field_min_m_.array()).all() &&
-            (centroid.array() <= field_max_m_.array()).all())
-          continue;
+        if (field_m_.contains(centroid / volume)) continue;
       }
       const std::vector<TetIndex> elements = body.elements;  // swap_in refreshes the list
       ++specimens_taken_out_;

@@ -8,21 +8,33 @@
 
 namespace liversim {
 
+std::optional<ToolKind> tool_for_the_hand(const std::string& name,
+                                          const std::optional<AllowedTools>& allowed,
+                                          const std::string& what) {
+  if (name == "hand") return std::nullopt;
+  const std::optional<ToolKind> kind = tool_kind(name);
+  if (!kind)
+    throw std::invalid_argument(what + " " + name +
+                                " is unknown: expected hand, probe, forceps or scalpel");
+  if (allowed &&
+      std::find(allowed->tools.begin(), allowed->tools.end(), *kind) == allowed->tools.end()) {
+    std::string listed = "hand";
+    for (const ToolKind tool : allowed->tools) listed += ", " + std::string(tool_name(tool));
+    throw std::invalid_argument(what + " " + name + " is not a tool the scenario " +
+                                (allowed->scenario.empty() ? "" : allowed->scenario + " ") +
+                                "allows (it allows: " + listed + ")");
+  }
+  return kind;
+}
+
 ScriptedTools::ScriptedTools(std::optional<ToolKind> held,
-                             std::vector<TrajectoryToolChange> changes,
-                             const std::vector<ToolKind>& allowed)
+                             const std::vector<TrajectoryToolChange>& changes,
+                             const std::optional<AllowedTools>& allowed)
     : held_(held) {
   for (const TrajectoryToolChange& change : changes) {
-    std::optional<ToolKind> kind;
-    if (change.tool != "hand") {
-      kind = tool_kind(change.tool);
-      std::ostringstream at;
-      at << "the trajectory's tool at " << change.time_s << " s, " << change.tool;
-      if (!kind) throw std::invalid_argument(at.str() + ", is no tool");
-      if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), *kind) == allowed.end())
-        throw std::invalid_argument(at.str() + ", is not a tool the scenario allows");
-    }
-    changes_.emplace_back(change.time_s, kind);
+    std::ostringstream at;
+    at << "the trajectory's tool at " << change.time_s << " s:";
+    changes_.emplace_back(change.time_s, tool_for_the_hand(change.tool, allowed, at.str()));
   }
   // A tool the script sets at its start is held from the start.
   while (next_ < changes_.size() && changes_[next_].first <= 0.0) held_ = changes_[next_++].second;

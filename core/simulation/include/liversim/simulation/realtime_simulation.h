@@ -20,6 +20,8 @@
 #include "liversim/interaction/tools.h"
 #include "liversim/simulation/tissue_outcome.h"
 
+#include <Eigen/Geometry>
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -332,7 +334,7 @@ class RealtimeSimulation {
   double resected_volume_m3_ = 0.0;
   // The field: the organ's box at rest, kFieldMarginM larger; the free bodies now (refreshed when
   // the model changes) and those taken out.
-  Eigen::Vector3d field_min_m_ = Eigen::Vector3d::Zero(), field_max_m_ = Eigen::Vector3d::Zero();
+  Eigen::AlignedBox3d field_m_;
   std::vector<FreeBody> free_bodies_;
   int specimens_taken_out_ = 0;
   double specimens_taken_out_m3_ = 0.0;

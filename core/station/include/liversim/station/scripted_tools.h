@@ -16,13 +16,25 @@ namespace liversim {
 
 class Workstation;
 
+// The tools a scenario allows the hand, and the scenario's name for messages.
+struct AllowedTools {
+  std::vector<ToolKind> tools;
+  std::string scenario;
+};
+// The tool `name` names for the hand (hand, probe, forceps, scalpel; none: the hand), checked
+// against the tools a scenario allows (none: any). Throws std::invalid_argument beginning with
+// `what` (where the name was given) and saying what is expected.
+std::optional<ToolKind> tool_for_the_hand(const std::string& name,
+                                          const std::optional<AllowedTools>& allowed,
+                                          const std::string& what);
+
 class ScriptedTools {
  public:
   // `held`: what the hand holds until the script's first change (none: the hand). Throws
   // std::invalid_argument naming the change (its time) when a tool is unknown or not in
-  // `allowed` (empty: any tool).
-  ScriptedTools(std::optional<ToolKind> held, std::vector<TrajectoryToolChange> changes,
-                const std::vector<ToolKind>& allowed = {});
+  // `allowed` (none: any tool; tool_for_the_hand).
+  ScriptedTools(std::optional<ToolKind> held, const std::vector<TrajectoryToolChange>& changes,
+                const std::optional<AllowedTools>& allowed = std::nullopt);
 
   // What the hand holds now (none: the hand).
   std::optional<ToolKind> held() const { return held_; }
