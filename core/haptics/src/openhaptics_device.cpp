@@ -290,10 +290,10 @@ DeviceStatus OpenHapticsDevice::read(double /*time_s*/, DeviceSample& sample) {
 
 DeviceStatus OpenHapticsDevice::write_force(const Eigen::Vector3d& force_n) {
   const bool own_frame = !own_clock_running_.load(std::memory_order_relaxed);
-  if (own_frame) {
-    api_.hdMakeCurrentDevice(device_handle_);
-    api_.hdBeginFrame(device_handle_);
-  }
+  // In the scheduler's tick the other hand's device may have been made current since this one's
+  // frame began: the force goes to this one.
+  api_.hdMakeCurrentDevice(device_handle_);
+  if (own_frame) api_.hdBeginFrame(device_handle_);
   // After a fatal error the force stays zero; a non-finite force is never sent to the motors.
   const bool refuse = status_.fault == DeviceFault::fatal || !force_n.allFinite();
   set_force(refuse ? Eigen::Vector3d::Zero() : force_n);
@@ -355,6 +355,7 @@ void OpenHapticsDevice::servo_tick() {
   collect_errors();  // so that read() in `tick` reports them
   const bool stopping = zero_force_requested_.load();
   if (!stopping) tick_(tick_context_);
+  api_.hdMakeCurrentDevice(device_handle_);  // the tick may have driven another device too
   if (stopping || status_.fault == DeviceFault::fatal) set_force(Eigen::Vector3d::Zero());
   api_.hdEndFrame(device_handle_);
   collect_errors();

@@ -9,14 +9,29 @@
 
 namespace liversim {
 
+ServoLoop::Channel::Channel(HapticDevice& device_in, const WorkspaceMapping& mapping_in,
+                            const Options& options)
+    : device(device_in),
+      mapping(mapping_in),
+      renderer(device_in.limits(), options.safety),
+      log(options.log_capacity) {}
+
 ServoLoop::ServoLoop(HapticDevice& device, Options options)
-    : device_(device),
-      options_(options),
-      renderer_(device.limits(), options.safety),
-      epoch_(std::chrono::steady_clock::now()),
-      log_(options.log_capacity) {
+    : options_(options), epoch_(std::chrono::steady_clock::now()) {
   if (auto problem = validate(options_.safety)) throw std::invalid_argument(*problem);
   if (auto problem = validate(options_.mapping)) throw std::invalid_argument(*problem);
+  channels_[hand_index(Hand::right)] =
+      std::make_unique<Channel>(device, options_.mapping, options_);
+}
+
+ServoLoop::ServoLoop(HapticDevice& right, HapticDevice& left, Options options)
+    : ServoLoop(right, options) {
+  if (&right == &left)
+    throw std::invalid_argument("one device cannot be in both hands: each hand needs its own");
+  if (auto problem = validate(options_.left_mapping))
+    throw std::invalid_argument("the left hand's device: " + *problem);
+  channels_[hand_index(Hand::left)] =
+      std::make_unique<Channel>(left, options_.left_mapping, options_);
 }
 
 ServoLoop::~ServoLoop() {
@@ -31,10 +46,13 @@ void ServoLoop::start() {
   if (running_.load()) return;
   stop_requested_ = false;
   running_ = true;
-  if (device_.start_own_clock(&ServoLoop::tick_from_device, this)) {
-    own_clock_ = true;
-    return;
-  }
+  // A device with a scheduler of its own (OpenHaptics) ticks both hands' devices from it.
+  for (const auto& channel : channels_)
+    if (channel && channel->device.start_own_clock(&ServoLoop::tick_from_device, this)) {
+      own_clock_device_ = &channel->device;
+      own_clock_ = true;
+      return;
+    }
   thread_ = std::thread([this] { run(); });
 }
 
@@ -42,8 +60,11 @@ void ServoLoop::stop() {
   if (!running_.load()) return;
   stop_requested_ = true;
   if (own_clock_.load()) {
-    device_.stop_own_clock();  // zeroes the force on its way out
+    own_clock_device_->stop_own_clock();  // zeroes its force on its way out
     own_clock_ = false;
+    own_clock_device_ = nullptr;
+    for (const auto& channel : channels_)
+      if (channel) channel->device.write_force(Eigen::Vector3d::Zero());
   }
   if (thread_.joinable()) thread_.join();
   running_ = false;
@@ -78,69 +99,99 @@ void ServoLoop::run() {
     if (late_s > 1e-9 * static_cast<double>(period_ns)) deadline = now;
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr);
   }
-  device_.write_force(Eigen::Vector3d::Zero());
+  for (const auto& channel : channels_)
+    if (channel) channel->device.write_force(Eigen::Vector3d::Zero());
 }
 
 void ServoLoop::tick(double now_s) {
+  const bool paused = paused_.load(std::memory_order_relaxed);
+  const bool publish_stats = now_s - last_stats_s_ >= 0.05;
+  for (const auto& channel : channels_)
+    if (channel) tick(*channel, now_s, paused, publish_stats);
+  if (publish_stats) last_stats_s_ = now_s;
+}
+
+void ServoLoop::tick(Channel& channel, double now_s, bool paused, bool publish_stats) {
   ServoFrame frame;
   frame.time_s = now_s;
-  if (fatal_.load(std::memory_order_relaxed)) return;  // the device is gone: nothing to drive
-  const DeviceStatus read = device_.read(now_s, frame.sample);
-  if (!read.ok()) ++device_faults_;
+  if (channel.fatal.load(std::memory_order_relaxed)) return;  // the device is gone
+  const DeviceStatus read = channel.device.read(now_s, frame.sample);
+  if (!read.ok()) ++channel.device_faults;
   if (read.fault == DeviceFault::fatal) {
-    fatal_ = true;
-    fault_message_ = read.message;
-    renderer_.hold_zero(true);
-    device_.write_force(Eigen::Vector3d::Zero());
+    channel.fatal = true;
+    channel.fault_message = read.message;
+    channel.renderer.hold_zero(true);
+    channel.device.write_force(Eigen::Vector3d::Zero());
     return;
   }
-  if (models_.update()) renderer_.accept(models_.front());
-  renderer_.hold_zero(paused_.load(std::memory_order_relaxed));
-  frame.force_n = renderer_.command(now_s, frame.sample);
-  if (read.fault ==
-      DeviceFault::recoverable) {  // zero now; the force ramps back from the next tick
-    fault_message_ = read.message;
-    renderer_.restart_ramp();
+  if (channel.models.update()) channel.renderer.accept(channel.models.front());
+  channel.renderer.hold_zero(paused);
+  frame.force_n = channel.renderer.command(now_s, frame.sample);
+  if (read.fault == DeviceFault::recoverable) {  // zero now; the force ramps back from the next
+    channel.fault_message = read.message;
+    channel.renderer.restart_ramp();
     frame.force_n.setZero();
   }
-  const DeviceStatus wrote = device_.write_force(frame.force_n);
+  const DeviceStatus wrote = channel.device.write_force(frame.force_n);
   if (wrote.fault == DeviceFault::fatal) {
-    fatal_ = true;
-    fault_message_ = wrote.message;
-    renderer_.hold_zero(true);
+    channel.fatal = true;
+    channel.fault_message = wrote.message;
+    channel.renderer.hold_zero(true);
   }
-  frames_.back() = frame;
-  frames_.publish();
-  log_.push(frame);
-  if (now_s - last_stats_s_ >= 0.05) {
-    ServoStats& out = stats_.back();
-    out = renderer_.stats();
-    out.device_faults = device_faults_;
-    stats_.publish();
-    last_stats_s_ = now_s;
+  channel.frames.back() = frame;
+  channel.frames.publish();
+  channel.log.push(frame);
+  if (publish_stats) {
+    ServoStats& out = channel.stats.back();
+    out = channel.renderer.stats();
+    out.device_faults = channel.device_faults;
+    channel.stats.publish();
   }
 }
 
-void ServoLoop::publish(LocalForceModel model, double published_s) {
+void ServoLoop::publish(Hand hand, LocalForceModel model, double published_s) {
+  Channel* channel = channels_[hand_index(hand)].get();
+  if (!channel) return;
   model.published_s = published_s;
-  models_.back() = to_device(model, options_.mapping);
-  models_.publish();
+  channel->models.back() = to_device(model, channel->mapping);
+  channel->models.publish();
 }
 
-bool ServoLoop::newest_frame(ServoFrame& frame) {
-  have_frame_ = frames_.update() || have_frame_;
-  if (have_frame_) frame = frames_.front();
-  return have_frame_;
+bool ServoLoop::newest_frame(Hand hand, ServoFrame& frame) {
+  Channel* channel = channels_[hand_index(hand)].get();
+  if (!channel) return false;
+  channel->have_frame = channel->frames.update() || channel->have_frame;
+  if (channel->have_frame) frame = channel->frames.front();
+  return channel->have_frame;
 }
 
-ServoStats ServoLoop::stats() {
+const WorkspaceMapping& ServoLoop::mapping(Hand hand) const {
+  const Channel* channel = channels_[hand_index(hand)].get();
+  return channel ? channel->mapping : options_.mapping;
+}
+
+ServoStats ServoLoop::stats(Hand hand) {
+  Channel* channel = channels_[hand_index(hand)].get();
+  if (!channel) return {};
   std::lock_guard lock(stats_reader_);
-  stats_.update();
-  return stats_.front();
+  channel->stats.update();
+  return channel->stats.front();
 }
 
-std::string ServoLoop::device_fault() {
-  return fatal_.load() ? std::string(fault_message_.load()) : std::string();
+std::string ServoLoop::device_fault(Hand hand) {
+  const Channel* channel = channels_[hand_index(hand)].get();
+  return channel && channel->fatal.load() ? std::string(channel->fault_message.load())
+                                          : std::string();
+}
+
+bool ServoLoop::next_logged_frame(Hand hand, ServoFrame& frame) {
+  Channel* channel = channels_[hand_index(hand)].get();
+  return channel && channel->log.pop(frame);
+}
+
+std::uint64_t ServoLoop::dropped_log_frames(Hand hand) const {
+  const Channel* channel = channels_[hand_index(hand)].get();
+  return channel ? channel->log.dropped() : 0;
 }
 
 }  // namespace liversim
