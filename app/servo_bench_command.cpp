@@ -54,27 +54,55 @@ std::vector<TrajectoryPoint> circle_on_top(const TetMesh& mesh, double seconds) 
   return points;
 }
 
+// alone: the servo and a publisher thread; simulation: with the real-time simulation, the probe in
+// the device's hand; two_devices: with the simulation, a device in each hand holding a probe.
+enum class Condition { alone, simulation, two_devices };
+
+std::string condition_name(Condition condition) {
+  switch (condition) {
+    case Condition::alone:
+      return "alone";
+    case Condition::simulation:
+      return "with the simulation";
+    case Condition::two_devices:
+      return "two devices, with the simulation";
+  }
+  return "";
+}
+
 struct ServoRun {
-  bool simulation = false;
+  Condition condition = Condition::alone;
+  int run = 0;
+  std::string device;  // the hand whose device it was, with two
   ServoStats stats;
 };
 
-ServoRun run_once(const SceneSetup& scene, bool with_simulation, double seconds) {
+// The left hand's device plays the same circle 4 cm to the left (−x) of the right hand's.
+constexpr double kLeftHandOffsetM = -0.04;
+
+std::vector<ServoRun> run_once(const SceneSetup& scene, Condition condition, int run,
+                               double seconds) {
   const std::vector<TrajectoryPoint> circle = circle_on_top(scene.mesh, seconds);
   const Eigen::Vector3d circle_centre_m =
       (circle.front().position_mm - Eigen::Vector3d(10.0, 0.0, 0.0)) * 1e-3;
   TrajectoryDevice device("bench circle", circle);
-  ServoLoop servo(device, ServoLoop::Options{});
+  TrajectoryDevice left_device("bench circle, left hand", circle);
+  ServoLoop::Options options;
+  options.left_mapping.offset_m = {kLeftHandOffsetM, 0.0, 0.0};
+  const bool two = condition == Condition::two_devices;
+  std::unique_ptr<ServoLoop> servo = two ? std::make_unique<ServoLoop>(device, left_device, options)
+                                         : std::make_unique<ServoLoop>(device, options);
   std::unique_ptr<RealtimeSimulation> simulation;
   std::atomic<bool> stop_publisher{false};
   std::thread publisher;
-  if (with_simulation) {
+  if (condition != Condition::alone) {
     auto model = std::make_shared<const SimModel>(build_model(scene.mesh, scene.model_options));
     simulation =
         std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
     simulation->enable_tools(boundary_surface(*model));
-    simulation->set_haptic_servo(&servo);
-    simulation->set_device_tool(DeviceToolSettings{});
+    simulation->set_haptic_servo(servo.get());
+    simulation->set_device_tool(Hand::right, DeviceToolSettings{});
+    if (two) simulation->set_device_tool(Hand::left, DeviceToolSettings{});
     simulation->start();
   } else {
     // A force model every 5 ms, as the simulation publishes one per cycle: a 100 N/m spring to
@@ -85,33 +113,37 @@ ServoRun run_once(const SceneSetup& scene, bool with_simulation, double seconds)
         wall.stiffness_n_per_m = Eigen::Matrix3d::Identity() * 100.0;
         wall.position_m = circle_centre_m;
         wall.radius_m = 0.02;
-        servo.publish(wall);
+        servo->publish(wall);
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
     });
   }
-  servo.start();
+  servo->start();
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
-  servo.stop();
+  servo->stop();
   if (simulation) simulation->stop();
   stop_publisher = true;
   if (publisher.joinable()) publisher.join();
-  return {with_simulation, servo.stats()};
+  if (!two) return {{condition, run, "", servo->stats()}};
+  return {{condition, run, "right", servo->stats(Hand::right)},
+          {condition, run, "left", servo->stats(Hand::left)}};
 }
 
 int run(const ServoBenchOptions& o) {
   std::filesystem::create_directories(o.output_dir);
   const SceneSetup scene = default_scene(o.tets);
   std::vector<ServoRun> runs;
-  for (bool with_simulation : {false, true})
-    for (int r = 0; r < o.runs; ++r) {
-      runs.push_back(run_once(scene, with_simulation, o.seconds));
-      const ServoStats& s = runs.back().stats;
-      std::cout << (with_simulation ? "with the simulation" : "alone") << ", run " << r + 1 << ": "
-                << number(s.rate_hz()) << " Hz, p99 " << number(s.period_percentile_s(0.99) * 1e3)
-                << " ms, max " << number(s.max_period_s * 1e3) << " ms, " << s.missed_deadlines
-                << " missed deadlines" << std::endl;
-    }
+  for (Condition condition : {Condition::alone, Condition::simulation, Condition::two_devices})
+    for (int r = 0; r < o.runs; ++r)
+      for (const ServoRun& one : run_once(scene, condition, r + 1, o.seconds)) {
+        runs.push_back(one);
+        const ServoStats& s = one.stats;
+        std::cout << condition_name(condition) << (one.device.empty() ? "" : ", " + one.device)
+                  << ", run " << r + 1 << ": " << number(s.rate_hz()) << " Hz, p99 "
+                  << number(s.period_percentile_s(0.99) * 1e3) << " ms, max "
+                  << number(s.max_period_s * 1e3) << " ms, " << s.missed_deadlines
+                  << " missed deadlines" << std::endl;
+      }
   std::ostringstream md;
   md << "# Haptic servo timing\n\n"
      << written_by("liversim-cli bench-servo --seconds " + number(o.seconds) + " --runs " +
@@ -126,17 +158,20 @@ int run(const ServoBenchOptions& o) {
         "simulation of the "
      << scene.description
      << " runs on all cores with the probe as the device's tool, publishing the local force model "
-        "each cycle: the workstation's load without its window.\n\n"
+        "each cycle: the workstation's load without its window. **Two devices** (issue 43): a "
+        "device in each hand, each holding a probe, the left hand's circle 4 cm to the left of the "
+        "right's; one servo schedule reads both and writes each its own force in the same tick, so "
+        "both devices have the same periods, listed for each.\n\n"
      << "A tick is late (a missed deadline) when its period exceeds 1.5 ms. Periods come from "
         "the servo's histogram (10 µs bins), so the percentiles are bin upper edges.\n\n"
-     << "| condition | run | ticks | rate (Hz) | period p50 (ms) | p99 (ms) | p99.9 (ms) | max "
-        "(ms) | missed deadlines | watchdog trips | largest force (N) |\n"
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  int index = 0;
+     << "| condition | device | run | ticks | rate (Hz) | period p50 (ms) | p99 (ms) | p99.9 (ms) "
+        "| max (ms) | missed deadlines | watchdog trips | largest force (N) |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const ServoRun& run : runs) {
     const ServoStats& s = run.stats;
-    md << "| " << (run.simulation ? "with the simulation" : "alone") << " | "
-       << (index++ % o.runs) + 1 << " | " << s.ticks << " | " << number(s.rate_hz()) << " | "
+    md << "| " << condition_name(run.condition) << " | "
+       << (run.device.empty() ? "the one" : run.device + " hand's") << " | " << run.run << " | "
+       << s.ticks << " | " << number(s.rate_hz()) << " | "
        << number(s.period_percentile_s(0.5) * 1e3) << " | "
        << number(s.period_percentile_s(0.99) * 1e3) << " | "
        << number(s.period_percentile_s(0.999) * 1e3) << " | " << number(s.max_period_s * 1e3)
@@ -152,8 +187,8 @@ std::function<std::optional<int>()> add_servo_bench_command(CLI::App& app) {
   auto options = std::make_shared<ServoBenchOptions>();
   auto* command = app.add_subcommand(
       "bench-servo",
-      "Measure the haptic servo's rate and tick jitter alone and with the simulation running; "
-      "write docs/haptics-servo.md");
+      "Measure the haptic servo's rate and tick jitter alone, with the simulation running, and "
+      "with a device in each hand; write docs/haptics-servo.md");
   command->add_option("--seconds", options->seconds, "Length of each run (s)")
       ->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();

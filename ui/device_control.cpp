@@ -169,7 +169,7 @@ CalibrationDialog* DeviceControl::openCalibration() {
   context.home_m =
       device_home_m(station_.simulation().snapshot().position_m, context.view_rotation);
   context.device_position_mm = [this]() -> std::optional<Eigen::Vector3d> {
-    const auto& sample = station_.simulation().snapshot().device_sample;
+    const auto& sample = station_.simulation().snapshot().hand(Hand::right).device_sample;
     return sample ? std::optional<Eigen::Vector3d>(sample->position_mm) : std::nullopt;
   };
   HapticPreferences shown = haptics_;

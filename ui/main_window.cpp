@@ -835,16 +835,18 @@ void MainWindow::showNewestSnapshot() {
     shownTopology_ = snapshot.topology_version;
   }
   scene_->update_positions(snapshot.position_m);
-  scene_->show_tool(snapshot.tool);  // where the simulation has it
-  if (mouseControl_->tool() || (servo() && snapshot.tool))
-    toolPanel_->showForce(snapshot.time_s, snapshot.tool_force_n, snapshot.tool_grasping);
+  // The device's (or the mouse's) hand: the Tool panel shows its force and its blade.
+  const HandSnapshot& held = snapshot.hand(Hand::right);
+  for (Hand hand : kHands) scene_->show_tool(hand, snapshot.hand(hand).tool);  // where it has them
+  if (mouseControl_->tool() || (servo() && held.tool))
+    toolPanel_->showForce(snapshot.time_s, held.force_n, held.grasping);
   else if (const auto pull = mouseControl_->grabForce_n(snapshot.position_m))
     toolPanel_->showForce(snapshot.time_s, *pull, true);
   else
     toolPanel_->showForce(snapshot.time_s, Eigen::Vector3d::Zero(), false);
-  const bool scalpel = snapshot.tool && snapshot.tool->kind == ToolKind::scalpel;
-  toolPanel_->showBlade(scalpel ? std::optional(snapshot.blade_edge_in_tissue_m) : std::nullopt,
-                        snapshot.blade_cutting);
+  const bool scalpel = held.tool && held.tool->kind == ToolKind::scalpel;
+  toolPanel_->showBlade(scalpel ? std::optional(held.blade_edge_in_tissue_m) : std::nullopt,
+                        held.blade_cutting);
   viewport_->scheduleRender();
 }
 

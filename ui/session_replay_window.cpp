@@ -293,14 +293,14 @@ void SessionReplayWindow::showSnapshot() {
     shownModel_ = snapshot.model;
   }
   scene_->update_positions(snapshot.position_m);
-  scene_->show_tool(snapshot.tool);
+  for (Hand hand : kHands) scene_->show_tool(hand, snapshot.hand(hand).tool);
   const double t = positionS();
   cursor_->replace({QPointF(t, 0.0), QPointF(t, largestForceN_ * 1.1)});
   // The replayed force, one point a frame; a seek back starts the curve again.
   if (replayedForce_->count() > 0 && replayedForce_->at(replayedForce_->count() - 1).x() > t)
     replayedForce_->clear();
   if (replayedForce_->count() == 0 || replayedForce_->at(replayedForce_->count() - 1).x() < t)
-    replayedForce_->append(t, snapshot.tool_force_n.norm());
+    replayedForce_->append(t, snapshot.hand(Hand::right).force_n.norm());
   viewport_->scheduleRender();
 }
 

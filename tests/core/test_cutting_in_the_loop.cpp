@@ -139,7 +139,7 @@ TEST_P(ScalpelInTheLoopTest, AStrokePartsTheLiverAndTheExplicitStepStaysUp) {
     ++cycles;
     parts += parted;
     simulation.update_snapshot();
-    broke_in |= simulation.snapshot().blade_cutting;
+    broke_in |= simulation.snapshot().hand(Hand::right).blade_cutting;
     if (steps.substeps > 0 && steps.smallest_substep_s < smallest_step_s) {
       smallest_step_s = steps.smallest_substep_s;
       at_smallest = steps;
@@ -248,7 +248,7 @@ TEST_P(ShortStrokeTest, PartsTheTissueAndKeepsTheStep) {
   simulation.replay(inputs, [&](const StepReport& report, bool changed) {
     if (report.substeps > 0) smallest_step_s = std::min(smallest_step_s, report.smallest_substep_s);
     simulation.update_snapshot();
-    broke_in |= simulation.snapshot().blade_cutting;
+    broke_in |= simulation.snapshot().hand(Hand::right).blade_cutting;
     changes += changed;
   });
   EXPECT_TRUE(broke_in) << "the blade never broke in";
@@ -303,7 +303,7 @@ TEST(LoopStep, ACuttingScalpelTakesOneForceEvaluationPerLoopStep) {
   long loop_steps = 0, evaluations = 0;
   simulation.replay(inputs, [&](const StepReport& report, bool) {
     simulation.update_snapshot();
-    if (!simulation.snapshot().blade_cutting) return;
+    if (!simulation.snapshot().hand(Hand::right).blade_cutting) return;
     loop_steps += steps;
     evaluations += report.force_evaluations;
   });
@@ -378,10 +378,11 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
     simulation.update_snapshot();
     const SimulationSnapshot& seen = simulation.snapshot();
     if (cycle++ * kCycleS * kSpeedMPerS < 0.01) return;
-    ASSERT_TRUE(seen.blade_cutting) << "the blade is not cutting at cycle " << cycle;
-    steady.push_back(seen.cutting_force_n);
-    depths_m.push_back(seen.blade_edge_in_tissue_m);
-    const Eigen::Vector3d edge_heel = seen.tool->pose.origin_m;
+    ASSERT_TRUE(seen.hand(Hand::right).blade_cutting)
+        << "the blade is not cutting at cycle " << cycle;
+    steady.push_back(seen.hand(Hand::right).cutting_force_n);
+    depths_m.push_back(seen.hand(Hand::right).blade_edge_in_tissue_m);
+    const Eigen::Vector3d edge_heel = seen.hand(Hand::right).tool->pose.origin_m;
     const SimModel& now = *seen.model;
     for (std::size_t n = 0; n < now.node_count; ++n) {
       const Eigen::Vector3d rest = now.rest_position_m.at(n);
@@ -463,13 +464,13 @@ TEST(BladeEntry, PutBackIntoItsOwnCutTheBladeIsInAtOnce) {
     ++cycle;
     if (cycle > groove_cycles) {
       Entry& entry = cycle <= into_groove_end ? groove : uncut;
-      if (seen.blade_cutting && !cutting_before && !entry.broke_in) {
+      if (seen.hand(Hand::right).blade_cutting && !cutting_before && !entry.broke_in) {
         entry.broke_in = true;
         entry.force_before_n = force_before_n;
       }
     }
-    cutting_before = seen.blade_cutting;
-    force_before_n = seen.tool_force_n.norm();
+    cutting_before = seen.hand(Hand::right).blade_cutting;
+    force_before_n = seen.hand(Hand::right).force_n.norm();
   });
   ASSERT_TRUE(groove.broke_in) << "lowered into its groove, the blade never broke in";
   ASSERT_TRUE(uncut.broke_in) << "pressed into uncut tissue, the blade never broke in";

@@ -685,6 +685,76 @@ TEST(ServoLoop, APassingDeviceFaultDropsTheForceAndItRampsBackButNeverDuringAPau
   }
 }
 
+// Two hands (issue 43): one schedule reads both devices and drives each with the force published
+// for its hand; each hand's frames are its device's; a device that dies stops its own force only.
+TEST(ServoLoop, TwoDevicesAreDrivenInTheSameTickEachWithItsOwnForce) {
+  ManualDevice right;
+  WarmingDevice left;
+  ServoLoop::Options options;
+  options.left_mapping.offset_m = {0.1, 0.0, 0.0};
+  ServoLoop servo(right, left, options);
+  EXPECT_TRUE(servo.has_device(Hand::right));
+  EXPECT_TRUE(servo.has_device(Hand::left));
+  EXPECT_EQ(servo.mapping(Hand::left).offset_m.x(), 0.1);
+  EXPECT_EQ(servo.mapping(Hand::right).offset_m.x(), 0.0);
+  right.set({0.0, 0.0, -2.0}, 1);
+  LocalForceModel right_push, left_push;
+  right_push.force_n = {0.0, 0.0, 0.5};
+  left_push.force_n = {-0.3, 0.0, 0.0};
+  for (int k = 0; k < 300; ++k) {
+    servo.publish(Hand::right, right_push, k * kTickS);
+    servo.publish(Hand::left, left_push, k * kTickS);
+    servo.tick(k * kTickS);
+  }
+  EXPECT_NEAR(right.last_force_n().z(), 0.5, 1e-9);
+  EXPECT_NEAR(right.last_force_n().x(), 0.0, 1e-12);
+  EXPECT_NEAR(left.force_n.x(), -0.3, 1e-9);
+  EXPECT_NEAR(left.force_n.z(), 0.0, 1e-12);
+  ServoFrame frame;
+  ASSERT_TRUE(servo.newest_frame(Hand::right, frame));
+  EXPECT_EQ(frame.sample.position_mm.z(), -2.0);
+  ASSERT_TRUE(servo.newest_frame(Hand::left, frame));
+  EXPECT_EQ(frame.sample.position_mm.z(), 0.0);
+  std::size_t right_frames = 0, left_frames = 0;
+  while (servo.next_logged_frame(Hand::right, frame)) ++right_frames;
+  while (servo.next_logged_frame(Hand::left, frame)) {
+    EXPECT_NEAR(frame.force_n.z(), 0.0, 1e-12) << "the left device's frame has the right's force";
+    ++left_frames;
+  }
+  EXPECT_EQ(right_frames, 300u);
+  EXPECT_EQ(left_frames, 300u);
+  EXPECT_EQ(servo.stats(Hand::left).ticks, servo.stats(Hand::right).ticks);
+  EXPECT_THROW(ServoLoop(right, right, {}), std::invalid_argument) << "one device in both hands";
+  ServoLoop::Options bad;
+  bad.left_mapping.scale = 0.0;
+  EXPECT_THROW(ServoLoop(right, left, bad), std::invalid_argument);
+}
+
+// A device gone for good in one hand.
+class UnpluggedDevice final : public HapticDevice {
+ public:
+  std::string name() const override { return "unplugged"; }
+  DeviceLimits limits() const override { return {}; }
+  DeviceStatus read(double, DeviceSample&) override {
+    return {DeviceFault::fatal, "the device was unplugged"};
+  }
+  DeviceStatus write_force(const Eigen::Vector3d&) override { return {}; }
+};
+
+TEST(ServoLoop, ADeviceThatDiesInOneHandLeavesTheOtherHandsDeviceDriven) {
+  ManualDevice right;
+  UnpluggedDevice left;
+  ServoLoop servo(right, left, {});
+  HandTicks tick{servo, {}};
+  tick.push.force_n = {0.0, 0.4, 0.0};
+  while (tick.k < 200) tick();
+  EXPECT_EQ(servo.device_fault(Hand::left), "the device was unplugged");
+  EXPECT_EQ(servo.device_fault(Hand::right), "");
+  EXPECT_NEAR(right.last_force_n().y(), 0.4, 1e-9) << "the right hand's device lost its force";
+  ServoFrame frame;
+  EXPECT_FALSE(servo.newest_frame(Hand::left, frame)) << "a dead device gave frames";
+}
+
 // Records a session on a scripted device pressing into a wall that the "simulation" republishes
 // every 10 ticks from the newest frame, ticking on an exact 1 ms clock; returns the frames.
 std::vector<ServoFrame> press_into_a_wall(HapticDevice& device, double duration_s) {

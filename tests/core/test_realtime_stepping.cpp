@@ -273,9 +273,10 @@ TEST_F(RealtimeSteppingFixture, ForcepsInTheLoopHoldPullAndRelease) {
     return simulation.snapshot();
   };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!newest().tool_grasping && std::chrono::steady_clock::now() < deadline)
+  while (!newest().hand(Hand::right).grasping && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  ASSERT_TRUE(newest().tool_grasping) << "the forceps closed on the surface took no hold";
+  ASSERT_TRUE(newest().hand(Hand::right).grasping)
+      << "the forceps closed on the surface took no hold";
   forceps.pose.origin_m.z() += 0.01;
   simulation.set_tool(forceps);
   // Until the held point has come up by half the lift (a second of simulated time at most).
@@ -287,7 +288,7 @@ TEST_F(RealtimeSteppingFixture, ForcepsInTheLoopHoldPullAndRelease) {
     seen = newest();
   }
   EXPECT_GT(seen.position_m.z[node] - marked.z(), 0.005);
-  EXPECT_LT(seen.tool_force_n.z(), 0.0) << "the tissue pulls the forceps back down";
+  EXPECT_LT(seen.hand(Hand::right).force_n.z(), 0.0) << "the tissue pulls the forceps back down";
   // A device that sends a NaN pose while holding: the step refuses the input, the loop goes on.
   Tool broken = forceps;
   broken.pose.origin_m.x() = std::nan("");
@@ -300,10 +301,10 @@ TEST_F(RealtimeSteppingFixture, ForcepsInTheLoopHoldPullAndRelease) {
       << "tools are enabled while the simulation is stopped";
   forceps.jaw_opening = 1.0;
   simulation.set_tool(forceps);
-  while (newest().tool_grasping && std::chrono::steady_clock::now() < deadline)
+  while (newest().hand(Hand::right).grasping && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   simulation.stop();
-  EXPECT_FALSE(simulation.snapshot().tool_grasping);
+  EXPECT_FALSE(simulation.snapshot().hand(Hand::right).grasping);
   EXPECT_EQ(check_health(*model, simulation.state()), HealthProblem::none);
 }
 
@@ -404,24 +405,33 @@ TEST_F(RealtimeSteppingFixture, ReplayingTheLoggedInputsReproducesTheRunToTheLas
   scalpel.kind = ToolKind::scalpel;
   scalpel.geometry.blade_length_m = 0.06;
   const Eigen::Vector3d start(box.center().x() - 0.04, box.center().y(), box.max().z() + 0.005);
+  // The left hand's probe presses the top beside the stroke while the scalpel cuts.
+  probe.pose.origin_m = Eigen::Vector3d(box.center().x(), box.center().y() + 0.02, box.max().z());
   for (int k = 0; k <= 60; ++k) {
     scalpel.pose.origin_m = start + Eigen::Vector3d(0.001 * k, 0.0, 0.0);
     live->set_tool(scalpel);
+    if (k % 6 == 0) {
+      probe.pose.origin_m.z() -= 0.0005;
+      live->set_tool(Hand::left, probe);
+    }
     simulate_for(0.020);
   }
   live->set_tool(std::nullopt);
+  live->set_tool(Hand::left, std::nullopt);
   simulate_for(0.050);
   live->stop();
   const std::vector<SimulationInput> log = live->take_input_log();
-  int cycles = 0, tools = 0, springs = 0;
+  int cycles = 0, tools = 0, left_tools = 0, springs = 0;
   for (const SimulationInput& input : log) {
     cycles += input.kind == SimulationInput::Kind::cycle;
     tools += input.kind == SimulationInput::Kind::tool;
+    left_tools += input.kind == SimulationInput::Kind::tool && input.hand == Hand::left;
     springs += input.kind == SimulationInput::Kind::springs;
   }
   EXPECT_GT(cycles, 50);
   EXPECT_GT(tools, 10);
-  EXPECT_EQ(springs, 2);  // the grab and its release
+  EXPECT_EQ(left_tools, 12);  // eleven presses and the probe taken away
+  EXPECT_EQ(springs, 2);      // the grab and its release
   ASSERT_GT(live->model().node_count, model->node_count) << "the scalpel cut nothing";
   ASSERT_FALSE(live->stats().halted);
 
@@ -478,7 +488,7 @@ TEST_F(RealtimeSteppingFixture, AScalpelThatBrokeInCutsWhereverItIsDrawnUntilItI
   // Pressed in until it breaks in.
   bool broke_in = false;
   for (int k = 0; k < 150 && !broke_in; ++k)
-    broke_in = move_to(heel - Eigen::Vector3d(0.0, 0.0, 2e-4)).blade_cutting;
+    broke_in = move_to(heel - Eigen::Vector3d(0.0, 0.0, 2e-4)).hand(Hand::right).blade_cutting;
   ASSERT_TRUE(broke_in) << "pressed 30 mm in, the blade did not break in";
   // In, it passes into the tissue without pushing, on through the liver (so that the stroke
   // passes through whole elements of this coarse mesh, 2 cm across). Held still, the tissue
@@ -500,11 +510,12 @@ TEST_F(RealtimeSteppingFixture, AScalpelThatBrokeInCutsWhereverItIsDrawnUntilItI
   SimulationSnapshot seen;
   for (int k = 0; k < 80; ++k) seen = move_to(heel + Eigen::Vector3d(1e-3, 0.0, 0.0));
   EXPECT_GT(seen.topology_version, 0u) << "the blade passed through the tissue uncut";
-  EXPECT_TRUE(seen.blade_cutting);
+  EXPECT_TRUE(seen.hand(Hand::right).blade_cutting);
   // Drawn out (its tip clear of the tissue), it is out: the next cut needs a new break-in.
   while (heel.z() - scalpel.geometry.blade_length_m < top_m + 0.01)
     seen = move_to(heel + Eigen::Vector3d(0.0, 0.0, 1e-3));
-  EXPECT_FALSE(seen.blade_cutting) << "the blade drawn out of the tissue still cuts";
+  EXPECT_FALSE(seen.hand(Hand::right).blade_cutting)
+      << "the blade drawn out of the tissue still cuts";
   simulation.stop();
   EXPECT_FALSE(simulation.stats().halted);
   EXPECT_EQ(check_health(*simulation.snapshot().model, simulation.state()), HealthProblem::none);
@@ -538,7 +549,7 @@ TEST_F(RealtimeSteppingFixture, TheForceOnAProbeReachesTheHapticDeviceInNewtons)
   simulation.stop();
   const auto stopped = std::chrono::steady_clock::now();
   simulation.update_snapshot();
-  const Eigen::Vector3d simulated_n = simulation.snapshot().tool_force_n;
+  const Eigen::Vector3d simulated_n = simulation.snapshot().hand(Hand::right).force_n;
   ASSERT_GT(simulated_n.norm(), 0.05) << "the probe pressed nothing";
   // A stall of this shared machine trips the watchdog, and its ramp back up takes 0.05 s (the CI
   // once read 77 % of the force): wait for the full force, well before the model goes stale
@@ -560,6 +571,73 @@ TEST_F(RealtimeSteppingFixture, TheForceOnAProbeReachesTheHapticDeviceInNewtons)
   EXPECT_GE(servo.stats().watchdog_trips, 1u);
   servo.stop();
   EXPECT_EQ(device.last_force_n(), Eigen::Vector3d::Zero()) << "force left on after stop";
+}
+
+// A scripted device in each hand (issue 43): the left one's forceps close on the marked node and
+// lift it while the right one's probe presses the top; each tool is where its own device's mapping
+// puts it, and each device is pushed by its own tool's tissue.
+TEST_F(RealtimeSteppingFixture, TwoScriptedDevicesMoveAToolEachAndEachFeelsItsOwn) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(*mesh_));
+  const NodeIndex node = anterior_marked_node(*mesh_);
+  const Eigen::Vector3d marked = model->rest_position_m.at(node);
+  DeviceToolSettings forceps, probe;
+  forceps.kind = ToolKind::forceps;
+  probe.kind = ToolKind::probe;
+  const Eigen::AlignedBox3d box = rest_box(*model);
+  ServoLoop::Options options;
+  options.left_mapping.offset_m = marked - forceps_grasp_point_m(device_tool(forceps, {}, 1));
+  options.mapping.offset_m = {box.center().x(), box.center().y(), box.max().z()};
+  // Left: open, 15 mm above; down; closed from 0.6 s; lifted 25 mm over 1 s. Right: from 10 mm
+  // above the top's highest point, pressed 8 mm down over 1 s.
+  TrajectoryDevice left("left script", {{0.0, {0.0, 0.0, 15.0}, 0},
+                                        {0.4, {0.0, 0.0, 0.0}, 0},
+                                        {0.6, {0.0, 0.0, 0.0}, 1},
+                                        {1.0, {0.0, 0.0, 0.0}, 1},
+                                        {2.0, {0.0, 0.0, 25.0}, 1},
+                                        {30.0, {0.0, 0.0, 25.0}, 1}});
+  TrajectoryDevice right(
+      "right script",
+      {{0.0, {0.0, 0.0, 10.0}, 0}, {1.0, {0.0, 0.0, -8.0}, 0}, {30.0, {0.0, 0.0, -8.0}, 0}});
+  ServoLoop servo(right, left, options);
+  simulation.set_haptic_servo(&servo);
+  simulation.set_device_tool(Hand::left, forceps);
+  simulation.set_device_tool(Hand::right, probe);
+  servo.start();
+  simulation.start();
+  const SimulationSnapshot both = run_until(simulation, 60.0, [&](const SimulationSnapshot& s) {
+    return s.hand(Hand::left).grasping && s.position_m.z[node] - marked.z() > 0.005 &&
+           s.hand(Hand::right).force_n.z() > 0.05;
+  });
+  simulation.stop();
+  servo.stop();
+  const HandSnapshot& l = both.hand(Hand::left);
+  const HandSnapshot& r = both.hand(Hand::right);
+  ASSERT_TRUE(l.grasping) << "the left hand's forceps took no hold";
+  ASSERT_GT(both.position_m.z[node] - marked.z(), 0.005) << "the held node was not lifted";
+  ASSERT_GT(r.force_n.z(), 0.05) << "the right hand's probe pressed nothing";
+  ASSERT_TRUE(l.tool && l.device_sample && r.tool && r.device_sample);
+  EXPECT_EQ(l.tool->kind, ToolKind::forceps);
+  EXPECT_EQ(r.tool->kind, ToolKind::probe);
+  EXPECT_LT(
+      (l.tool->pose.origin_m - options.left_mapping.scene_position_m(l.device_sample->position_mm))
+          .norm(),
+      1e-12);
+  EXPECT_LT((r.tool->pose.origin_m - options.mapping.scene_position_m(r.device_sample->position_mm))
+                .norm(),
+            1e-12);
+  EXPECT_LT(l.force_n.z(), 0.0) << "the tissue pulls the forceps back down";
+  // Each device was pushed by its own tool: the probe's up, the forceps' down.
+  double right_up = 0.0, left_down = 0.0;
+  ServoFrame frame;
+  while (servo.next_logged_frame(Hand::right, frame))
+    right_up = std::max(right_up, frame.force_n.z());
+  while (servo.next_logged_frame(Hand::left, frame))
+    left_down = std::max(left_down, -frame.force_n.z());
+  EXPECT_GT(right_up, 0.0) << "the right device never felt its probe";
+  EXPECT_GT(left_down, 0.0) << "the left device never felt its forceps";
+  EXPECT_FALSE(simulation.stats().halted);
 }
 
 // A scripted device holds the forceps (issue 8): the servo's mapping puts the device's origin on
@@ -592,14 +670,15 @@ TEST_F(RealtimeSteppingFixture, AScriptedDeviceHoldsTheForcepsPullsTheLiverAndFe
   simulation.set_tool(std::nullopt);  // ignored while the device holds a tool
   servo.start();
   simulation.start();
-  const SimulationSnapshot grasped = run_until(
-      simulation, 60.0, [](const SimulationSnapshot& seen) { return seen.tool_grasping; });
-  ASSERT_TRUE(grasped.tool_grasping) << "the jaws closed by the button took no hold";
-  ASSERT_TRUE(grasped.tool && grasped.device_sample);
-  EXPECT_EQ(grasped.tool->kind, ToolKind::forceps);
-  EXPECT_EQ(grasped.tool->jaw_opening, 0.0);
-  EXPECT_LT((grasped.tool->pose.origin_m -
-             options.mapping.scene_position_m(grasped.device_sample->position_mm))
+  const SimulationSnapshot grasped =
+      run_until(simulation, 60.0,
+                [](const SimulationSnapshot& seen) { return seen.hand(Hand::right).grasping; });
+  ASSERT_TRUE(grasped.hand(Hand::right).grasping) << "the jaws closed by the button took no hold";
+  ASSERT_TRUE(grasped.hand(Hand::right).tool && grasped.hand(Hand::right).device_sample);
+  EXPECT_EQ(grasped.hand(Hand::right).tool->kind, ToolKind::forceps);
+  EXPECT_EQ(grasped.hand(Hand::right).tool->jaw_opening, 0.0);
+  EXPECT_LT((grasped.hand(Hand::right).tool->pose.origin_m -
+             options.mapping.scene_position_m(grasped.hand(Hand::right).device_sample->position_mm))
                 .norm(),
             1e-12)
       << "the tool is not where the mapping puts the device";
@@ -608,8 +687,8 @@ TEST_F(RealtimeSteppingFixture, AScriptedDeviceHoldsTheForcepsPullsTheLiverAndFe
     return s.position_m.z[node] - marked.z() > 0.005;
   });
   EXPECT_GT(lifted.position_m.z[node] - marked.z(), 0.005);
-  EXPECT_TRUE(lifted.tool_grasping);
-  EXPECT_LT(lifted.tool_force_n.z(), 0.0) << "the tissue pulls the forceps back down";
+  EXPECT_TRUE(lifted.hand(Hand::right).grasping);
+  EXPECT_LT(lifted.hand(Hand::right).force_n.z(), 0.0) << "the tissue pulls the forceps back down";
   simulation.stop();  // the last model stands for the servo until it goes stale
   servo.stop();
   EXPECT_GT(servo.stats().ticks, 0u);
@@ -623,13 +702,14 @@ TEST_F(RealtimeSteppingFixture, AScriptedDeviceHoldsTheForcepsPullsTheLiverAndFe
   simulation.start();
   // The first snapshots may still be the last cycle's before the stop.
   const SimulationSnapshot after = run_until(simulation, 60.0, [](const SimulationSnapshot& seen) {
-    return seen.tool && seen.tool->kind == ToolKind::probe;
+    return seen.hand(Hand::right).tool && seen.hand(Hand::right).tool->kind == ToolKind::probe;
   });
   simulation.stop();
-  ASSERT_TRUE(after.tool);
-  EXPECT_EQ(after.tool->kind, ToolKind::probe);
-  EXPECT_TRUE(after.device_sample) << "the servo's frames are still read";
-  EXPECT_FALSE(after.tool_grasping) << "the forceps let go when the device put them down";
+  ASSERT_TRUE(after.hand(Hand::right).tool);
+  EXPECT_EQ(after.hand(Hand::right).tool->kind, ToolKind::probe);
+  EXPECT_TRUE(after.hand(Hand::right).device_sample) << "the servo's frames are still read";
+  EXPECT_FALSE(after.hand(Hand::right).grasping)
+      << "the forceps let go when the device put them down";
 }
 
 // The mouse puts the device's tool down where it presses: a frame stamped before the press, with
@@ -648,17 +728,20 @@ TEST_F(RealtimeSteppingFixture, FramesFromBeforeTheDeviceToolWasSetAreNotTaken) 
   simulation.set_haptic_servo(&servo);
   simulation.set_device_tool(DeviceToolSettings{}, 2.0);
   simulation.start();
-  const SimulationSnapshot before = run_until(
-      simulation, 0.05, [](const SimulationSnapshot& seen) { return seen.tool.has_value(); });
-  EXPECT_FALSE(before.tool) << "the frame of t = 1 s, before the press at 2 s, was taken";
-  ASSERT_TRUE(before.device_sample) << "the frame itself was read";
+  const SimulationSnapshot before = run_until(simulation, 0.05, [](const SimulationSnapshot& seen) {
+    return seen.hand(Hand::right).tool.has_value();
+  });
+  EXPECT_FALSE(before.hand(Hand::right).tool)
+      << "the frame of t = 1 s, before the press at 2 s, was taken";
+  ASSERT_TRUE(before.hand(Hand::right).device_sample) << "the frame itself was read";
   device.place(new_mm, 0);
   servo.tick(2.0);
-  const SimulationSnapshot after = run_until(
-      simulation, 1.0, [](const SimulationSnapshot& seen) { return seen.tool.has_value(); });
+  const SimulationSnapshot after = run_until(simulation, 1.0, [](const SimulationSnapshot& seen) {
+    return seen.hand(Hand::right).tool.has_value();
+  });
   simulation.stop();
-  ASSERT_TRUE(after.tool) << "the frame stamped at the press was not taken";
-  EXPECT_LT((after.tool->pose.origin_m - new_mm * 1e-3).norm(), 1e-12);
+  ASSERT_TRUE(after.hand(Hand::right).tool) << "the frame stamped at the press was not taken";
+  EXPECT_LT((after.hand(Hand::right).tool->pose.origin_m - new_mm * 1e-3).norm(), 1e-12);
 }
 
 // The blade breaks in by the toughness of the tissue it presses on (RegionMaterial): pressed in
@@ -686,9 +769,9 @@ TEST_F(RealtimeSteppingFixture, ABladeBreaksIntoTougherTissueOnlyUnderAHarderPre
     for (int k = 0; k < 300; ++k) {  // up to 30 mm
       scalpel.pose.origin_m.z() -= 1e-4;
       simulation.set_tool(scalpel);
-      if (run_until(simulation, 0.01, [](const SimulationSnapshot&) {
-            return false;
-          }).blade_cutting) {
+      if (run_until(simulation, 0.01, [](const SimulationSnapshot&) { return false; })
+              .hand(Hand::right)
+              .blade_cutting) {
         depth_m = touching_z_m - scalpel.pose.origin_m.z();
         break;
       }
@@ -730,13 +813,13 @@ TEST_F(RealtimeSteppingFixture, ADisarmedScalpelPressesButNeverBreaksIn) {
   };
   SimulationSnapshot seen;
   for (int k = 0; k < 100; ++k) seen = press(2e-4);  // 20 mm
-  EXPECT_FALSE(seen.blade_cutting) << "a disarmed blade broke in";
+  EXPECT_FALSE(seen.hand(Hand::right).blade_cutting) << "a disarmed blade broke in";
   EXPECT_EQ(seen.topology_version, 0u);
-  EXPECT_GT(seen.tool_contacts, 0u) << "the blade pressed nothing";
+  EXPECT_GT(seen.hand(Hand::right).contacts, 0u) << "the blade pressed nothing";
   scalpel.blade_armed = true;
-  for (int k = 0; k < 150 && !seen.blade_cutting; ++k) seen = press(1e-4);
+  for (int k = 0; k < 150 && !seen.hand(Hand::right).blade_cutting; ++k) seen = press(1e-4);
   simulation.stop();
-  EXPECT_TRUE(seen.blade_cutting) << "armed, the pressed blade did not break in";
+  EXPECT_TRUE(seen.hand(Hand::right).blade_cutting) << "armed, the pressed blade did not break in";
   EXPECT_FALSE(simulation.stats().halted);
 }
 

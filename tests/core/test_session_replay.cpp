@@ -53,7 +53,12 @@ std::vector<SimulationInput> every_kind_of_input() {
   SimulationInput untimed_cycle = input(SimulationInput::Kind::cycle);
   untimed_cycle.steps = 1;
   const SimulationInput take_out = input(SimulationInput::Kind::take_out_specimens);
-  return {tool, springs, cycle, take_out, no_tool, no_springs, untimed_cycle};
+  SimulationInput left_tool = tool;
+  left_tool.hand = Hand::left;
+  SimulationInput left_no_tool = no_tool;
+  left_no_tool.hand = Hand::left;
+  return {tool,       springs,       cycle,     take_out,    no_tool,
+          no_springs, untimed_cycle, left_tool, left_no_tool};
 }
 
 TEST(SessionLog, InputChunksReadBackExactly) {
@@ -65,6 +70,9 @@ TEST(SessionLog, InputChunksReadBackExactly) {
     const SimulationInput& a = inputs[i];
     const SimulationInput& b = read[i];
     EXPECT_EQ(a.kind, b.kind);
+    if (a.kind == SimulationInput::Kind::tool) {
+      EXPECT_EQ(a.hand, b.hand);
+    }
     ASSERT_EQ(a.tool.has_value(), b.tool.has_value());
     if (a.tool) {
       EXPECT_EQ(a.tool->kind, b.tool->kind);
@@ -105,7 +113,7 @@ TEST(SessionLog, ADamagedInputChunkIsRefusedNamingWhatIsWrong) {
   EXPECT_NE(decode_error(bytes).find("\"LSI1\""), std::string::npos) << decode_error(bytes);
   bytes = good;
   bytes.resize(bytes.size() - 3);
-  EXPECT_NE(decode_error(bytes).find("ends inside input 6"), std::string::npos)
+  EXPECT_NE(decode_error(bytes).find("ends inside input 7"), std::string::npos)
       << decode_error(bytes);
   bytes = good;
   bytes.push_back(0);
@@ -180,18 +188,18 @@ class SessionReplayTest : public ::testing::Test {
     Tool scalpel;
     scalpel.kind = ToolKind::scalpel;
     scalpel.pose.origin_m = {entry.x(), entry.y(), top_z + scalpel.geometry.blade_length_m};
-    for (int k = 0; k < 40 && !live_->snapshot().blade_cutting; ++k) {
+    for (int k = 0; k < 40 && !live_->snapshot().hand(Hand::right).blade_cutting; ++k) {
       scalpel.pose.origin_m.z() -= 0.001;
       live_->set_tool(scalpel);
       wait_simulated(0.01);
     }
-    broke_in_ = live_->snapshot().blade_cutting;
+    broke_in_ = live_->snapshot().hand(Hand::right).blade_cutting;
     for (int k = 0; k < 20; ++k) {  // in: the blade sinks without pushing
       scalpel.pose.origin_m.z() -= 0.001;
       live_->set_tool(scalpel);
       wait_simulated(0.01);
     }
-    in_after_sinking_ = live_->snapshot().blade_cutting;
+    in_after_sinking_ = live_->snapshot().hand(Hand::right).blade_cutting;
     // Drawn until it has cut, then 1 cm on. On this coarse mesh (elements about 2 cm across) a cut
     // parts only elements the blade has passed all the way through: the first faces part after 4
     // to 6 cm, depending on how deep the blade broke in, which the threads' timing decides.
@@ -200,7 +208,7 @@ class SessionReplayTest : public ::testing::Test {
       live_->set_tool(scalpel);
       wait_simulated(0.01);
       ++positions_drawn_;
-      if (live_->snapshot().blade_cutting) ++cycles_drawn_in_;
+      if (live_->snapshot().hand(Hand::right).blade_cutting) ++cycles_drawn_in_;
       if (live_->snapshot().topology_version > 0) ++after_cut;
     }
     live_->set_tool(std::nullopt);

@@ -445,6 +445,53 @@ TEST_F(RenderBaselineTest, ToolModelsAreReadAndDrawnWhereTheirCapsulesAre) {
   expectMatchesBaseline(modelled, "forceps_model");
 }
 
+// Two hands (issue 43): the left hand's forceps and the right hand's scalpel are drawn at once,
+// each where its capsules are, and the same kind in both hands is drawn twice.
+TEST_F(RenderBaselineTest, EachHandsToolIsDrawnAtOnce) {
+  const SceneSetup setup = default_scene();
+  LiverScene scene(setup.mesh, setup.visual);
+  scene.set_tool_models(load_tool_models());
+  const fs::path empty = screenshot(scene, "no_tools");
+  Tool forceps;
+  forceps.kind = ToolKind::forceps;
+  forceps.jaw_opening = 0.4;
+  forceps.pose.origin_m = Eigen::Vector3d(-0.03, 0.0, 0.08);
+  forceps.pose.orientation = Eigen::AngleAxisd(-0.5, Eigen::Vector3d::UnitX());
+  Tool scalpel;
+  scalpel.kind = ToolKind::scalpel;
+  scalpel.pose.origin_m = Eigen::Vector3d(0.05, 0.0, 0.08);
+  scalpel.pose.orientation = Eigen::AngleAxisd(-0.5, Eigen::Vector3d::UnitX());
+  scene.show_tool(Hand::left, forceps);
+  scene.show_tool(Hand::right, scalpel);
+  const fs::path both = screenshot(scene, "two_hands");
+  const auto image = readPng(both);
+  // Steel (grey: red ≈ blue) halfway along each tool's shaft.
+  for (const Tool& tool : {forceps, scalpel}) {
+    std::array<Capsule, 3> parts;
+    tool_capsules(tool, parts);
+    const Eigen::Vector2d pixel = screenshotPixel(scene, 0.5 * (parts[0].a_m + parts[0].b_m));
+    const auto* p =
+        static_cast<unsigned char*>(image->GetScalarPointer(int(pixel.x()), int(pixel.y()), 0));
+    EXPECT_LT(std::abs(p[0] - p[2]), 40) << tool_name(tool.kind) << "'s shaft is not drawn";
+  }
+  // The left hand's put down: only the right's is drawn; a scalpel in each hand: two scalpels.
+  scene.show_tool(Hand::left, std::nullopt);
+  const fs::path right_only = screenshot(scene, "right_hand_only");
+  EXPECT_GT(changedPixels(both, right_only), 500) << "the left hand's forceps stayed";
+  Tool other = scalpel;
+  other.pose.origin_m.x() = -0.03;
+  scene.show_tool(Hand::left, other);
+  const fs::path two_scalpels = screenshot(scene, "two_scalpels");
+  EXPECT_GT(changedPixels(right_only, two_scalpels), 500) << "the left hand's scalpel is not drawn";
+  // Put down, neither is drawn.
+  scene.show_tool(Hand::left, std::nullopt);
+  scene.show_tool(Hand::right, std::nullopt);
+  const fs::path none = screenshot(scene, "tools_put_down");
+  EXPECT_EQ(changedPixels(empty, none), 0) << "a tool put down is still drawn";
+  for (const fs::path& file : {empty, right_only, two_scalpels, none}) fs::remove(file);
+  expectMatchesBaseline(both, "two_hands");
+}
+
 // The organ's pixels: red well above blue, which neither the grey-blue background nor the steel
 // has.
 bool organPixel(const unsigned char* p) {

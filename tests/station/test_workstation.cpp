@@ -251,8 +251,8 @@ TEST_F(StationTest, AGraspAndReleaseByTheDeviceAreSessionEvents) {
   // First where the view holds the forceps: the grasp point's offset from the device's point.
   const Eigen::Vector3d above_mm = topOfTheMiddle_mm() + Eigen::Vector3d(0, 0, 40);
   play({{0.0, above_mm, 0}, {600.0, above_mm, 0}});
-  ASSERT_TRUE(frameUntil([&] { return snapshot().tool.has_value(); }));
-  Tool closed = *snapshot().tool;
+  ASSERT_TRUE(frameUntil([&] { return snapshot().hand(Hand::right).tool.has_value(); }));
+  Tool closed = *snapshot().hand(Hand::right).tool;
   closed.jaw_opening = 0.0;
   const Eigen::Vector3d grasp_offset_m = forceps_grasp_point_m(closed) - closed.pose.origin_m;
   ASSERT_FALSE(station_->use_device(DeviceChoice::mouse, WorkspaceMapping{}));
@@ -261,8 +261,10 @@ TEST_F(StationTest, AGraspAndReleaseByTheDeviceAreSessionEvents) {
   play({{0.0, at_mm, 0}, {0.3, at_mm, 1}, {1.5, at_mm, 0}, {600.0, at_mm, 0}});
   ASSERT_TRUE(station_->recording_session());
   const std::int64_t session = *station_->recording_session();
-  ASSERT_TRUE(frameUntil([&] { return snapshot().tool_grasping; })) << "the forceps took no hold";
-  ASSERT_TRUE(frameUntil([&] { return !snapshot().tool_grasping; })) << "they did not let go";
+  ASSERT_TRUE(frameUntil([&] { return snapshot().hand(Hand::right).grasping; }))
+      << "the forceps took no hold";
+  ASSERT_TRUE(frameUntil([&] { return !snapshot().hand(Hand::right).grasping; }))
+      << "they did not let go";
   station_->frame();  // the display frame that sees the release
   ASSERT_FALSE(station_->use_device(DeviceChoice::mouse, WorkspaceMapping{}));
   station_->finish_metrics();
@@ -303,7 +305,7 @@ TEST_F(StationTest, ARecordedSessionReplaysItsDeviceInputAndIsNotRecordedAgain) 
   EXPECT_FALSE(station_->recording_session()) << "a replay was recorded";
   const Eigen::Vector3d along = (end_mm - start_mm).normalized();
   ASSERT_TRUE(frameUntil([&] {
-    const auto sample = snapshot().device_sample;
+    const auto sample = snapshot().hand(Hand::right).device_sample;
     if (!sample) return false;
     const Eigen::Vector3d off = sample->position_mm - start_mm;
     EXPECT_LT((off - off.dot(along) * along).norm(), 1e-9) << "off the recorded line";
@@ -325,7 +327,7 @@ TEST_F(StationTest, LiveModelChangesCarryTheLiverOnAndAreSessionEvents) {
   const Eigen::Vector3d pressed = topOfTheMiddle_mm() + Eigen::Vector3d(0, 0, ball_mm - 6);
   play({{0.0, pressed + Eigen::Vector3d(0, 0, 20), 0}, {0.5, pressed, 0}, {600.0, pressed, 0}});
   const std::int64_t session = *station_->recording_session();
-  ASSERT_TRUE(frameUntil([&] { return snapshot().tool_force_n.norm() > 0.05; }));
+  ASSERT_TRUE(frameUntil([&] { return snapshot().hand(Hand::right).force_n.norm() > 0.05; }));
 
   IntegratorSettings settings = station_->integrator();
   ASSERT_EQ(settings.kind, IntegratorKind::central_difference);
@@ -343,7 +345,7 @@ TEST_F(StationTest, LiveModelChangesCarryTheLiverOnAndAreSessionEvents) {
       frameUntil([&] { return snapshot().model && snapshot().model->integrator == settings; }));
   // Carried on, not restarted: the step count and time go on, and the probe still presses.
   EXPECT_GE(snapshot().step_count, steps_before);
-  ASSERT_TRUE(frameUntil([&] { return snapshot().tool_force_n.norm() > 0.05; }));
+  ASSERT_TRUE(frameUntil([&] { return snapshot().hand(Hand::right).force_n.norm() > 0.05; }));
   EXPECT_EQ(station_->recording_session(), session) << "the session goes on";
 
   // A bad setting is refused, naming it; the integrator in use stays.
@@ -471,7 +473,7 @@ TEST_F(StationTest, AFatalDeviceFaultEndsTheSessionAndTheMouseTakesOver) {
   ASSERT_FALSE(station_->use_device(DeviceChoice::openhaptics, WorkspaceMapping{}));
   ASSERT_TRUE(station_->recording_session());
   ASSERT_TRUE(servoTicks(200));
-  ASSERT_TRUE(frameUntil([&] { return snapshot().tool.has_value(); }));
+  ASSERT_TRUE(frameUntil([&] { return snapshot().hand(Hand::right).tool.has_value(); }));
   auto inject = fakeHook<void (*)(unsigned, int)>("fake_hd_inject_error");
   auto last_force = fakeHook<void (*)(double*)>("fake_hd_last_force");
   ASSERT_TRUE(inject && last_force);

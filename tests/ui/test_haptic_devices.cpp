@@ -167,15 +167,17 @@ TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
       << window_->devicePanel()->statusText().toStdString();
   ASSERT_NE(window_->servo(), nullptr);
   EXPECT_TRUE(window_->devicePanel()->statusText().contains("trajectory.txt"));
-  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().tool_force_n.norm() > 0.05; }, kTimeoutMs))
-      << "the scripted probe pressed nothing: " << snapshot().tool_force_n.transpose();
-  ASSERT_TRUE(snapshot().tool && snapshot().device_sample);
-  EXPECT_EQ(snapshot().tool->kind, ToolKind::probe);
-  EXPECT_LT((snapshot().tool->pose.origin_m - window_->hapticPreferences().mapping.scene_position_m(
-                                                  snapshot().device_sample->position_mm))
+  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().hand(Hand::right).force_n.norm() > 0.05; },
+                              kTimeoutMs))
+      << "the scripted probe pressed nothing: " << snapshot().hand(Hand::right).force_n.transpose();
+  ASSERT_TRUE(snapshot().hand(Hand::right).tool && snapshot().hand(Hand::right).device_sample);
+  EXPECT_EQ(snapshot().hand(Hand::right).tool->kind, ToolKind::probe);
+  EXPECT_LT((snapshot().hand(Hand::right).tool->pose.origin_m -
+             window_->hapticPreferences().mapping.scene_position_m(
+                 snapshot().hand(Hand::right).device_sample->position_mm))
                 .norm(),
             1e-12);
-  EXPECT_GT(snapshot().tool_force_n.z(), 0.0) << "the liver pushes the probe up";
+  EXPECT_GT(snapshot().hand(Hand::right).force_n.z(), 0.0) << "the liver pushes the probe up";
   EXPECT_TRUE(window_->toolPanel()->forceText().contains("Force on the tool"));
   // The servo's figures reach the panel (the status timer, every half second).
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 200; }, kTimeoutMs));
@@ -186,7 +188,8 @@ TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
   ASSERT_TRUE(window_->useDevice(DeviceChoice::mouse));
   EXPECT_EQ(window_->device(), DeviceChoice::mouse);
   EXPECT_TRUE(window_->devicePanel()->statusText().contains("mouse"));
-  ASSERT_TRUE(QTest::qWaitFor([&] { return !snapshot().tool.has_value(); }, kTimeoutMs));
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return !snapshot().hand(Hand::right).tool.has_value(); }, kTimeoutMs));
 }
 
 // The window's part of recording (the recording itself: tests/station): a device session's
@@ -283,7 +286,8 @@ TEST_F(DeviceTest, APalpationMarkOverTheHiddenLesionIsStoredAndGradedASuccess) {
   const std::int64_t session = *window_->recordingSession();
   ASSERT_TRUE(QTest::qWaitFor(
       [&] {
-        return snapshot().tool && (snapshot().tool->pose.origin_m - hover_mm * 1e-3).norm() < 1e-9;
+        return snapshot().hand(Hand::right).tool &&
+               (snapshot().hand(Hand::right).tool->pose.origin_m - hover_mm * 1e-3).norm() < 1e-9;
       },
       kTimeoutMs));
   QAction* mark = window_->findChild<QAction*>("markLesionAction");
@@ -433,7 +437,7 @@ TEST_F(DeviceTest, ARecordedSessionIsReplayedFromTheWindowAndAMissingOneIsNamed)
       << window_->devicePanel()->statusText().toStdString();
   ASSERT_TRUE(QTest::qWaitFor(
       [&] {
-        const auto sample = snapshot().device_sample;
+        const auto sample = snapshot().hand(Hand::right).device_sample;
         return sample && (sample->position_mm - end_mm).norm() < 1e-9;
       },
       kTimeoutMs));
@@ -466,7 +470,8 @@ TEST_F(DeviceTest, CalibrationPutsTheStylusJustInFrontOfTheLiverAndIsRemembered)
   // The script's frames, not the mouse's before it.
   ASSERT_TRUE(QTest::qWaitFor(
       [&] {
-        return snapshot().device_sample && snapshot().device_sample->position_mm == stylus_mm;
+        return snapshot().hand(Hand::right).device_sample &&
+               snapshot().hand(Hand::right).device_sample->position_mm == stylus_mm;
       },
       kTimeoutMs));
   CalibrationDialog* dialog = window_->openCalibration();
@@ -508,7 +513,8 @@ TEST_F(DeviceTest, TheOmniIsOfferedWhenItOpensAndAFatalFaultHandsTheToolBackToTh
   window_->toolPanel()->setTool(ToolKind::probe);
   ASSERT_TRUE(window_->useDevice(DeviceChoice::openhaptics)) << panel->statusText().toStdString();
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->servo()->stats().ticks > 200; }, kTimeoutMs));
-  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().tool.has_value(); }, kTimeoutMs))
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return snapshot().hand(Hand::right).tool.has_value(); }, kTimeoutMs))
       << "the Omni's stylus moves no tool";
   // Unplugged: HD_COMM_ERROR is fatal.
   auto inject = fakeHook<void (*)(unsigned, int)>("fake_hd_inject_error");

@@ -333,12 +333,13 @@ TEST_F(MainWindowTest, ForcepsFromTheToolPanelHoldPullAndLetGo) {
   pressAndMove(*start, *start + kDrag, [&] { heldThroughout &= window_->heldTool().has_value(); });
   EXPECT_TRUE(heldThroughout);
   EXPECT_EQ(window_->activeGrab(), nullptr) << "a tool is not the hand's grab";
-  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().tool_grasping; },
-                              kSimulatedTimeTimeoutMs))
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return window_->simulation().snapshot().hand(Hand::right).grasping; },
+                      kSimulatedTimeTimeoutMs))
       << "the forceps closed on the liver took no hold";
   ASSERT_TRUE(waitSimulated(0.3));
   const SimulationSnapshot held = window_->simulation().snapshot();
-  EXPECT_GT(held.tool_force_n.norm(), 0.0) << "the held tissue pulls on the forceps";
+  EXPECT_GT(held.hand(Hand::right).force_n.norm(), 0.0) << "the held tissue pulls on the forceps";
   EXPECT_TRUE(window_->toolPanel()->forceText().contains("holding tissue"));
   EXPECT_GT(window_->toolPanel()->trace()->sampleCount(), 1u);
   EXPECT_GT(maxDisplacementFromRest(), 0.002) << "the pull moved the liver";
@@ -348,10 +349,11 @@ TEST_F(MainWindowTest, ForcepsFromTheToolPanelHoldPullAndLetGo) {
 
   release(*start + kDrag);
   EXPECT_FALSE(window_->heldTool().has_value());
-  ASSERT_TRUE(QTest::qWaitFor([&] { return !window_->simulation().snapshot().tool_grasping; },
-                              kSimulatedTimeTimeoutMs));
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return !window_->simulation().snapshot().hand(Hand::right).grasping; },
+                      kSimulatedTimeTimeoutMs));
   ASSERT_TRUE(waitSimulated(0.05));
-  EXPECT_EQ(window_->simulation().snapshot().tool_force_n.norm(), 0.0);
+  EXPECT_EQ(window_->simulation().snapshot().hand(Hand::right).force_n.norm(), 0.0);
 }
 
 // The mouse is a device like the others (issue 8): its tool goes through the 1 kHz servo at the
@@ -379,23 +381,25 @@ TEST_F(MainWindowTest, TheMouseDrivesTheToolThroughTheServoAndItsSessionIsRecord
   bool toolThroughTheServo = true;
   pressAndMove(*start, *start + kDrag, [&] {
     const SimulationSnapshot& seen = window_->simulation().snapshot();
-    if (seen.tool && seen.device_sample)
-      toolThroughTheServo &=
-          (seen.tool->pose.origin_m - seen.device_sample->position_mm * 1e-3).norm() < 1e-12;
+    if (seen.hand(Hand::right).tool && seen.hand(Hand::right).device_sample)
+      toolThroughTheServo &= (seen.hand(Hand::right).tool->pose.origin_m -
+                              seen.hand(Hand::right).device_sample->position_mm * 1e-3)
+                                 .norm() < 1e-12;
   });
   ASSERT_TRUE(window_->recordingSession()) << window_->sessionsProblem().toStdString();
   const std::int64_t session = *window_->recordingSession();
   ASSERT_TRUE(QTest::qWaitFor(
       [&] {
-        const auto& tool = window_->simulation().snapshot().tool;
+        const auto& tool = window_->simulation().snapshot().hand(Hand::right).tool;
         return tool && (tool->pose.origin_m - window_->heldTool()->pose.origin_m).norm() < 1e-12;
       },
       kSimulatedTimeTimeoutMs))
       << "the probe never reached the point the drag put it";
   EXPECT_TRUE(toolThroughTheServo) << "the tool was not at the device's point";
   release(*start + kDrag);
-  ASSERT_TRUE(QTest::qWaitFor([&] { return !window_->simulation().snapshot().tool; },
-                              kSimulatedTimeTimeoutMs))
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return !window_->simulation().snapshot().hand(Hand::right).tool; },
+                      kSimulatedTimeTimeoutMs))
       << "the released probe stayed";
   // A scene change would end it too; choosing the mouse again does.
   QSignalSpy metricsStored(window_.get(), &MainWindow::sessionMetricsStored);
@@ -452,8 +456,9 @@ TEST_F(MainWindowTest, TheScalpelDrawnAcrossTheLiverCutsIt) {
                                     .norm();
   const QPoint across(static_cast<int>(std::lround(100.0 * 0.050 / metresPer100Px)), 0);
   sendMouse(QEvent::MouseButtonPress, *start, Qt::LeftButton, Qt::LeftButton);
-  ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().blade_cutting; },
-                              kSimulatedTimeTimeoutMs))
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] { return window_->simulation().snapshot().hand(Hand::right).blade_cutting; },
+      kSimulatedTimeTimeoutMs))
       << "the pressed blade did not break into the tissue";
   // Each move after some simulated time, so that a slow machine sees the same stroke.
   for (int step = 1; step <= kDragMoves; ++step) {
@@ -463,8 +468,8 @@ TEST_F(MainWindowTest, TheScalpelDrawnAcrossTheLiverCutsIt) {
   ASSERT_TRUE(QTest::qWaitFor([&] { return window_->simulation().snapshot().topology_version > 0; },
                               kSimulatedTimeTimeoutMs))
       << "the scalpel drawn across the liver cut nothing (contacts "
-      << window_->simulation().snapshot().tool_contacts << ", blade in the tissue "
-      << window_->simulation().snapshot().blade_cutting << ")";
+      << window_->simulation().snapshot().hand(Hand::right).contacts << ", blade in the tissue "
+      << window_->simulation().snapshot().hand(Hand::right).blade_cutting << ")";
   const QImage cutting = window_->viewport()->grabRendering();
   pictures_.emplace_back("cutting", cutting);
   release(*start + across);
@@ -514,13 +519,16 @@ TEST_F(MainWindowTest, TheWheelSetsTheHeldScalpelsDepthAndThePanelShowsIt) {
   ASSERT_NE(blade, nullptr);
   sendMouse(QEvent::MouseButtonPress, *start, Qt::LeftButton, Qt::LeftButton);
   ASSERT_TRUE(QTest::qWaitFor(
-      [&] { return window_->simulation().snapshot().blade_edge_in_tissue_m > 0.005; },
+      [&] {
+        return window_->simulation().snapshot().hand(Hand::right).blade_edge_in_tissue_m > 0.005;
+      },
       kSimulatedTimeTimeoutMs))
       << "the blade put in where pressed is not in the tissue";
   ASSERT_TRUE(waitSimulated(0.1));
-  const double inBefore_m = window_->simulation().snapshot().blade_edge_in_tissue_m;
-  ASSERT_TRUE(window_->simulation().snapshot().tool);
-  const Tool putOn = *window_->simulation().snapshot().tool;
+  const double inBefore_m =
+      window_->simulation().snapshot().hand(Hand::right).blade_edge_in_tissue_m;
+  ASSERT_TRUE(window_->simulation().snapshot().hand(Hand::right).tool);
+  const Tool putOn = *window_->simulation().snapshot().hand(Hand::right).tool;
   ASSERT_TRUE(QTest::qWaitFor([&] { return blade->isVisible(); }, 5'000));
   EXPECT_TRUE(blade->text().contains(QStringLiteral("mm in the tissue")))
       << blade->text().toStdString();
@@ -528,7 +536,8 @@ TEST_F(MainWindowTest, TheWheelSetsTheHeldScalpelsDepthAndThePanelShowsIt) {
 
   send_wheel(*window_->viewport(), *start, -6, Qt::LeftButton);
   ASSERT_TRUE(waitSimulated(0.2));
-  const double inAfter_m = window_->simulation().snapshot().blade_edge_in_tissue_m;
+  const double inAfter_m =
+      window_->simulation().snapshot().hand(Hand::right).blade_edge_in_tissue_m;
   std::cout << "the blade's edge in the tissue: " << inBefore_m * 1e3
             << " mm, drawn back 6 mm: " << inAfter_m * 1e3 << " mm\n";
   EXPECT_LT(inAfter_m, inBefore_m - 0.003) << "the wheel did not draw the blade back";
@@ -536,8 +545,9 @@ TEST_F(MainWindowTest, TheWheelSetsTheHeldScalpelsDepthAndThePanelShowsIt) {
   // The panel shows the depth now (to its tenth of a millimetre, a snapshot or two later).
   ASSERT_TRUE(QTest::qWaitFor(
       [&] {
-        return blade->text().contains(
-            QString::number(window_->simulation().snapshot().blade_edge_in_tissue_m * 1e3, 'f', 1));
+        return blade->text().contains(QString::number(
+            window_->simulation().snapshot().hand(Hand::right).blade_edge_in_tissue_m * 1e3, 'f',
+            1));
       },
       5'000))
       << blade->text().toStdString();
@@ -546,10 +556,10 @@ TEST_F(MainWindowTest, TheWheelSetsTheHeldScalpelsDepthAndThePanelShowsIt) {
   // handle goes into the tissue with it, and more of it is in.
   send_wheel(*window_->viewport(), *start, 16, Qt::LeftButton);
   ASSERT_TRUE(waitSimulated(0.2));
-  const Tool pushed = *window_->simulation().snapshot().tool;
+  const Tool pushed = *window_->simulation().snapshot().hand(Hand::right).tool;
   const Eigen::Vector3d shaft = putOn.pose.orientation * Eigen::Vector3d::UnitZ();
   EXPECT_NEAR((putOn.pose.origin_m - pushed.pose.origin_m).dot(shaft), 0.010, 1e-9);
-  const double inDeep_m = window_->simulation().snapshot().blade_edge_in_tissue_m;
+  const double inDeep_m = window_->simulation().snapshot().hand(Hand::right).blade_edge_in_tissue_m;
   std::cout << "pushed 10 mm deeper than put on: " << inDeep_m * 1e3 << " mm in the tissue\n";
   EXPECT_GT(inDeep_m, inBefore_m + 0.005);
   EXPECT_FALSE(window_->simulation().stats().halted);

@@ -112,7 +112,8 @@ TEST_F(SessionReplayWindowTest, ACutThroughTheLesionIsRecordedAndReplaysToTheSam
   send_mouse(viewport, QEvent::MouseButtonPress, from, Qt::LeftButton, Qt::LeftButton);
   ASSERT_TRUE(window_->recordingSession()) << window_->sessionsProblem().toStdString();
   const std::int64_t session = *window_->recordingSession();
-  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().blade_cutting; }, kTimeoutMs))
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return snapshot().hand(Hand::right).blade_cutting; }, kTimeoutMs))
       << "the pressed blade did not break into the tissue";
   constexpr int kMoves = 14;
   for (int k = 1; k <= kMoves; ++k) {

@@ -116,8 +116,8 @@ TEST(Walkthrough, OpenAShippedScenarioRunItWithAScriptedDeviceStopAndSeeTheResul
   ASSERT_TRUE(QTest::qWaitFor(
       [&] {
         const SimulationSnapshot& s = window.simulation().snapshot();
-        return s.time_s > start_s + 2.0 && s.tool &&
-               (s.tool->pose.origin_m - hover_mm * 1e-3).norm() < 1e-9;
+        return s.time_s > start_s + 2.0 && s.hand(Hand::right).tool &&
+               (s.hand(Hand::right).tool->pose.origin_m - hover_mm * 1e-3).norm() < 1e-9;
       },
       kTimeoutMs));
   window.activateWindow();  // its shortcuts work while it is the active window

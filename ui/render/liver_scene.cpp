@@ -187,13 +187,16 @@ void LiverScene::set_tool_models(const ToolModels& models) {
       renderer_->AddActor(into.actors.back());
     }
   };
-  make(models.probe, tool_models_[static_cast<int>(ToolKind::probe)]);
-  make(models.scalpel, tool_models_[static_cast<int>(ToolKind::scalpel)]);
   // The forceps are drawn from a model only with their jaws.
   const bool forceps = models.forceps_body && models.forceps_jaw;
-  make(forceps ? models.forceps_body : std::nullopt,
-       tool_models_[static_cast<int>(ToolKind::forceps)]);
-  for (ModelActors& jaw : forceps_jaws_) make(forceps ? models.forceps_jaw : std::nullopt, jaw);
+  for (HandTool& hand : hand_tools_) {
+    make(models.probe, hand.models[static_cast<int>(ToolKind::probe)]);
+    make(models.scalpel, hand.models[static_cast<int>(ToolKind::scalpel)]);
+    make(forceps ? models.forceps_body : std::nullopt,
+         hand.models[static_cast<int>(ToolKind::forceps)]);
+    for (ModelActors& jaw : hand.forceps_jaws)
+      make(forceps ? models.forceps_jaw : std::nullopt, jaw);
+  }
 }
 
 LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual)
@@ -244,32 +247,33 @@ LiverScene::LiverScene(const TetMesh& mesh, VisualSurface visual)
   grab_marker_->PickableOff();
   renderer_->AddActor(grab_marker_);
 
-  for (ToolPart& part : tool_parts_) {
-    part.line = vtkSmartPointer<vtkLineSource>::New();
-    part.tube = vtkSmartPointer<vtkTubeFilter>::New();
-    part.tube->SetInputConnection(part.line->GetOutputPort());
-    part.tube->SetNumberOfSides(20);
-    auto add_actor = [&](vtkAlgorithmOutput* output) {
-      auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-      mapper->SetInputConnection(output);
-      auto actor = vtkSmartPointer<vtkActor>::New();
-      actor->SetMapper(mapper);
-      actor->GetProperty()->SetColor(kSteel[0], kSteel[1], kSteel[2]);
-      actor->GetProperty()->SetSpecular(0.8);
-      actor->GetProperty()->SetSpecularPower(40.0);
-      actor->VisibilityOff();
-      actor->PickableOff();  // picks hit the liver through the tool
-      renderer_->AddActor(actor);
-      return actor;
-    };
-    part.actors[0] = add_actor(part.tube->GetOutputPort());
-    for (int k = 0; k < 2; ++k) {
-      part.end[k] = vtkSmartPointer<vtkSphereSource>::New();
-      part.end[k]->SetThetaResolution(20);
-      part.end[k]->SetPhiResolution(12);
-      part.actors[1 + k] = add_actor(part.end[k]->GetOutputPort());
+  for (HandTool& hand : hand_tools_)
+    for (ToolPart& part : hand.parts) {
+      part.line = vtkSmartPointer<vtkLineSource>::New();
+      part.tube = vtkSmartPointer<vtkTubeFilter>::New();
+      part.tube->SetInputConnection(part.line->GetOutputPort());
+      part.tube->SetNumberOfSides(20);
+      auto add_actor = [&](vtkAlgorithmOutput* output) {
+        auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+        mapper->SetInputConnection(output);
+        auto actor = vtkSmartPointer<vtkActor>::New();
+        actor->SetMapper(mapper);
+        actor->GetProperty()->SetColor(kSteel[0], kSteel[1], kSteel[2]);
+        actor->GetProperty()->SetSpecular(0.8);
+        actor->GetProperty()->SetSpecularPower(40.0);
+        actor->VisibilityOff();
+        actor->PickableOff();  // picks hit the liver through the tool
+        renderer_->AddActor(actor);
+        return actor;
+      };
+      part.actors[0] = add_actor(part.tube->GetOutputPort());
+      for (int k = 0; k < 2; ++k) {
+        part.end[k] = vtkSmartPointer<vtkSphereSource>::New();
+        part.end[k]->SetThetaResolution(20);
+        part.end[k]->SetPhiResolution(12);
+        part.actors[1 + k] = add_actor(part.end[k]->GetOutputPort());
+      }
     }
-  }
 
   lesion_points_->SetDataTypeToDouble();
   lesion_normals_->SetNumberOfComponents(3);
@@ -386,14 +390,15 @@ void LiverScene::set_surface(VisualSurface visual, const std::vector<std::uint8_
   update_positions(position_m);
 }
 
-void LiverScene::show_tool(const std::optional<Tool>& tool) {
-  for (ModelActors& model : tool_models_) model.show(false);
-  for (ModelActors& jaw : forceps_jaws_) jaw.show(false);
+void LiverScene::show_tool(Hand which, const std::optional<Tool>& tool) {
+  HandTool& hand = hand_tools_[hand_index(which)];
+  for (ModelActors& model : hand.models) model.show(false);
+  for (ModelActors& jaw : hand.forceps_jaws) jaw.show(false);
   // The models are made at the default sizes: another tool geometry is drawn as its capsules.
   if (tool && has_model(tool->kind) && tool->geometry == ToolGeometry{}) {
-    show_tool(std::span<const Capsule>());
+    show_tool(which, std::span<const Capsule>());
     const Eigen::Affine3d pose = Eigen::Translation3d(tool->pose.origin_m) * tool->pose.orientation;
-    ModelActors& model = tool_models_[static_cast<int>(tool->kind)];
+    ModelActors& model = hand.models[static_cast<int>(tool->kind)];
     model.place(pose);
     model.show(true);
     if (tool->kind == ToolKind::forceps) {
@@ -401,16 +406,16 @@ void LiverScene::show_tool(const std::optional<Tool>& tool) {
       // first turned half a turn about the shaft.
       const double angle =
           std::clamp(tool->jaw_opening, 0.0, 1.0) * tool->geometry.max_jaw_angle_rad;
-      forceps_jaws_[0].place(pose * Eigen::AngleAxisd(-angle, Eigen::Vector3d::UnitY()));
-      forceps_jaws_[1].place(pose * Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()) *
-                             Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitZ()));
-      for (ModelActors& jaw : forceps_jaws_) jaw.show(true);
+      hand.forceps_jaws[0].place(pose * Eigen::AngleAxisd(-angle, Eigen::Vector3d::UnitY()));
+      hand.forceps_jaws[1].place(pose * Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitZ()));
+      for (ModelActors& jaw : hand.forceps_jaws) jaw.show(true);
     }
     return;
   }
   std::array<Capsule, 3> parts;
   const int count = tool ? tool_capsules(*tool, parts) : 0;
-  show_tool(std::span<const Capsule>(parts.data(), static_cast<std::size_t>(count)));
+  show_tool(which, std::span<const Capsule>(parts.data(), static_cast<std::size_t>(count)));
 }
 
 void LiverScene::show_cut_model(const SimModel& model, const NodeArray& position_m) {
@@ -580,9 +585,10 @@ void LiverScene::show_grab_marker(const std::optional<Eigen::Vector3d>& point_m)
   grab_marker_->SetVisibility(point_m.has_value());
 }
 
-void LiverScene::show_tool(std::span<const Capsule> parts) {
-  for (std::size_t i = 0; i < tool_parts_.size(); ++i) {
-    ToolPart& part = tool_parts_[i];
+void LiverScene::show_tool(Hand which, std::span<const Capsule> parts) {
+  std::array<ToolPart, 3>& tool_parts = hand_tools_[hand_index(which)].parts;
+  for (std::size_t i = 0; i < tool_parts.size(); ++i) {
+    ToolPart& part = tool_parts[i];
     const bool shown = i < parts.size();
     for (auto& actor : part.actors) actor->SetVisibility(shown);
     if (!shown) continue;

@@ -117,11 +117,14 @@ class LiverScene {
   bool ambient_occlusion() const;
   // A small sphere at the grabbed point, or none.
   void show_grab_marker(const std::optional<Eigen::Vector3d>& point_m);
-  // The tool's parts (tools.h: tool_capsules) as steel-grey rods with rounded ends; none hides it.
-  void show_tool(std::span<const Capsule> parts);
-  // The tool as its model when there is one (set_tool_models), else as its capsules; none hides
-  // it.
-  void show_tool(const std::optional<Tool>& tool);
+  // The tool in `hand` as its parts (tools.h: tool_capsules): steel-grey rods with rounded ends;
+  // none hides it. Without a hand: the right one's.
+  void show_tool(Hand hand, std::span<const Capsule> parts);
+  void show_tool(std::span<const Capsule> parts) { show_tool(Hand::right, parts); }
+  // The tool in `hand` as its model when there is one (set_tool_models), else as its capsules;
+  // none hides it. Each hand's tool is drawn apart: two hands may hold the same kind.
+  void show_tool(Hand hand, const std::optional<Tool>& tool);
+  void show_tool(const std::optional<Tool>& tool) { show_tool(Hand::right, tool); }
   void set_tool_models(const ToolModels& models);
 
   // Display coordinates are VTK's: pixels from the bottom-left corner of the render window.
@@ -154,7 +157,6 @@ class LiverScene {
     std::array<vtkSmartPointer<vtkSphereSource>, 2> end;
     std::array<vtkSmartPointer<vtkActor>, 3> actors;  // tube, two ends
   };
-  std::array<ToolPart, 3> tool_parts_;
   // Tool models: one actor per model mesh, placed by the tool's pose (the forceps' jaw twice).
   struct ModelActors {
     std::vector<vtkSmartPointer<vtkActor>> actors;
@@ -162,10 +164,15 @@ class LiverScene {
     void show(bool shown);
     void place(const Eigen::Affine3d& pose);
   };
-  std::array<ModelActors, 3> tool_models_;  // by ToolKind: probe, forceps (body), scalpel
-  std::array<ModelActors, 2> forceps_jaws_;
+  // What draws the tool of one hand.
+  struct HandTool {
+    std::array<ToolPart, 3> parts;
+    std::array<ModelActors, 3> models;  // by ToolKind: probe, forceps (body), scalpel
+    std::array<ModelActors, 2> forceps_jaws;
+  };
+  std::array<HandTool, kHands.size()> hand_tools_;
   bool has_model(ToolKind kind) const {
-    return !tool_models_[static_cast<int>(kind)].actors.empty();
+    return !hand_tools_[0].models[static_cast<int>(kind)].actors.empty();
   }
 
   // Lesions: their rest vertices and triangles, embedded in the uncut mesh and in the model shown.

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace liversim {
 
@@ -26,6 +27,16 @@ std::string_view tool_name(ToolKind kind) {
 std::optional<ToolKind> tool_kind(std::string_view name) {
   for (ToolKind kind : kToolKinds)
     if (tool_name(kind) == name) return kind;
+  return std::nullopt;
+}
+
+std::string_view hand_name(Hand hand) {
+  return hand == Hand::left ? "left" : "right";
+}
+
+std::optional<Hand> hand_named(std::string_view name) {
+  for (Hand hand : kHands)
+    if (hand_name(hand) == name) return hand;
   return std::nullopt;
 }
 
@@ -329,6 +340,30 @@ void ToolInteraction::try_grasp(const Tool& tool, const NodeArray& position) {
     const double k = grasp_settings_.total_stiffness_n_per_m * grasp_weight_[i] / weight_sum;
     grasp_.stiffness_n_per_m.push_back(k);
     grasp_.damping_n_s_per_m.push_back(critical_damping_n_s_per_m(k, model_->lumped_mass_kg[node]));
+  }
+}
+
+void ToolInteraction::carry_hold(const ForcepsGrasp& held, std::span<const NodeIndex> node_origin) {
+  grasp_.clear();
+  if (held.empty()) return;
+  // Copies of each held node in this model (a crack duplicates a node on it).
+  std::unordered_map<NodeIndex, std::size_t> held_at;
+  for (std::size_t i = 0; i < held.nodes.size(); ++i) held_at.emplace(held.nodes[i], i);
+  std::vector<int> copies(held.nodes.size(), 0);
+  std::vector<std::pair<NodeIndex, std::size_t>> carried;  // new node, index in `held`
+  for (std::size_t n = 0; n < node_origin.size() && n < model_->node_count; ++n) {
+    const auto found = held_at.find(node_origin[n]);
+    if (found == held_at.end() || model_->inverse_mass_per_kg[n] == 0.0) continue;
+    carried.emplace_back(static_cast<NodeIndex>(n), found->second);
+    ++copies[found->second];
+  }
+  for (const auto& [node, i] : carried) {
+    const double k = held.stiffness_n_per_m[i] / copies[i];
+    grasp_.nodes.push_back(node);
+    grasp_.offset_in_tool_m.push_back(held.offset_in_tool_m[i]);
+    grasp_.stiffness_n_per_m.push_back(k);
+    grasp_.damping_n_s_per_m.push_back(
+        critical_damping_n_s_per_m(k, model_->lumped_mass_kg[static_cast<std::size_t>(node)]));
   }
 }
 

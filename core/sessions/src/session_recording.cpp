@@ -35,11 +35,12 @@ SessionEventWatch::SessionEventWatch(const Scenario* scenario)
 void SessionEventWatch::observe(double now_s, const SimulationSnapshot& snapshot,
                                 const RealtimeStats& stats, bool cut,
                                 std::vector<SessionEvent>& out) {
-  detector_.observe(now_s,
-                    {snapshot.tool_grasping, snapshot.topology_version,
-                     snapshot.tool_force_n.norm(), stats.rollbacks, snapshot.resected_volume_m3,
-                     snapshot.specimens_taken_out, snapshot.specimens_taken_out_m3},
-                    out);
+  detector_.observe(
+      now_s,
+      {snapshot.hand(Hand::right).grasping, snapshot.topology_version,
+       snapshot.hand(Hand::right).force_n.norm(), stats.rollbacks, snapshot.resected_volume_m3,
+       snapshot.specimens_taken_out, snapshot.specimens_taken_out_m3},
+      out);
   // A cut into a lesion: checked against the whole cut surface, each lesion reported once.
   if (!cut || !snapshot.model || lesions_.empty()) return;
   const auto surface = cut_surface_at_rest_m(*snapshot.model);

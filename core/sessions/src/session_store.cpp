@@ -245,12 +245,20 @@ class ByteReader {
 
 }  // namespace
 
+namespace {
+constexpr std::uint8_t kLeftHandToolInput = 4;
+}  // namespace
+
 std::vector<std::uint8_t> encode_input_chunk(std::span<const SimulationInput> inputs) {
   ByteWriter out;
   for (char c : kInputMagic) out.u8(static_cast<std::uint8_t>(c));
   out.u32(static_cast<std::uint32_t>(inputs.size()));
   for (const SimulationInput& input : inputs) {
-    out.u8(static_cast<std::uint8_t>(input.kind));
+    // A tool of the left hand is kind 4, laid out as the right hand's (kind 0): files written
+    // before there were two hands read as they were.
+    out.u8(input.kind == SimulationInput::Kind::tool && input.hand == Hand::left
+               ? kLeftHandToolInput
+               : static_cast<std::uint8_t>(input.kind));
     switch (input.kind) {
       case SimulationInput::Kind::tool: {
         out.u8(input.tool ? 1 : 0);
@@ -296,8 +304,10 @@ std::vector<SimulationInput> decode_input_chunk(std::span<const std::uint8_t> by
   for (SimulationInput& input : inputs) {
     const std::uint8_t kind = in.u8();
     switch (kind) {
-      case 0: {
+      case 0:
+      case kLeftHandToolInput: {
         input.kind = SimulationInput::Kind::tool;
+        input.hand = kind == kLeftHandToolInput ? Hand::left : Hand::right;
         if (in.u8() == 0) break;
         Tool tool;
         const std::uint8_t tool_kind = in.u8();
@@ -344,7 +354,9 @@ std::vector<SimulationInput> decode_input_chunk(std::span<const std::uint8_t> by
         break;
       default:
         throw StorageError("input " + std::to_string(in.input) + " of an input chunk has kind " +
-                           std::to_string(kind) + ", which is none of tool, springs or cycle");
+                           std::to_string(kind) +
+                           ", which is none this version knows (0 tool, 1 springs, 2 cycle, 3 "
+                           "specimens taken out, 4 left hand's tool)");
     }
     ++in.input;
   }

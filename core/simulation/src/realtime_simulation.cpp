@@ -120,42 +120,43 @@ void RealtimeSimulation::stop() {
 void RealtimeSimulation::enable_tools(const BoundarySurface& surface, ContactSettings contact,
                                       GraspSettings grasp) {
   if (running()) throw std::logic_error("enable_tools: stop the simulation first");
-  tools_.emplace(*model_, surface, contact, grasp);
+  for (HandInLoop& hand : hands_) hand.tools.emplace(*model_, surface, contact, grasp);
   contact_settings_ = contact;
   grasp_settings_ = grasp;
-  // The set springs and at most two per surface node from the tool (hold and contact): no
-  // reallocation in a step.
-  step_springs_.reserve(options_.spring_capacity + 2 * surface.nodes.size());
+  // The set springs and at most two per surface node from each hand's tool (hold and contact):
+  // no reallocation in a step.
+  step_springs_.reserve(options_.spring_capacity + 2 * hands_.size() * surface.nodes.size());
 }
 
 void RealtimeSimulation::enable_cutting(CuttingSettings settings) {
   if (running()) throw std::logic_error("enable_cutting: stop the simulation first");
-  if (!tools_) throw std::logic_error("enable_cutting: enable the tools first");
+  if (!tools_enabled()) throw std::logic_error("enable_cutting: enable the tools first");
   if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
   cutting_ = settings;
 }
 
-void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
+void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
+  const Tool& scalpel = *hand.active_tool;
   // Out, the blade; in, the whole tool cuts (cutting_edge_m).
-  const auto edge = blade_in_tissue_ ? cutting_edge_m(scalpel) : blade_edge_m(scalpel);
+  const auto edge = hand.blade_in_tissue ? cutting_edge_m(scalpel) : blade_edge_m(scalpel);
   // How deep the blade is, shown to the trainee (with the mouse it sets the depth); while it cuts,
   // what holds it back, and whether it is still in: within a few millimetres of tissue (in its own
   // cut the edge may touch no element). Clear of the surface's box (refitted in this cycle's
   // steps), the edge meets nothing: no walk over the elements.
   constexpr double kBladeReachM = 0.003;
   const EdgeInTissue in =
-      tools_->bvh().bounds().overlaps(Aabb::around(edge[0], edge[1], kBladeReachM))
+      hand.tools->bvh().bounds().overlaps(Aabb::around(edge[0], edge[1], kBladeReachM))
           ? edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)
           : EdgeInTissue{};
-  blade_edge_in_tissue_m_ = in.length_m;
-  if (!blade_in_tissue_) {
+  hand.blade_edge_in_tissue_m = in.length_m;
+  if (!hand.blade_in_tissue) {
     if (!scalpel.blade_armed) return;
     // Breaks in once the force on the blade reaches the toughness of the tissue it presses on
     // times the length of its edge in contact: the tissue would give way at that load
     // (CuttingSettings). An element's average stress under a thin blade depends on the element's
     // size, not the blade's load. An edge already through the surface (put in deep, or pressed
     // through faster than the tissue gave way) has made its way in: it is in.
-    const PartContact& blade = tools_->part_contact(kScalpelBlade);
+    const PartContact& blade = hand.tools->part_contact(kScalpelBlade);
     if (!blade.touched()) return;
     const RegionMaterial& pressed =
         model_->regions[static_cast<std::size_t>(std::max(0, blade.region))];
@@ -164,25 +165,25 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
         blade.force_on_part_n.norm() <
             pressed.fracture_toughness_j_per_m2 * blade_edge_in_contact_m(blade, scalpel.geometry))
       return;
-    blade_in_tissue_ = true;
-    stroke_.edges_m.assign(1, cutting_edge_m(scalpel));
+    hand.blade_in_tissue = true;
+    hand.stroke.edges_m.assign(1, cutting_edge_m(scalpel));
     return;
   }
-  resist_cutting(edge, in);
+  resist_cutting(hand, edge, in);
   // A new instant of the stroke once the edge has moved kStrokeInstantM (a broken-in blade's
   // stroke starts where it broke in).
-  const auto& last = stroke_.edges_m.back();
+  const auto& last = hand.stroke.edges_m.back();
   if ((edge[0] - last[0]).norm() < kStrokeInstantM && (edge[1] - last[1]).norm() < kStrokeInstantM)
     return;
   // Drawn out of the tissue, the blade has to break in again.
-  if (!in.within_reach) return end_stroke();
+  if (!in.within_reach) return hand.end_stroke();
   // Disarmed, the blade passes on without cutting; armed again, the stroke goes on from here.
   if (!scalpel.blade_armed) {
-    stroke_.edges_m.assign(1, edge);
+    hand.stroke.edges_m.assign(1, edge);
     return;
   }
-  stroke_.add(edge);
-  if (stroke_.edges_m.size() < 2) return;
+  hand.stroke.add(edge);
+  if (hand.stroke.edges_m.size() < 2) return;
   const auto update_start = std::chrono::steady_clock::now();
   // Once in, the edge cuts whatever it is drawn through: the stress at a sharp edge in the tissue
   // (a crack front) is unbounded, which no element's average resolves, so the threshold decides
@@ -193,14 +194,14 @@ void RealtimeSimulation::cut_with_scalpel(const Tool& scalpel) {
   // And the mesh is refined around the blade as it goes, so that a short stroke parts tissue on
   // the shipped meshes (elements 10–14 mm across).
   propagating.refine_edge_m = kBladeRefineEdgeM;
-  CutResult cut = cut_tissue(*model_, state_, stroke_, propagating);
+  CutResult cut = cut_tissue(*model_, state_, hand.stroke, propagating);
   const auto trace_cut = [&](bool parted) {
     if (!trace_) return;
     LoopRecord record;
     record.kind = LoopRecord::Kind::cut;
     record.wall_s = trace_wall_s();
     record.simulated_s = state_.time_s;
-    record.blade_in_tissue = blade_in_tissue_;
+    record.blade_in_tissue = hand.blade_in_tissue;
     record.cut_update_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - update_start).count();
     record.parted = parted;
@@ -231,8 +232,14 @@ void RealtimeSimulation::swap_in(CutResult change, std::span<const TetIndex> bod
   state_ = std::move(change.state);
   checkpoint_ = make_checkpoint(*model_);
   const BoundarySurface surface = boundary_surface(*model_);
-  tools_.emplace(*model_, surface, contact_settings_, grasp_settings_);
-  step_springs_.reserve(options_.spring_capacity + 2 * surface.nodes.size());
+  for (HandInLoop& hand : hands_) {
+    // A hold of one hand's forceps goes on through the other hand's cut.
+    ForcepsGrasp held;
+    if (hand.tools && hand.tools->grasp()) held = *hand.tools->grasp();
+    hand.tools.emplace(*model_, surface, contact_settings_, grasp_settings_);
+    hand.tools->carry_hold(held, change.node_origin);
+  }
+  step_springs_.reserve(options_.spring_capacity + 2 * hands_.size() * surface.nodes.size());
   {
     std::lock_guard lock(springs_mutex_);
     pending_springs_.clear();
@@ -316,36 +323,44 @@ void RealtimeSimulation::observe_outcome() {
   outcome_->model = model_;
 }
 
-void RealtimeSimulation::resist_cutting(const std::array<Eigen::Vector3d, 2>& edge,
+void RealtimeSimulation::resist_cutting(HandInLoop& hand,
+                                        const std::array<Eigen::Vector3d, 2>& edge,
                                         const EdgeInTissue& in) {
   // The edge's velocity across itself, from its midpoint cycle to cycle in simulated time,
   // smoothed over 10 ms (a device's frames come at the servo's rate, cycles at the loop's).
   constexpr double kSmoothingS = 0.01;
   const Eigen::Vector3d middle = 0.5 * (edge[0] + edge[1]);
-  const double dt = state_.time_s - blade_time_s_;
-  if (blade_time_s_ >= 0.0 && dt > 0.0)
-    blade_velocity_m_per_s_ +=
-        dt / (kSmoothingS + dt) * ((middle - blade_middle_m_) / dt - blade_velocity_m_per_s_);
-  blade_middle_m_ = middle;
-  blade_time_s_ = state_.time_s;
+  const double dt = state_.time_s - hand.blade_time_s;
+  if (hand.blade_time_s >= 0.0 && dt > 0.0)
+    hand.blade_velocity_m_per_s +=
+        dt / (kSmoothingS + dt) *
+        ((middle - hand.blade_middle_m) / dt - hand.blade_velocity_m_per_s);
+  hand.blade_middle_m = middle;
+  hand.blade_time_s = state_.time_s;
   const Eigen::Vector3d axis = (edge[1] - edge[0]).normalized();
-  const Eigen::Vector3d across = blade_velocity_m_per_s_ - blade_velocity_m_per_s_.dot(axis) * axis;
+  const Eigen::Vector3d across =
+      hand.blade_velocity_m_per_s - hand.blade_velocity_m_per_s.dot(axis) * axis;
   const double speed = across.norm();
   if (!(speed > 0.0)) {
-    cutting_force_n_.setZero();
+    hand.cutting_force_n.setZero();
     return;
   }
-  cutting_force_n_ = -in.resistance_n *
-                     std::min(1.0, speed / cutting_->full_resistance_speed_m_per_s) * across /
-                     speed;
+  hand.cutting_force_n = -in.resistance_n *
+                         std::min(1.0, speed / cutting_->full_resistance_speed_m_per_s) * across /
+                         speed;
 }
 
-void RealtimeSimulation::end_stroke() {
-  stroke_.edges_m.clear();
-  blade_in_tissue_ = false;
-  cutting_force_n_.setZero();
-  blade_velocity_m_per_s_.setZero();
-  blade_time_s_ = -1.0;
+void RealtimeSimulation::HandInLoop::end_stroke() {
+  stroke.edges_m.clear();
+  blade_in_tissue = false;
+  cutting_force_n.setZero();
+  blade_velocity_m_per_s.setZero();
+  blade_time_s = -1.0;
+}
+
+bool RealtimeSimulation::any_blade_in_tissue() const {
+  return std::any_of(hands_.begin(), hands_.end(),
+                     [](const HandInLoop& hand) { return hand.blade_in_tissue; });
 }
 
 double RealtimeSimulation::haptic_servo_period_s() const {
@@ -356,31 +371,37 @@ double RealtimeSimulation::haptic_servo_period_s() const {
 void RealtimeSimulation::set_haptic_servo(ServoLoop* servo) {
   if (running()) throw std::logic_error("set_haptic_servo: stop the simulation first");
   haptic_servo_ = servo;
-  device_sample_.reset();
+  for (HandInLoop& hand : hands_) hand.device_sample.reset();
 }
 
-void RealtimeSimulation::set_device_tool(const std::optional<DeviceToolSettings>& settings,
+void RealtimeSimulation::set_device_tool(Hand which,
+                                         const std::optional<DeviceToolSettings>& settings,
                                          double from_servo_s) {
   std::lock_guard lock(springs_mutex_);
-  pending_device_tool_ = settings;
-  pending_device_tool_from_s_ = from_servo_s;
-  device_tool_changed_ = true;
-  // The tool held so far goes with the change; a set_tool after this call counts.
-  pending_tool_.reset();
-  tool_changed_ = false;
+  HandInLoop& held = hand(which);
+  held.pending_device_tool = settings;
+  held.pending_device_tool_from_s = from_servo_s;
+  held.device_tool_changed = true;
+  // The hand's tool held so far goes with the change; a set_tool after this call counts.
+  held.pending_tool.reset();
+  held.tool_changed = false;
 }
 
-void RealtimeSimulation::take_tool(const std::optional<Tool>& tool) {
-  if (logging_inputs_.load(std::memory_order_relaxed))
-    log_input({SimulationInput::Kind::tool, tool, {}, 0, false});
-  change_tool(tool);
+void RealtimeSimulation::take_tool(Hand which, const std::optional<Tool>& tool) {
+  if (logging_inputs_.load(std::memory_order_relaxed)) {
+    SimulationInput input{SimulationInput::Kind::tool, tool, {}, 0, false};
+    input.hand = which;
+    log_input(std::move(input));
+  }
+  change_tool(which, tool);
 }
 
-void RealtimeSimulation::change_tool(const std::optional<Tool>& tool) {
-  const bool kind_changed = !tool || !active_tool_ || tool->kind != active_tool_->kind;
-  active_tool_ = tool;
-  if (!active_tool_ && tools_) tools_->release();
-  if (kind_changed || active_tool_->kind != ToolKind::scalpel) end_stroke();
+void RealtimeSimulation::change_tool(Hand which, const std::optional<Tool>& tool) {
+  HandInLoop& held = hand(which);
+  const bool kind_changed = !tool || !held.active_tool || tool->kind != held.active_tool->kind;
+  held.active_tool = tool;
+  if (!held.active_tool && held.tools) held.tools->release();
+  if (kind_changed || held.active_tool->kind != ToolKind::scalpel) held.end_stroke();
 }
 
 void RealtimeSimulation::take_inputs() {
@@ -392,17 +413,20 @@ void RealtimeSimulation::take_inputs() {
       if (logging_inputs_.load(std::memory_order_relaxed))  // a copy: only when logging
         log_input({SimulationInput::Kind::springs, std::nullopt, active_springs_, 0, false});
     }
-    if (device_tool_changed_) {
-      // The tool held so far goes: the device's appears with its first frame, or without a
-      // device, set_tool's next one.
-      device_tool_changed_ = false;
-      device_tool_ = pending_device_tool_;
-      device_tool_from_s_ = pending_device_tool_from_s_;
-      take_tool(std::nullopt);
-    }
-    if (tool_changed_) {
-      tool_changed_ = false;
-      if (!device_tool_) take_tool(pending_tool_);
+    for (Hand which : kHands) {
+      HandInLoop& held = hand(which);
+      if (held.device_tool_changed) {
+        // The tool held so far goes: the device's appears with its first frame, or without a
+        // device, set_tool's next one.
+        held.device_tool_changed = false;
+        held.device_tool = held.pending_device_tool;
+        held.device_tool_from_s = held.pending_device_tool_from_s;
+        take_tool(which, std::nullopt);
+      }
+      if (held.tool_changed) {
+        held.tool_changed = false;
+        if (!held.device_tool) take_tool(which, held.pending_tool);
+      }
     }
   }
   if (take_out_requested_.exchange(false)) {
@@ -410,20 +434,24 @@ void RealtimeSimulation::take_inputs() {
       log_input({SimulationInput::Kind::take_out_specimens, std::nullopt, {}, 0, false});
     take_out_free_bodies(true);
   }
-  ServoFrame frame;
-  if (haptic_servo_ && haptic_servo_->newest_frame(frame)) {
-    device_sample_ = frame.sample;
-    if (device_tool_ && frame.time_s >= device_tool_from_s_)
-      take_tool(device_tool(*device_tool_,
-                            haptic_servo_->mapping().scene_position_m(frame.sample.position_mm),
-                            frame.sample.buttons));
+  if (!haptic_servo_) return;
+  for (Hand which : kHands) {
+    HandInLoop& held = hand(which);
+    ServoFrame frame;
+    if (!haptic_servo_->newest_frame(which, frame)) continue;
+    held.device_sample = frame.sample;
+    if (held.device_tool && frame.time_s >= held.device_tool_from_s)
+      take_tool(which, device_tool(
+                           *held.device_tool,
+                           haptic_servo_->mapping(which).scene_position_m(frame.sample.position_mm),
+                           frame.sample.buttons));
   }
 }
 
-void RealtimeSimulation::set_tool(const std::optional<Tool>& tool) {
+void RealtimeSimulation::set_tool(Hand which, const std::optional<Tool>& tool) {
   std::lock_guard lock(springs_mutex_);
-  pending_tool_ = tool;
-  tool_changed_ = true;
+  hand(which).pending_tool = tool;
+  hand(which).tool_changed = true;
 }
 
 bool RealtimeSimulation::set_springs(std::span<const NodeSpring> springs) {
@@ -477,16 +505,21 @@ void merge_guarded(GuardedReport& total, const GuardedReport& one) {
 
 GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   const SimModel& model = *model_;  // a cut may replace it between cycles
-  const bool tool_acts = tools_ && active_tool_;
+  const bool tool_acts =
+      std::any_of(hands_.begin(), hands_.end(), [](const HandInLoop& h) { return h.acts(); });
   // Guarded: a bad step goes back to the last good state and is retried with shorter steps; a
   // bad input (a NaN from a device) is refused.
   GuardOptions guard;
   guard.check_energy = check_energy;
-  // A tool's springs follow the surface: recomputed before every step of the cycle.
+  // The tools' springs follow the surface: recomputed before every step of the cycle.
   auto tool_inputs = [&] {
     step_springs_.assign(active_springs_.begin(), active_springs_.end());
-    const auto tool_springs = tools_->update(*active_tool_, state_.position_m, blade_in_tissue_);
-    step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
+    for (HandInLoop& hand : hands_) {
+      if (!hand.acts()) continue;
+      const auto tool_springs =
+          hand.tools->update(*hand.active_tool, state_.position_m, hand.blade_in_tissue);
+      step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
+    }
     return StepInputs{{}, step_springs_};
   };
   GuardedReport guarded;
@@ -512,8 +545,9 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   rollbacks_ += guarded.rollbacks;
   if (guarded.inputs_rejected) ++rejected_inputs_;
   if (guarded.gave_up) halted_ = true;
-  if (cutting_ && tool_acts && active_tool_->kind == ToolKind::scalpel && !guarded.gave_up)
-    cut_with_scalpel(*active_tool_);
+  if (cutting_ && !guarded.gave_up)
+    for (HandInLoop& hand : hands_)
+      if (hand.acts() && hand.active_tool->kind == ToolKind::scalpel) cut_with_scalpel(hand);
   if (!free_bodies_.empty() && !guarded.gave_up) take_out_free_bodies(false);
   return guarded;
 }
@@ -546,7 +580,7 @@ void RealtimeSimulation::log_input(SimulationInput input) {
   // replacing one that no cycle used has the same effect as both (change_tool), so it replaces it.
   if (input.kind == SimulationInput::Kind::tool && input.tool && !input_log_.empty()) {
     SimulationInput& last = input_log_.back();
-    if (last.kind == SimulationInput::Kind::tool && last.tool &&
+    if (last.kind == SimulationInput::Kind::tool && last.hand == input.hand && last.tool &&
         last.tool->kind == input.tool->kind) {
       last.tool = input.tool;
       return;
@@ -560,7 +594,7 @@ void RealtimeSimulation::replay(std::span<const SimulationInput> inputs,
   if (running()) throw std::logic_error("replay needs the simulation stopped");
   for (const SimulationInput& input : inputs) switch (input.kind) {
       case SimulationInput::Kind::tool:
-        change_tool(input.tool);
+        change_tool(input.hand, input.tool);
         break;
       case SimulationInput::Kind::springs:
         // A log from another model (or a damaged one) must not index past this one's nodes.
@@ -586,7 +620,6 @@ void RealtimeSimulation::replay(std::span<const SimulationInput> inputs,
 }
 
 void RealtimeSimulation::publish_cycle() {
-  const bool tool_acts = tools_ && active_tool_;
   SimulationSnapshot& out = snapshots_.back();
   // Same size: copies without allocating (a cut's new size allocates once).
   out.position_m.x = state_.position_m.x;
@@ -594,23 +627,35 @@ void RealtimeSimulation::publish_cycle() {
   out.position_m.z = state_.position_m.z;
   out.time_s = state_.time_s;
   out.step_count = state_.step_count;
-  // The local model of the force on the tool: its F0 is the snapshot's tool force.
-  LocalForceModel force_model =
-      tool_acts ? tool_force_model(tools_->springs(), state_.position_m,
-                                   active_tool_->pose.origin_m, haptic_servo_period_s())
-                : LocalForceModel{};
-  if (tool_acts && blade_in_tissue_) force_model.force_n += cutting_force_n_;  // the cut's pull
-  out.tool_force_n = force_model.force_n;
-  out.cutting_force_n = tool_acts && blade_in_tissue_ ? cutting_force_n_ : Eigen::Vector3d::Zero();
-  out.tool_grasping = tool_acts && tools_->grasping();
-  out.tool_contacts = tool_acts ? tools_->contact_count() : 0;
-  out.blade_cutting = tool_acts && blade_in_tissue_;
-  out.blade_edge_in_tissue_m = tool_acts && cutting_ && active_tool_->kind == ToolKind::scalpel
-                                   ? blade_edge_in_tissue_m_
-                                   : 0.0;
-  out.tool = tool_acts ? active_tool_ : std::nullopt;
-  out.device_sample = device_sample_;
-  if (haptic_servo_) haptic_servo_->publish(force_model);
+  for (Hand which : kHands) {
+    const HandInLoop& held = hand(which);
+    HandSnapshot& seen = out.hands[hand_index(which)];
+    seen.device_sample = held.device_sample;
+    if (!held.acts()) {
+      seen.tool.reset();
+      seen.force_n.setZero();
+      seen.cutting_force_n.setZero();
+      seen.grasping = seen.blade_cutting = false;
+      seen.contacts = 0;
+      seen.blade_edge_in_tissue_m = 0.0;
+      if (haptic_servo_) haptic_servo_->publish(which, LocalForceModel{});
+      continue;
+    }
+    // The local model of the force on the tool: its F0 is the snapshot's tool force.
+    LocalForceModel force_model =
+        tool_force_model(held.tools->springs(), state_.position_m, held.active_tool->pose.origin_m,
+                         haptic_servo_period_s());
+    if (held.blade_in_tissue) force_model.force_n += held.cutting_force_n;  // the cut's pull
+    seen.force_n = force_model.force_n;
+    seen.cutting_force_n = held.blade_in_tissue ? held.cutting_force_n : Eigen::Vector3d::Zero();
+    seen.grasping = held.tools->grasping();
+    seen.contacts = held.tools->contact_count();
+    seen.blade_cutting = held.blade_in_tissue;
+    seen.blade_edge_in_tissue_m =
+        cutting_ && held.active_tool->kind == ToolKind::scalpel ? held.blade_edge_in_tissue_m : 0.0;
+    seen.tool = held.active_tool;
+    if (haptic_servo_) haptic_servo_->publish(which, force_model);
+  }
   observe_outcome();
   out.model = model_;
   out.topology_version = topology_version_;
@@ -698,7 +743,7 @@ void RealtimeSimulation::run() {
         record.kind = LoopRecord::Kind::window;
         record.wall_s = Seconds(now - loop_start_).count();
         record.simulated_s = state_.time_s;
-        record.blade_in_tissue = blade_in_tissue_;
+        record.blade_in_tissue = any_blade_in_tissue();
         record.window_wall_s = window_s;
         record.window_simulated_s = simulated_s;
         record.integrating_s = window_integrating_s;

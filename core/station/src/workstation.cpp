@@ -746,9 +746,10 @@ void Workstation::record_tool_choice() {
 std::optional<Eigen::Vector3d> Workstation::mark_lesion_under_tool() {
   if (!recorder_ || !servo_) return std::nullopt;
   const SimulationSnapshot& snapshot = simulation_->snapshot();
-  if (!snapshot.tool || !snapshot.model) return std::nullopt;
+  const std::optional<Tool>& tool = snapshot.hand(Hand::right).tool;
+  if (!tool || !snapshot.model) return std::nullopt;
   const Eigen::Vector3d rest_m =
-      rest_point_nearest(*snapshot.model, snapshot.position_m, snapshot.tool->pose.origin_m);
+      rest_point_nearest(*snapshot.model, snapshot.position_m, tool->pose.origin_m);
   recorder_->record_event({servo_->now_s(), SessionEventKind::lesion_marked, mark_detail(rest_m)});
   return rest_m;
 }

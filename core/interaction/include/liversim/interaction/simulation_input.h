@@ -21,13 +21,14 @@ struct SimulationInput {
   // Specimen).
   enum class Kind : std::uint8_t { tool, springs, cycle, take_out_specimens };
   Kind kind = Kind::cycle;
-  std::optional<Tool> tool;         // tool: the tool from then on (none: taken away)
+  std::optional<Tool> tool;         // tool: the hand's tool from then on (none: taken away)
   std::vector<NodeSpring> springs;  // springs: the set springs from then on
   int steps = 0;                    // cycle: whole steps taken
   bool check_energy = false;        // cycle: the energy books were closed at its first step
   // cycle: the haptic servo's clock when the cycle began (the clock of the session's frames and
   // events), NaN without a servo. Not used to step: a replay places its cycles on the timeline.
   double servo_time_s = std::numeric_limits<double>::quiet_NaN();
+  Hand hand = Hand::right;  // tool: the hand that holds it
 };
 
 // How a session's scene was built, so that a replay builds the same model: the session's

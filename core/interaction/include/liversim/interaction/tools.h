@@ -26,6 +26,16 @@ std::string_view tool_name(ToolKind kind);
 // The tool named `name` (as tool_name names it), if any.
 std::optional<ToolKind> tool_kind(std::string_view name);
 
+// The surgeon's hands: each may hold a tool, and both act in the same step (one holds and
+// retracts while the other cuts). The device (or the mouse) moves the right hand's tool.
+enum class Hand : std::uint8_t { right, left };
+inline constexpr std::array<Hand, 2> kHands = {Hand::right, Hand::left};
+constexpr std::size_t hand_index(Hand hand) {
+  return static_cast<std::size_t>(hand);
+}
+std::string_view hand_name(Hand hand);  // "right", "left"
+std::optional<Hand> hand_named(std::string_view name);
+
 // A segment swept by a sphere: every tool part is one.
 struct Capsule {
   Eigen::Vector3d a_m, b_m;
@@ -200,6 +210,11 @@ class ToolInteraction {
     contact_count_ = 0;
   }
   const ForcepsGrasp* grasp() const { return grasping() ? &grasp_ : nullptr; }
+  // Takes over the hold `held` of the model this one was cut from: each node of this model that
+  // came from a held node (`node_origin`, CutResult's) is held as it was, its share of the
+  // stiffness split among the copies a cut made of it. Held nodes that are gone (taken out with a
+  // free body) are let go. So forceps in one hand keep their hold while the other hand cuts.
+  void carry_hold(const ForcepsGrasp& held, std::span<const NodeIndex> node_origin);
   std::size_t contact_count() const { return contact_count_; }
   // What part `i` of the tool (tool_capsules' order) met in the last update; a part that did not
   // push (the jaws of a hold, a cutting blade) met nothing.

@@ -22,6 +22,7 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -37,26 +38,33 @@
 
 namespace liversim {
 
-struct SimulationSnapshot {
-  NodeArray position_m;
-  double time_s = 0.0;
-  std::uint64_t step_count = 0;
-  // The tool (when tools are enabled and one is set): the tissue's force on it after the last
-  // step, whether the forceps hold tissue, and how many nodes its contact pushes.
-  Eigen::Vector3d tool_force_n = Eigen::Vector3d::Zero();
-  bool tool_grasping = false;
-  std::size_t tool_contacts = 0;
+// What one hand's tool did in a cycle (SimulationSnapshot::hands).
+struct HandSnapshot {
+  // The tool the hand held in the cycle (none: an empty hand), for drawing.
+  std::optional<Tool> tool;
+  // The tissue's force on the tool after the last step, whether the forceps hold tissue, and
+  // how many nodes its contact pushes.
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  bool grasping = false;
+  std::size_t contacts = 0;
   bool blade_cutting = false;  // the scalpel has broken into the tissue
-  // Of tool_force_n, the tissue's resistance to the cutting blade (CuttingSettings): its
-  // toughness times the edge in the tissue, against the blade's motion across its edge.
+  // Of force_n, the tissue's resistance to the cutting blade (CuttingSettings): its toughness
+  // times the edge in the tissue, against the blade's motion across its edge.
   Eigen::Vector3d cutting_force_n = Eigen::Vector3d::Zero();
   // How much of the scalpel's edge is inside the tissue (m; with cutting enabled), cutting or not:
   // how deep the blade is, along its edge.
   double blade_edge_in_tissue_m = 0.0;
-  // The tool acting in the last cycle (set_tool's, or the device's), for drawing.
-  std::optional<Tool> tool;
-  // The haptic device's newest frame (set_haptic_servo), which the device's tool follows.
+  // The newest frame of the hand's haptic device (set_haptic_servo), which its tool follows.
   std::optional<DeviceSample> device_sample;
+};
+
+struct SimulationSnapshot {
+  NodeArray position_m;
+  double time_s = 0.0;
+  std::uint64_t step_count = 0;
+  // Each hand's tool (when tools are enabled), in kHands' order.
+  std::array<HandSnapshot, kHands.size()> hands;
+  const HandSnapshot& hand(Hand which) const { return hands[hand_index(which)]; }
   // The model the positions belong to: a cut replaces it (and raises topology_version), so a
   // reader rebuilds what it draws from the mesh when the version changes.
   std::shared_ptr<const SimModel> model;
@@ -216,7 +224,7 @@ class RealtimeSimulation {
   // deforming surface before each step, besides the springs above.
   void enable_tools(const BoundarySurface& surface, ContactSettings contact = {},
                     GraspSettings grasp = {});
-  bool tools_enabled() const { return tools_.has_value(); }
+  bool tools_enabled() const { return hands_[0].tools.has_value(); }
   // From then on a scalpel cuts (cutting.h). Its blade presses on the tissue like any tool until
   // the force on it reaches the tissue's toughness times its edge in contact
   // (RegionMaterial::fracture_toughness_j_per_m2); then the blade breaks in:
@@ -234,21 +242,28 @@ class RealtimeSimulation {
   // body). Each is kept by the outcome tracker as a specimen (OutcomeTracker::specimens_taken_out).
   static constexpr double kFieldMarginM = 0.03;
   void take_out_specimens() { take_out_requested_ = true; }
-  // The tool's kind, pose and jaws from any thread (nothing: no tool in the scene); the newest
-  // is used from the next cycle on.
-  void set_tool(const std::optional<Tool>& tool);
-  // Publishes the local model of the force on the tool to `servo` after every cycle (none: the
-  // zero model), for the haptic device to render, and takes the device's newest frame from it
-  // each cycle (the only reader of ServoLoop::newest_frame while it runs). Call while stopped;
-  // null stops both.
+  // The tool's kind, pose and jaws in `hand` from any thread (nothing: the hand holds none); the
+  // newest is used from the next cycle on. Both hands' tools act in every step; a hand's forceps
+  // keep their hold while the other hand's scalpel cuts. Without a hand: the right one.
+  void set_tool(Hand hand, const std::optional<Tool>& tool);
+  void set_tool(const std::optional<Tool>& tool) { set_tool(Hand::right, tool); }
+  // Publishes the local model of the force on each hand's tool to `servo` after every cycle (none:
+  // the zero model), for the hand's haptic device to render, and takes each device's newest frame
+  // from it each cycle (the only reader of ServoLoop::newest_frame while it runs). Call while
+  // stopped; null stops both.
   void set_haptic_servo(ServoLoop* servo);
-  // From any thread: the haptic device holds this tool (nothing: it holds none). While one is set
-  // and a servo is attached, each cycle takes the device's newest frame, maps it into the scene
-  // (the servo's WorkspaceMapping) and uses device_tool() as the tool; set_tool is then ignored.
-  // Frames stamped before `from_servo_s` (servo clock) are not taken: the mouse puts the tool
-  // down where it presses, and a frame from before the press must not show it where it was.
-  void set_device_tool(const std::optional<DeviceToolSettings>& settings,
+  // From any thread: the haptic device in `hand` holds this tool (nothing: it holds none). While
+  // one is set and the servo has a device in that hand, each cycle takes the device's newest
+  // frame, maps it into the scene (its WorkspaceMapping) and uses device_tool() as the hand's
+  // tool; set_tool for that hand is then ignored. Frames stamped before `from_servo_s` (servo
+  // clock) are not taken: the mouse puts the tool down where it presses, and a frame from before
+  // the press must not show it where it was. Without a hand: the right one.
+  void set_device_tool(Hand hand, const std::optional<DeviceToolSettings>& settings,
                        double from_servo_s = -std::numeric_limits<double>::infinity());
+  void set_device_tool(const std::optional<DeviceToolSettings>& settings,
+                       double from_servo_s = -std::numeric_limits<double>::infinity()) {
+    set_device_tool(Hand::right, settings, from_servo_s);
+  }
 
   // From any thread: from the next cycle on, each published cycle is observed by an outcome
   // tracker, and cuts carry it over (a session's tissue damage, lift, resected volume). Off until
@@ -308,28 +323,35 @@ class RealtimeSimulation {
   std::vector<NodeSpring> pending_springs_;
   bool springs_changed_ = false;
   std::vector<NodeSpring> active_springs_;  // simulation thread's copy
-  std::optional<Tool> pending_tool_;        // under springs_mutex_
-  bool tool_changed_ = false;
-  std::optional<Tool> active_tool_;                        // simulation thread's copy
-  std::optional<DeviceToolSettings> pending_device_tool_;  // under springs_mutex_
-  bool device_tool_changed_ = false;
-  double pending_device_tool_from_s_ = 0.0;        // under springs_mutex_
-  std::optional<DeviceToolSettings> device_tool_;  // simulation thread's copy
-  double device_tool_from_s_ = 0.0;
-  std::optional<DeviceSample> device_sample_;  // the servo's newest frame
   ServoLoop* haptic_servo_ = nullptr;
-  std::optional<ToolInteraction> tools_;  // simulation thread only once started
-  std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tool's
+  // What a hand holds and does with it, and the device that moves it.
+  struct HandInLoop {
+    std::optional<Tool> pending_tool;                       // under springs_mutex_
+    bool tool_changed = false;                              // under springs_mutex_
+    std::optional<DeviceToolSettings> pending_device_tool;  // under springs_mutex_
+    bool device_tool_changed = false;                       // under springs_mutex_
+    double pending_device_tool_from_s = 0.0;                // under springs_mutex_
+    std::optional<DeviceToolSettings> device_tool;          // simulation thread's copy
+    double device_tool_from_s = 0.0;
+    std::optional<DeviceSample> device_sample;  // the servo's newest frame of the hand's device
+    std::optional<Tool> active_tool;            // simulation thread's copy
+    std::optional<ToolInteraction> tools;       // simulation thread only once started
+    BladeStroke stroke;
+    bool blade_in_tissue = false;  // the scalpel broke in: its blade passes and cuts
+    Eigen::Vector3d cutting_force_n = Eigen::Vector3d::Zero();  // on the blade, while it cuts
+    double blade_edge_in_tissue_m = 0.0;  // of the scalpel's edge, after the last cycle
+    Eigen::Vector3d blade_velocity_m_per_s = Eigen::Vector3d::Zero();
+    Eigen::Vector3d blade_middle_m = Eigen::Vector3d::Zero();
+    double blade_time_s = -1.0;  // when blade_middle_m was; < 0: not yet
+    bool acts() const { return tools && active_tool; }
+    void end_stroke();  // the blade is out: the next cut needs a new break-in
+  };
+  std::array<HandInLoop, kHands.size()> hands_;
+  HandInLoop& hand(Hand which) { return hands_[hand_index(which)]; }
+  std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tools'
   ContactSettings contact_settings_;
   GraspSettings grasp_settings_;
   std::optional<CuttingSettings> cutting_;
-  BladeStroke stroke_;            // simulation thread only
-  bool blade_in_tissue_ = false;  // the scalpel broke in: its blade passes and cuts
-  Eigen::Vector3d cutting_force_n_ = Eigen::Vector3d::Zero();  // on the blade, while it cuts
-  double blade_edge_in_tissue_m_ = 0.0;  // of the scalpel's edge, after the last cycle
-  Eigen::Vector3d blade_velocity_m_per_s_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d blade_middle_m_ = Eigen::Vector3d::Zero();
-  double blade_time_s_ = -1.0;  // when blade_middle_m_ was; < 0: not yet
   std::uint64_t topology_version_ = 0;
   double resected_volume_m3_ = 0.0;
   // The field: the organ's box at rest, kFieldMarginM larger; the free bodies now (refreshed when
@@ -345,16 +367,18 @@ class RealtimeSimulation {
   // Free bodies out of the field (or all of them) taken out; true if any was.
   bool take_out_free_bodies(bool all);
   IntegratorKind integrator_kind_;  // the model's, fixed: stats() reads it from any thread
-  // Extends the stroke with the scalpel's edge, cuts, and swaps in the cut model and state.
-  void cut_with_scalpel(const Tool& scalpel);
-  void end_stroke();  // the blade is out: the next cut needs a new break-in
+  // Extends the hand's stroke with its scalpel's edge, cuts, and swaps in the cut model and state.
+  void cut_with_scalpel(HandInLoop& hand);
   // While the blade cuts: the tissue's resistance to it (CuttingSettings), from its edge `edge`
   // and that edge's stretch in the tissue.
-  void resist_cutting(const std::array<Eigen::Vector3d, 2>& edge, const EdgeInTissue& in);
+  void resist_cutting(HandInLoop& hand, const std::array<Eigen::Vector3d, 2>& edge,
+                      const EdgeInTissue& in);
+  bool any_blade_in_tissue() const;
   // Takes the inputs set from other threads (springs, tool, device tool) for the next cycle.
   void take_inputs();
-  void change_tool(const std::optional<Tool>& tool);
-  void take_tool(const std::optional<Tool>& tool);  // the loop's: logged, then change_tool
+  void change_tool(Hand hand, const std::optional<Tool>& tool);
+  // The loop's: logged, then change_tool.
+  void take_tool(Hand hand, const std::optional<Tool>& tool);
   // A cycle's steps, guarded, and the cut of a scalpel in the tissue after them.
   GuardedReport advance_cycle(int steps, bool check_energy);
   // The snapshot of the cycle just taken (and the force model to the servo, if any).
