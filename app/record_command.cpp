@@ -42,6 +42,10 @@ struct RecordOptions {
   std::optional<double> duration_s;    // none: the trajectory's length
   std::optional<double> progress_s;
   std::string tool = "hand";  // the workstation's Tool panel starts on the hand
+  // A device in the left hand too: its trajectory (in the same device frame as the right's) and
+  // the tool it holds until its tool column says otherwise.
+  std::optional<fs::path> left_trajectory;
+  std::string left_tool = "hand";
 };
 
 // The workstation's display frame: how often the recorder takes the simulation's input log and
@@ -104,21 +108,30 @@ int record(const RecordOptions& options) {
   const sigset_t stop_signals = block_stop_signals();  // before any thread starts
 
   // Input first (a bad file is said before anything slow), then the database, then the scene.
-  std::vector<TrajectoryPoint> script;
+  std::vector<TrajectoryPoint> script, left_script;
   std::optional<OpenedScenario> scenario;
-  std::optional<ScriptedTools> tools;  // --tool, then the trajectory's tool column
+  std::optional<ScriptedTools> tools;       // --tool, then the trajectory's tool column
+  std::optional<ScriptedTools> left_tools;  // --left-tool, then the left trajectory's
   try {
     TrajectoryFile file = read_trajectory_file(options.trajectory);  // errors name file and line
     script = std::move(file.points);
+    std::optional<TrajectoryFile> left_file;
+    if (options.left_trajectory) left_file = read_trajectory_file(*options.left_trajectory);
     scenario = open_scenario_to_run(options.scenario);
     std::optional<AllowedTools> allowed;
     if (scenario) allowed = AllowedTools{scenario->scenario.tools, options.scenario->string()};
     tools.emplace(tool_for_the_hand(options.tool, allowed, "--tool"), file.tool_changes, allowed);
+    if (left_file) {
+      left_script = std::move(left_file->points);
+      left_tools.emplace(tool_for_the_hand(options.left_tool, allowed, "--left-tool"),
+                         left_file->tool_changes, allowed, Hand::left);
+    }
   } catch (const std::exception& e) {
     return fail(e.what());
   }
-  const double duration_s =
-      options.duration_s.value_or(script.empty() ? 0.0 : script.back().time_s);
+  double scripts_end_s = script.empty() ? 0.0 : script.back().time_s;
+  if (!left_script.empty()) scripts_end_s = std::max(scripts_end_s, left_script.back().time_s);
+  const double duration_s = options.duration_s.value_or(scripts_end_s);
   if (!(duration_s > 0.0))
     return fail("the trajectory " + options.trajectory.string() +
                 " lasts 0 s: give the session's length with --duration");
@@ -139,13 +152,17 @@ int record(const RecordOptions& options) {
   std::string device_fault;
   std::optional<SessionMetricsOutcome> metrics;
   StationListener listener;
-  listener.device_tool = [&]() -> std::optional<DeviceToolSettings> {
-    if (!tools->held()) return std::nullopt;
-    DeviceToolSettings held;
-    held.kind = *tools->held();
-    held.orientation = tool_orientation_from_view(view_axes);
+  // Each hand's tool held as the workstation holds the device's, in its opening view.
+  const auto held_tool = [&](const std::optional<ScriptedTools>& hand_tools) {
+    std::optional<DeviceToolSettings> held;
+    if (!hand_tools || !hand_tools->held()) return held;
+    held.emplace();
+    held->kind = *hand_tools->held();
+    held->orientation = tool_orientation_from_view(view_axes);
     return held;
   };
+  listener.device_tool = [&] { return held_tool(tools); };
+  listener.left_device_tool = [&] { return held_tool(left_tools); };
   listener.trainee = [&] { return options.trainee.value_or(default_trainee_name()); };
   listener.recording_refused = [&](const StorageError& e) { failure = e; };
   listener.recording_stopped = [&](const StorageError& e) { failure = e; };
@@ -172,6 +189,11 @@ int record(const RecordOptions& options) {
   // A device not calibrated: the workstation's first-use mapping in its opening view.
   const WorkspaceMapping mapping =
       first_use_mapping(station->setup().mesh.rest_position_m, view_axes);
+  if (!left_script.empty())
+    if (const std::optional<DeviceRefusal> refusal =
+            station->use_left_device(std::move(left_script), *options.left_trajectory, mapping))
+      return fail("cannot play the left hand's trajectory " + options.left_trajectory->string() +
+                  ": " + refusal->detail);
   if (const std::optional<DeviceRefusal> refusal = station->use_device(
           DeviceChoice::scripted, mapping, std::move(script), options.trajectory))
     return fail("cannot play the trajectory " + options.trajectory.string() + ": " +
@@ -185,8 +207,12 @@ int record(const RecordOptions& options) {
   std::cout << "recording session " << session << " to " << options.database.string() << ": "
             << (station->scenario() ? station->scenario()->scenario.title : "Free practice") << " ("
             << station->setup().mesh.tet_count() << " tetrahedra), " << station->device_name()
-            << ", tool " << (tools->held() ? tool_name(*tools->held()) : "hand") << ", "
-            << number(duration_s) << " s" << std::endl;
+            << ", tool " << (tools->held() ? tool_name(*tools->held()) : "hand")
+            << (left_tools
+                    ? std::string(", left hand's tool ") +
+                          std::string(left_tools->held() ? tool_name(*left_tools->held()) : "hand")
+                    : std::string())
+            << ", " << number(duration_s) << " s" << std::endl;
   ServoLoop& servo = *station->servo();
   const double begin_s = servo.now_s();
   double next_progress_s = begin_s + options.progress_s.value_or(INFINITY);
@@ -198,6 +224,7 @@ int record(const RecordOptions& options) {
         wait_for_stop_signal(stop_signals, std::min(kFramePeriodS, duration_s - (now_s - begin_s)));
     if (stop_signal != 0) break;
     tools->advance(servo.now_s() - begin_s, servo.now_s(), *station);  // the script's tools
+    if (left_tools) left_tools->advance(servo.now_s() - begin_s, servo.now_s(), *station);
     station->frame();
     if (failure) break;
     if (!device_fault.empty()) {
@@ -297,12 +324,24 @@ std::function<std::optional<int>()> add_record_command(CLI::App& app) {
           "forceps or scalpel, until the trajectory's tool column says otherwise; its first "
           "button closes the forceps or arms the scalpel")
       ->capture_default_str();
-  return [options, command, tets]() -> std::optional<int> {
+  command->add_option(
+      "--left-trajectory", options->left_trajectory,
+      "A second scripted device, in the left hand (forceps holding while the right "
+      "hand cuts): its trajectory, as --trajectory's, in the same device frame; the "
+      "session's input log has its tools, its frames are not recorded yet");
+  auto* left_tool =
+      command
+          ->add_option("--left-tool", options->left_tool,
+                       "Tool the left hand's device holds, as --tool (with --left-trajectory)")
+          ->capture_default_str();
+  return [options, command, tets, left_tool]() -> std::optional<int> {
     if (!command->parsed()) return std::nullopt;
     if (options->scenario && tets->count() > 0)
       return fail(
           "--tets and --scenario cannot go together: the scenario sets the element count "
           "(organ.target_tet_count)");
+    if (left_tool->count() > 0 && !options->left_trajectory)
+      return fail("--left-tool needs --left-trajectory: the left hand's device plays it");
     return record(*options);
   };
 }

@@ -59,6 +59,12 @@ class StationTest : public ::testing::Test {
       held.orientation = tool_orientation_from_view(opening_view_device_axes());
       return held;
     };
+    listener.left_device_tool = [this]() -> std::optional<DeviceToolSettings> {
+      if (!left_tool_) return std::nullopt;
+      DeviceToolSettings held;
+      held.kind = *left_tool_;
+      return held;
+    };
     listener.trainee = [] { return std::string("Trainee One"); };
     listener.session_metrics_stored = [this](const SessionMetricsOutcome& outcome) {
       metrics_.push_back(outcome);
@@ -116,6 +122,7 @@ class StationTest : public ::testing::Test {
   fs::path folder_;
   TetMesh mesh_;
   std::optional<ToolKind> tool_;
+  std::optional<ToolKind> left_tool_;  // what the left hand's device holds
   std::unique_ptr<Workstation> station_;
   std::vector<SessionMetricsOutcome> metrics_;
   std::vector<StorageError> stopped_;
@@ -313,6 +320,55 @@ TEST_F(StationTest, ARecordedSessionReplaysItsDeviceInputAndIsNotRecordedAgain) 
   }));
   ASSERT_FALSE(station_->use_device(DeviceChoice::mouse, WorkspaceMapping{}));
   EXPECT_EQ(station_->sessions()->sessions().size(), 1u);
+}
+
+// A device in each hand (issue 43): the left hand's scripted device holds the forceps over one
+// end of the liver while the right hand's holds the probe over the other, through one servo; each
+// tool is where its own device puts it. The session's input log keeps the left hand's tools, so
+// that it replays whole. A left script that is empty is refused and the left hand stays empty.
+TEST_F(StationTest, ADeviceInTheLeftHandMovesItsOwnToolBesideTheRightHandsDevice) {
+  open(ToolKind::probe);
+  left_tool_ = ToolKind::forceps;
+  const fs::path database = folder_ / "two-hands.sqlite";
+  ASSERT_FALSE(station_->open_sessions(database));
+  const std::optional<DeviceRefusal> empty =
+      station_->use_left_device({}, folder_ / "none.txt", WorkspaceMapping{});
+  ASSERT_TRUE(empty);
+  EXPECT_EQ(empty->reason, DeviceRefusal::Reason::no_trajectory);
+  WorkspaceMapping left_mapping;
+  left_mapping.offset_m = {-0.03, 0.0, 0.0};  // the left hand's device 3 cm to the left
+  const Eigen::Vector3d above_mm = topOfTheMiddle_mm() + Eigen::Vector3d(0.0, 0.0, 20.0);
+  const fs::path left_file = folder_ / "left.txt";
+  save_trajectory(left_file, {{0.0, above_mm, 0}, {600.0, above_mm, 0}});
+  ASSERT_FALSE(station_->use_left_device(load_trajectory(left_file), left_file, left_mapping));
+  EXPECT_EQ(station_->left_device_name(), "") << "taken before the next device change";
+  play({{0.0, above_mm, 0}, {600.0, above_mm, 0}});
+  EXPECT_EQ(station_->left_device_name(), "Scripted: left.txt");
+  EXPECT_NE(station_->device_name().find("left hand: Scripted: left.txt"), std::string::npos)
+      << station_->device_name();
+  ASSERT_TRUE(station_->servo()->has_device(Hand::left));
+  const std::int64_t session = *station_->recording_session();
+  ASSERT_TRUE(frameUntil([&] {
+    return snapshot().hand(Hand::left).tool && snapshot().hand(Hand::right).tool;
+  })) << "the two hands' tools never came";
+  const HandSnapshot& left = snapshot().hand(Hand::left);
+  const HandSnapshot& right = snapshot().hand(Hand::right);
+  EXPECT_EQ(left.tool->kind, ToolKind::forceps);
+  EXPECT_EQ(right.tool->kind, ToolKind::probe);
+  EXPECT_LT((left.tool->pose.origin_m - left_mapping.scene_position_m(above_mm)).norm(), 1e-12);
+  EXPECT_LT((right.tool->pose.origin_m - above_mm * 1e-3).norm(), 1e-12);
+  // The left hand's tool changed by its device's holder: from the change on, it holds nothing.
+  left_tool_.reset();
+  station_->device_tool_changed(Hand::left, station_->servo()->now_s());
+  ASSERT_TRUE(frameUntil([&] { return !snapshot().hand(Hand::left).tool; }));
+  EXPECT_TRUE(snapshot().hand(Hand::right).tool) << "the right hand's tool went too";
+  ASSERT_FALSE(station_->use_device(DeviceChoice::mouse, WorkspaceMapping{}));
+  EXPECT_TRUE(station_->servo()->has_device(Hand::left))
+      << "the left hand's device went with the right hand's change to the mouse";
+  int left_tools = 0;
+  for (const SimulationInput& input : station_->sessions()->inputs(session))
+    left_tools += input.kind == SimulationInput::Kind::tool && input.hand == Hand::left;
+  EXPECT_GE(left_tools, 2) << "the left hand's forceps and their putting down are not in the log";
 }
 
 // A live integrator change carries the liver on where it is (carry_state), mid-press, and is a

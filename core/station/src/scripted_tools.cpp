@@ -29,8 +29,8 @@ std::optional<ToolKind> tool_for_the_hand(const std::string& name,
 
 ScriptedTools::ScriptedTools(std::optional<ToolKind> held,
                              const std::vector<TrajectoryToolChange>& changes,
-                             const std::optional<AllowedTools>& allowed)
-    : held_(held) {
+                             const std::optional<AllowedTools>& allowed, Hand hand)
+    : held_(held), hand_(hand) {
   for (const TrajectoryToolChange& change : changes) {
     std::ostringstream at;
     at << "the trajectory's tool at " << change.time_s << " s:";
@@ -45,8 +45,8 @@ bool ScriptedTools::advance(double elapsed_s, double now_s, Workstation& station
   while (next_ < changes_.size() && elapsed_s >= changes_[next_].first)
     held_ = changes_[next_++].second;
   if (held_ == before) return false;
-  station.device_tool_changed(now_s);
-  station.record_tool_choice();
+  station.device_tool_changed(hand_, now_s);
+  if (hand_ == Hand::right) station.record_tool_choice();
   return true;
 }
 

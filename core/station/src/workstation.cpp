@@ -440,12 +440,14 @@ void Workstation::clear_hand_springs() {
   simulation_->clear_springs();
 }
 
-std::optional<DeviceToolSettings> Workstation::device_tool() const {
-  return listener_.device_tool ? listener_.device_tool() : std::nullopt;
+std::optional<DeviceToolSettings> Workstation::device_tool(Hand hand) const {
+  const auto& asked = hand == Hand::left ? listener_.left_device_tool : listener_.device_tool;
+  return asked ? asked() : std::nullopt;
 }
 
-void Workstation::device_tool_changed(double from_servo_s) {
-  if (servo_) simulation_->set_device_tool(device_tool(), from_servo_s);
+void Workstation::device_tool_changed(Hand hand, double from_servo_s) {
+  if (servo_ && servo_->has_device(hand))
+    simulation_->set_device_tool(hand, device_tool(hand), from_servo_s);
 }
 
 // --- A display frame ---------------------------------------------------------------------------
@@ -506,9 +508,43 @@ std::string Workstation::open_omni(const std::string& library) {
 }
 
 std::string Workstation::device_name() const {
-  if (own_device_) return own_device_->name();
-  if (device_ == DeviceChoice::openhaptics && omni_) return omni_->name();
-  return "haptic device";
+  const std::string left = left_device_ ? "; left hand: " + left_device_->name() : "";
+  if (own_device_) return own_device_->name() + left;
+  if (device_ == DeviceChoice::openhaptics && omni_) return omni_->name() + left;
+  return "haptic device" + left;
+}
+
+std::string Workstation::left_device_name() const {
+  return left_device_ ? left_device_->name() : std::string();
+}
+
+std::unique_ptr<ServoLoop> Workstation::make_servo(HapticDevice& device,
+                                                   const WorkspaceMapping& mapping,
+                                                   HapticDevice* left) {
+  ServoLoop::Options options;
+  options.mapping = mapping;
+  options.left_mapping = left_mapping_;
+  return left ? std::make_unique<ServoLoop>(device, *left, options)
+              : std::make_unique<ServoLoop>(device, options);
+}
+
+std::optional<DeviceRefusal> Workstation::use_left_device(std::vector<TrajectoryPoint> script,
+                                                          const std::filesystem::path& script_file,
+                                                          const WorkspaceMapping& mapping) {
+  using Reason = DeviceRefusal::Reason;
+  if (script.empty()) return DeviceRefusal{Reason::no_trajectory, {}};
+  if (auto problem = validate(mapping)) return DeviceRefusal{Reason::servo_failed, *problem};
+  std::unique_ptr<HapticDevice> device;
+  try {
+    device = std::make_unique<TrajectoryDevice>("Scripted: " + script_file.filename().string(),
+                                                std::move(script));
+  } catch (const std::exception& e) {
+    return DeviceRefusal{Reason::no_trajectory, e.what()};
+  }
+  // The servo in use holds the old one (if any): the next use_device replaces both.
+  pending_left_device_ = std::move(device);
+  left_mapping_ = mapping;
+  return std::nullopt;
 }
 
 std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
@@ -546,19 +582,20 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
   }
   const bool mouse = choice == DeviceChoice::mouse;
   std::unique_ptr<ServoLoop> servo;
-  {
-    ServoLoop::Options options;
-    options.mapping = mouse                            ? kMouseMapping
-                      : choice == DeviceChoice::replay ? replay_mapping_
-                                                       : mapping;
-    try {
-      servo = std::make_unique<ServoLoop>(*device, options);
-    } catch (const std::exception& e) {
-      return DeviceRefusal{Reason::servo_failed, e.what()};
-    }
+  // The left hand's device: one chosen since the last device change, else the one in use.
+  HapticDevice* left = pending_left_device_ ? pending_left_device_.get() : left_device_.get();
+  try {
+    servo = make_servo(*device,
+                       mouse                            ? kMouseMapping
+                       : choice == DeviceChoice::replay ? replay_mapping_
+                                                        : mapping,
+                       left);
+  } catch (const std::exception& e) {
+    return DeviceRefusal{Reason::servo_failed, e.what()};
   }
   simulation_->stop();
-  detach_device();
+  detach_device();  // the old servo, which may hold the old left device, goes
+  if (pending_left_device_) left_device_ = std::move(pending_left_device_);
   servo_ = std::move(servo);
   own_device_ = std::move(owned);
   mouse_ = mouse ? static_cast<ManualDevice*>(own_device_.get()) : nullptr;
@@ -574,7 +611,8 @@ void Workstation::attach_device() {
   simulation_->trace_loop(loop_trace_);  // every simulation the station makes is traced alike
   if (!servo_) return;
   simulation_->set_haptic_servo(servo_.get());
-  simulation_->set_device_tool(device_tool());
+  for (Hand hand : kHands)
+    if (servo_->has_device(hand)) simulation_->set_device_tool(hand, device_tool(hand));
 }
 
 void Workstation::trace_loop(SpscRing<LoopRecord>* trace) {
@@ -588,7 +626,7 @@ void Workstation::trace_loop(SpscRing<LoopRecord>* trace) {
 void Workstation::detach_device() {
   if (!simulation_->running()) {
     simulation_->set_haptic_servo(nullptr);
-    simulation_->set_device_tool(std::nullopt);
+    for (Hand hand : kHands) simulation_->set_device_tool(hand, std::nullopt);
   }
   if (servo_) servo_->stop();  // the last command is a zero force; its last frames are logged
   end_recording();

@@ -34,17 +34,19 @@ class ScriptedTools {
   // std::invalid_argument naming the change (its time) when a tool is unknown or not in
   // `allowed` (none: any tool; tool_for_the_hand).
   ScriptedTools(std::optional<ToolKind> held, const std::vector<TrajectoryToolChange>& changes,
-                const std::optional<AllowedTools>& allowed = std::nullopt);
+                const std::optional<AllowedTools>& allowed = std::nullopt, Hand hand = Hand::right);
 
   // What the hand holds now (none: the hand).
   std::optional<ToolKind> held() const { return held_; }
   // At `elapsed_s` of the script: takes the changes due and, if the tool changed, tells the
-  // station (device_tool_changed from servo time `now_s`, and a tool_selected event). True when it
-  // changed. Changes at time 0 or before are taken by the constructor.
+  // station (device_tool_changed of its hand from servo time `now_s`, and for the right hand a
+  // tool_selected event: events do not name a hand yet). True when it changed. Changes at time 0
+  // or before are taken by the constructor.
   bool advance(double elapsed_s, double now_s, Workstation& station);
 
  private:
   std::optional<ToolKind> held_;
+  Hand hand_;
   std::vector<std::pair<double, std::optional<ToolKind>>> changes_;
   std::size_t next_ = 0;
 };

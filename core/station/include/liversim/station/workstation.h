@@ -124,6 +124,8 @@ struct StationListener {
   // Asked, not told: what the device holds now (none: the hand, or the mouse between presses),
   // whenever a device is attached to a simulation and for the session's tool events.
   std::function<std::optional<DeviceToolSettings>()> device_tool;
+  // The same for the left hand's device (use_left_device); unset: it holds nothing.
+  std::function<std::optional<DeviceToolSettings>()> left_device_tool;
   // Asked whenever a session begins: whom it is of. Unset: default_trainee_name().
   std::function<std::string()> trainee;
 };
@@ -208,7 +210,11 @@ class Workstation {
   void clear_hand_springs();
   // The device's tool changed (listener.device_tool says what it is now); from servo time
   // `from_servo_s` on (a press puts the tool down there: earlier frames must not show it).
-  void device_tool_changed(double from_servo_s = -std::numeric_limits<double>::infinity());
+  void device_tool_changed(double from_servo_s = -std::numeric_limits<double>::infinity()) {
+    device_tool_changed(Hand::right, from_servo_s);
+  }
+  // The same for the device in `hand` (listener.left_device_tool for the left).
+  void device_tool_changed(Hand hand, double from_servo_s);
 
   // --- Devices -----------------------------------------------------------------------------------
   // Looks for the Phantom Omni in the OpenHaptics runtime `library` (libHD.so, or a path): the
@@ -225,6 +231,18 @@ class Workstation {
                                           std::vector<TrajectoryPoint> script = {},
                                           const std::filesystem::path& script_file = {});
   DeviceChoice device() const { return device_; }
+  // A device in the left hand too (issue 43: forceps in one hand hold while the other cuts),
+  // driven by the same servo as the right hand's: a scripted trajectory (its file named in
+  // `script_file`), mapped by `mapping`; its tool is listener.left_device_tool's. It is taken at
+  // the next use_device, which makes the servo. Refused, the left hand staying as it was, for an
+  // empty or bad script or a bad mapping. Neither the Omni nor the mouse can be the left hand's
+  // yet; the left device's frames and tool events are not recorded yet (the session's input log has
+  // its tools, so the session replays whole).
+  std::optional<DeviceRefusal> use_left_device(std::vector<TrajectoryPoint> script,
+                                               const std::filesystem::path& script_file,
+                                               const WorkspaceMapping& mapping);
+  // The left hand's device, empty without one.
+  std::string left_device_name() const;
   // The device's name, as sessions record it.
   std::string device_name() const;
   ServoLoop* servo() const { return servo_.get(); }
@@ -298,7 +316,10 @@ class Workstation {
   void restart_from_rest();
   void attach_device();
   void detach_device();
-  std::optional<DeviceToolSettings> device_tool() const;
+  std::optional<DeviceToolSettings> device_tool(Hand hand = Hand::right) const;
+  // A servo for `device` in the right hand, and `left` (if any) in the left.
+  std::unique_ptr<ServoLoop> make_servo(HapticDevice& device, const WorkspaceMapping& mapping,
+                                        HapticDevice* left);
   void start_model_change(ModelChange change, std::function<ModelChangeBuilt()> build);
   // The running model and the scene's rest one (the same when uncut), each copied and changed.
   static ModelChangeBuilt changed_models(const std::shared_ptr<const SimModel>& running,
@@ -342,8 +363,11 @@ class Workstation {
   std::unique_ptr<HapticDevice> omni_;
   std::string omni_library_ = "libHD.so";
   std::string omni_problem_;
-  std::unique_ptr<HapticDevice> own_device_;  // the mouse, a script or a replay (not the Omni)
-  ManualDevice* mouse_ = nullptr;             // own_device_, while the mouse is the device
+  std::unique_ptr<HapticDevice> own_device_;   // the mouse, a script or a replay (not the Omni)
+  std::unique_ptr<HapticDevice> left_device_;  // the left hand's (a script), if any
+  std::unique_ptr<HapticDevice> pending_left_device_;  // chosen, for the next use_device
+  WorkspaceMapping left_mapping_;
+  ManualDevice* mouse_ = nullptr;  // own_device_, while the mouse is the device
   std::unique_ptr<ServoLoop> servo_;
   std::vector<TrajectoryPoint> replay_points_;
   WorkspaceMapping replay_mapping_;
