@@ -590,6 +590,18 @@
         <source>Session:</source>
         <translation>训练记录：</translation>
     </message>
+    <message>
+        <source>Trajectory for the left hand</source>
+        <translation>左手的轨迹</translation>
+    </message>
+    <message>
+        <source>Cannot play the trajectory in the left hand: %1</source>
+        <translation>无法在左手播放轨迹：%1</translation>
+    </message>
+    <message>
+        <source> In the left hand, %1 moves the tool chosen below.</source>
+        <translation>左手由 %1 移动下方所选的器械。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::DevicePanel</name>
@@ -656,6 +668,42 @@
     <message>
         <source>Servo: not running (the mouse moves the tool)</source>
         <translation>伺服：未运行（由鼠标移动器械）</translation>
+    </message>
+    <message>
+        <source>Left hand</source>
+        <translation>左手</translation>
+    </message>
+    <message>
+        <source>A second instrument: a device of its own moves it, beside the one above (forceps holding the lobe while the other hand cuts)</source>
+        <translation>第二件器械：由其自身的设备移动，与上方的器械并用（例如一只手用抓钳提住肝叶，另一只手切割）</translation>
+    </message>
+    <message>
+        <source>None</source>
+        <translation>无</translation>
+    </message>
+    <message>
+        <source>Device:</source>
+        <translation>设备：</translation>
+    </message>
+    <message>
+        <source>Holds:</source>
+        <translation>持有：</translation>
+    </message>
+    <message>
+        <source>Nothing (the hand)</source>
+        <translation>无（徒手）</translation>
+    </message>
+    <message>
+        <source>Probe</source>
+        <translation>探针</translation>
+    </message>
+    <message>
+        <source>Forceps</source>
+        <translation>抓钳</translation>
+    </message>
+    <message>
+        <source>Scalpel</source>
+        <translation>手术刀</translation>
     </message>
 </context>
 <context>

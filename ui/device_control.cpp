@@ -44,6 +44,76 @@ DeviceControl::DeviceControl(Workstation& station, MouseToolControl& mouse, Cont
       useDevice(device, file);
   });
   connect(context_.panel, &DevicePanel::calibrateRequested, this, [this] { openCalibration(); });
+  connect(context_.panel, &DevicePanel::leftDeviceChosen, this, [this](bool scripted) {
+    if (!scripted) return clearLeftDevice();
+    const QString file = QFileDialog::getOpenFileName(
+        context_.window, tr("Trajectory for the left hand"), haptics_.trajectory_file,
+        tr("Trajectories (*.txt *.trajectory);;All files (*)"));
+    if (file.isEmpty())  // cancelled: the left hand stays as it was
+      context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()));
+    else
+      useLeftDevice(file);
+  });
+  connect(context_.panel, &DevicePanel::leftToolChanged, this, [this] { leftToolChanged(); });
+}
+
+std::optional<DeviceToolSettings> DeviceControl::leftDeviceTool() const {
+  const std::optional<ToolKind> kind = context_.panel->leftTool();
+  if (!kind) return std::nullopt;
+  DeviceToolSettings settings;
+  settings.kind = *kind;
+  settings.orientation = tool_orientation_from_view(context_.viewAxes());
+  settings.action_buttons = haptics_.action_buttons;
+  return settings;
+}
+
+void DeviceControl::leftToolChanged() {
+  if (ServoLoop* servo = station_.servo()) station_.device_tool_changed(Hand::left, servo->now_s());
+}
+
+void DeviceControl::setLeftHandTools(const std::vector<ToolKind>& tools) {
+  const std::optional<ToolKind> held = context_.panel->leftTool();
+  context_.panel->setLeftHandTools(tools);
+  if (context_.panel->leftTool() != held) leftToolChanged();
+}
+
+bool DeviceControl::useLeftDevice(const QString& trajectoryFile) {
+  auto refuse = [&](const QString& why) {
+    context_.panel->showStatus(why, true);
+    context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()));
+    return false;
+  };
+  std::vector<TrajectoryPoint> script;
+  try {
+    script = load_trajectory(trajectoryFile.toStdString());  // its errors name the file and line
+  } catch (const std::exception& e) {
+    return refuse(
+        tr("Cannot play the trajectory in the left hand: %1").arg(QString::fromUtf8(e.what())));
+  }
+  if (!haptics_.mapping_set) {
+    haptics_.mapping =
+        first_use_mapping(station_.simulation().snapshot().position_m, context_.viewAxes());
+    haptics_.mapping_set = true;
+    save();
+  }
+  if (const std::optional<DeviceRefusal> refusal = station_.use_left_device(
+          std::move(script), trajectoryFile.toStdString(), haptics_.mapping))
+    return refuse(
+        tr("Cannot play the trajectory in the left hand: %1").arg(qstring(refusal->detail)));
+  // Taken with the next device change: the device in use again, with the left hand's beside it.
+  if (!useDevice(station_.device())) {
+    station_.clear_left_device();
+    return refuse(context_.panel->statusText());
+  }
+  context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()));
+  return true;
+}
+
+void DeviceControl::clearLeftDevice() {
+  if (station_.left_device_name().empty()) return context_.panel->showLeftDevice({});
+  station_.clear_left_device();
+  useDevice(station_.device());
+  context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()));
 }
 
 void DeviceControl::useLastDevice() {
@@ -126,11 +196,16 @@ void DeviceControl::showDeviceInUse() {
   panel.showDevice(station_.device());
   panel.setCalibrationAvailable(!mouse);
   panel.showServoStats(nullptr);
-  panel.showStatus(
-      mouse
-          ? tr("The mouse moves the tool: press on the liver to put the tool "
-               "chosen in the Tool panel there.")
-          : tr("%1 moves the tool chosen in the Tool panel.").arg(qstring(station_.device_name())));
+  const std::string left = station_.left_device_name();
+  panel.showLeftDevice(QString::fromStdString(left));
+  const QString leftHand =
+      left.empty() ? QString()
+                   : tr(" In the left hand, %1 moves the tool chosen below.").arg(qstring(left));
+  panel.showStatus((mouse ? tr("The mouse moves the tool: press on the liver to put the tool "
+                               "chosen in the Tool panel there.")
+                          : tr("%1 moves the tool chosen in the Tool panel.")
+                                .arg(qstring(station_.device_name()))) +
+                   leftHand);
 }
 
 void DeviceControl::deviceStopped(DeviceChoice choice, const std::string& device,

@@ -57,9 +57,20 @@ class DeviceControl : public QObject {
   std::optional<DeviceToolSettings> deviceTool() const;
   const HapticPreferences& preferences() const { return haptics_; }
 
+  // The left hand's device (issue 43): a scripted trajectory played beside the device in use, or
+  // none. The servo is made again with it, which restarts the device in use (and its session).
+  // False, saying why in the panel, when it cannot be played; the left hand then stays as it was.
+  bool useLeftDevice(const QString& trajectoryFile);
+  void clearLeftDevice();
+  // What the left hand's device holds: the panel's tool, its shaft along the view.
+  std::optional<DeviceToolSettings> leftDeviceTool() const;
+  // The tools a scenario allows the left hand too; a tool no longer offered is put down.
+  void setLeftHandTools(const std::vector<ToolKind>& tools);
+
  private:
   void showDeviceInUse();
   void save();
+  void leftToolChanged();  // tells the station
 
   Workstation& station_;
   MouseToolControl& mouse_;

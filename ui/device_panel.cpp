@@ -1,6 +1,8 @@
 #include "device_panel.h"
 
 #include <QComboBox>
+#include <QFormLayout>
+#include <QGroupBox>
 #include <QLabel>
 #include <QPushButton>
 #include <QVBoxLayout>
@@ -35,6 +37,27 @@ DevicePanel::DevicePanel(QWidget* parent) : QWidget(parent) {
       tr("The haptic servo loop: tick rate, tick periods (median and 99th "
          "percentile), late ticks, and the safety limits it applied"));
   layout->addWidget(servo_);
+
+  auto* left = new QGroupBox(tr("Left hand"), this);
+  left->setObjectName("leftHand");
+  left->setToolTip(
+      tr("A second instrument: a device of its own moves it, beside the one above (forceps "
+         "holding the lobe while the other hand cuts)"));
+  auto* form = new QFormLayout(left);
+  leftDevice_ = new QComboBox(left);
+  leftDevice_->setObjectName("leftHandDevice");
+  leftDevice_->addItem(tr("None"));
+  leftDevice_->addItem(tr("Scripted trajectory…"));
+  form->addRow(tr("Device:"), leftDevice_);
+  leftTool_ = new QComboBox(left);
+  leftTool_->setObjectName("leftHandTool");
+  form->addRow(tr("Holds:"), leftTool_);
+  layout->addWidget(left);
+  setLeftHandTools({kToolKinds.begin(), kToolKinds.end()});
+  setLeftTool(ToolKind::forceps);
+  connect(leftDevice_, &QComboBox::activated, this,
+          [this](int index) { emit leftDeviceChosen(index == 1); });
+  connect(leftTool_, &QComboBox::activated, this, [this] { emit leftToolChanged(); });
   layout->addStretch(1);
   showServoStats(nullptr);
   setCalibrationAvailable(false);
@@ -114,6 +137,39 @@ void DevicePanel::showServoStats(const ServoStats* stats) {
 
 QString DevicePanel::servoText() const {
   return servo_->text();
+}
+
+void DevicePanel::showLeftDevice(const QString& name) {
+  leftDevice_->setCurrentIndex(name.isEmpty() ? 0 : 1);
+  leftDevice_->setItemText(1, name.isEmpty() ? tr("Scripted trajectory…") : name);
+}
+
+bool DevicePanel::leftDeviceShown() const {
+  return leftDevice_->currentIndex() == 1;
+}
+
+std::optional<ToolKind> DevicePanel::leftTool() const {
+  const int kind = leftTool_->currentData().toInt();
+  if (kind < 0) return std::nullopt;
+  return static_cast<ToolKind>(kind);
+}
+
+void DevicePanel::setLeftTool(std::optional<ToolKind> tool) {
+  const int index = leftTool_->findData(tool ? static_cast<int>(*tool) : -1);
+  leftTool_->setCurrentIndex(index >= 0 ? index : 0);
+}
+
+void DevicePanel::setLeftHandTools(const std::vector<ToolKind>& tools) {
+  const std::optional<ToolKind> held = leftTool_->count() > 0 ? leftTool() : std::nullopt;
+  leftTool_->clear();
+  leftTool_->addItem(tr("Nothing (the hand)"), -1);
+  for (ToolKind kind : tools) {
+    const QString name = kind == ToolKind::probe     ? tr("Probe")
+                         : kind == ToolKind::forceps ? tr("Forceps")
+                                                     : tr("Scalpel");
+    leftTool_->addItem(name, static_cast<int>(kind));
+  }
+  setLeftTool(held);
 }
 
 }  // namespace liversim

@@ -1,13 +1,17 @@
 #pragma once
 // The haptic device: which one moves the tool (the mouse, a Phantom Omni through OpenHaptics, or
 // a scripted trajectory), why a device is not offered or has stopped, the workspace calibration,
-// and the 1 kHz servo's statistics.
+// and the 1 kHz servo's statistics; and the left hand (issue 43): a device of its own (a scripted
+// trajectory, as an assistant's hand) and the tool it holds, beside the right hand's.
 
 #include "haptic_preferences.h"
 
 #include "liversim/haptics/haptics.h"
 
 #include <QWidget>
+
+#include <optional>
+#include <vector>
 
 class QComboBox;
 class QLabel;
@@ -38,15 +42,28 @@ class DevicePanel : public QWidget {
 
   static QString servoSummary(const ServoStats& stats);
 
+  // The left hand: whether a device is in it (its name, shown), and the tool it holds.
+  void showLeftDevice(const QString& name);
+  bool leftDeviceShown() const;
+  std::optional<ToolKind> leftTool() const;
+  void setLeftTool(std::optional<ToolKind> tool);
+  // The tools a scenario allows (the hand always is); a held tool no longer offered is put down.
+  void setLeftHandTools(const std::vector<ToolKind>& tools);
+
  signals:
   void deviceChosen(liversim::DeviceChoice device);
   void calibrateRequested();
+  // The left hand's device: a scripted trajectory asked for (true) or none.
+  void leftDeviceChosen(bool scripted);
+  void leftToolChanged();
 
  private:
   QComboBox* devices_ = nullptr;
   QLabel* status_ = nullptr;
   QPushButton* calibrate_ = nullptr;
   QLabel* servo_ = nullptr;
+  QComboBox* leftDevice_ = nullptr;
+  QComboBox* leftTool_ = nullptr;
   QString omniProblem_;
 };
 

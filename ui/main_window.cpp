@@ -248,6 +248,9 @@ StationListener MainWindow::stationListener() {
   listener.device_tool = [this] {
     return devices_ ? devices_->deviceTool() : std::optional<DeviceToolSettings>();
   };
+  listener.left_device_tool = [this] {
+    return devices_ ? devices_->leftDeviceTool() : std::optional<DeviceToolSettings>();
+  };
   listener.trainee = [this] { return traineeName().toStdString(); };
   return listener;
 }
@@ -513,6 +516,7 @@ void MainWindow::showScenarioDetails() {
                                opened ? QString::fromStdString(opened->file.string()) : QString());
   // Free practice offers what a scenario does by default: every tool.
   toolPanel_->setAvailableTools(opened ? opened->scenario.tools : Scenario{}.tools);
+  if (devices_) devices_->setLeftHandTools(opened ? opened->scenario.tools : Scenario{}.tools);
   const Scenario described = station_->described_scenario();
   materialPanel_->showTissue(described.parenchyma, described.effects);
   materialPanel_->setGravityEditable(instructorMode_ || !opened);
@@ -878,6 +882,14 @@ Eigen::Quaterniond MainWindow::deviceAxesFromView() const {
   camera->GetViewUp(up);
   return device_axes_from_view(-Eigen::Vector3d(direction[0], direction[1], direction[2]),
                                Eigen::Vector3d(up[0], up[1], up[2]));
+}
+
+bool MainWindow::useLeftHandDevice(const QString& trajectoryFile) {
+  if (trajectoryFile.isEmpty()) {
+    devices_->clearLeftDevice();
+    return true;
+  }
+  return devices_->useLeftDevice(trajectoryFile);
 }
 
 bool MainWindow::useDevice(DeviceChoice device, const QString& trajectoryFile) {

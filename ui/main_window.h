@@ -119,6 +119,9 @@ class MainWindow : public QMainWindow {
   // start in libHD.so or LIVERSIM_OPENHAPTICS_LIBRARY), a scripted trajectory file or a replay.
   // False, saying why in the panel, when it cannot be used; the device in use then stays.
   bool useDevice(DeviceChoice device, const QString& trajectoryFile = {});
+  // The left hand's device (Device panel, "Left hand"): a scripted trajectory file played beside
+  // the device in use (empty: none). False, saying why in the panel, when it cannot be played.
+  bool useLeftHandDevice(const QString& trajectoryFile);
   DeviceChoice device() const { return station_->device(); }
   ServoLoop* servo() const { return station_->servo(); }
   const HapticPreferences& hapticPreferences() const;

@@ -192,6 +192,61 @@ TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
       QTest::qWaitFor([&] { return !snapshot().hand(Hand::right).tool.has_value(); }, kTimeoutMs));
 }
 
+// The left hand (issue 43): the Device panel's "Left hand" puts a scripted trajectory in the left
+// hand, holding the tool chosen there, beside the mouse in the right hand; changing its tool
+// changes what the left hand holds; a bad file is refused, saying so, and None takes it away.
+TEST_F(DeviceTest, ALeftHandDevicePlaysBesideTheMouseHoldingTheToolChosenForIt) {
+  useSceneMillimetres();
+  openWindow();
+  DevicePanel* panel = window_->devicePanel();
+  auto* leftTool = panel->findChild<QComboBox*>("leftHandTool");
+  auto* leftDevice = panel->findChild<QComboBox*>("leftHandDevice");
+  ASSERT_TRUE(leftTool && leftDevice);
+  EXPECT_EQ(panel->leftTool(), ToolKind::forceps) << "the left hand starts with the forceps";
+  EXPECT_FALSE(panel->leftDeviceShown());
+  const Eigen::Vector3d above = topOfTheMiddle_mm() + Eigen::Vector3d(-20, 0, 15);
+  const QString file = writeTrajectory({{0.0, above, 0}, {600.0, above, 0}});
+  EXPECT_FALSE(window_->useLeftHandDevice(folder_.filePath("missing.txt")));
+  EXPECT_TRUE(panel->statusText().contains("Cannot play the trajectory in the left hand"))
+      << panel->statusText().toStdString();
+  EXPECT_FALSE(panel->leftDeviceShown());
+  ASSERT_TRUE(window_->useLeftHandDevice(file)) << panel->statusText().toStdString();
+  EXPECT_EQ(window_->device(), DeviceChoice::mouse) << "the right hand's device changed";
+  EXPECT_TRUE(panel->leftDeviceShown());
+  EXPECT_TRUE(leftDevice->currentText().contains("trajectory.txt"))
+      << leftDevice->currentText().toStdString();
+  EXPECT_TRUE(panel->statusText().contains("left hand")) << panel->statusText().toStdString();
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        const auto& tool = snapshot().hand(Hand::left).tool;
+        return tool && tool->kind == ToolKind::forceps;
+      },
+      kTimeoutMs))
+      << "the left hand's forceps never came";
+  EXPECT_LT((snapshot().hand(Hand::left).tool->pose.origin_m -
+             window_->hapticPreferences().mapping.scene_position_m(above))
+                .norm(),
+            1e-12);
+  EXPECT_FALSE(snapshot().hand(Hand::right).tool) << "the mouse holds nothing until it presses";
+  // The scalpel chosen for the left hand, as a user picks it in the combo box.
+  leftTool->setCurrentIndex(leftTool->findText("Scalpel"));
+  emit leftTool->activated(leftTool->currentIndex());
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        const auto& tool = snapshot().hand(Hand::left).tool;
+        return tool && tool->kind == ToolKind::scalpel;
+      },
+      kTimeoutMs))
+      << "the left hand still holds the forceps";
+  // None: the left hand's device and tool go.
+  leftDevice->setCurrentIndex(0);
+  emit leftDevice->activated(0);
+  EXPECT_FALSE(panel->leftDeviceShown());
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return !snapshot().hand(Hand::left).tool.has_value(); }, kTimeoutMs));
+  EXPECT_FALSE(window_->servo()->has_device(Hand::left));
+}
+
 // The window's part of recording (the recording itself: tests/station): a device session's
 // metrics reported with the sessionMetricsStored signal once stored off the UI thread, the result
 // in the Scenario panel, and a file that cannot be a database named in the status bar with what to

@@ -514,6 +514,11 @@ std::string Workstation::device_name() const {
   return "haptic device" + left;
 }
 
+void Workstation::clear_left_device() {
+  pending_left_device_.reset();
+  left_device_changing_ = true;
+}
+
 std::string Workstation::left_device_name() const {
   return left_device_ ? left_device_->name() : std::string();
 }
@@ -543,6 +548,7 @@ std::optional<DeviceRefusal> Workstation::use_left_device(std::vector<Trajectory
   }
   // The servo in use holds the old one (if any): the next use_device replaces both.
   pending_left_device_ = std::move(device);
+  left_device_changing_ = true;
   left_mapping_ = mapping;
   return std::nullopt;
 }
@@ -583,7 +589,7 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
   const bool mouse = choice == DeviceChoice::mouse;
   std::unique_ptr<ServoLoop> servo;
   // The left hand's device: one chosen since the last device change, else the one in use.
-  HapticDevice* left = pending_left_device_ ? pending_left_device_.get() : left_device_.get();
+  HapticDevice* left = left_device_changing_ ? pending_left_device_.get() : left_device_.get();
   try {
     servo = make_servo(*device,
                        mouse                            ? kMouseMapping
@@ -595,7 +601,10 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
   }
   simulation_->stop();
   detach_device();  // the old servo, which may hold the old left device, goes
-  if (pending_left_device_) left_device_ = std::move(pending_left_device_);
+  if (left_device_changing_) {
+    left_device_ = std::move(pending_left_device_);
+    left_device_changing_ = false;
+  }
   servo_ = std::move(servo);
   own_device_ = std::move(owned);
   mouse_ = mouse ? static_cast<ManualDevice*>(own_device_.get()) : nullptr;

@@ -241,6 +241,8 @@ class Workstation {
   std::optional<DeviceRefusal> use_left_device(std::vector<TrajectoryPoint> script,
                                                const std::filesystem::path& script_file,
                                                const WorkspaceMapping& mapping);
+  // The left hand's device goes at the next use_device.
+  void clear_left_device();
   // The left hand's device, empty without one.
   std::string left_device_name() const;
   // The device's name, as sessions record it.
@@ -366,6 +368,7 @@ class Workstation {
   std::unique_ptr<HapticDevice> own_device_;   // the mouse, a script or a replay (not the Omni)
   std::unique_ptr<HapticDevice> left_device_;  // the left hand's (a script), if any
   std::unique_ptr<HapticDevice> pending_left_device_;  // chosen, for the next use_device
+  bool left_device_changing_ = false;  // pending_left_device_ (null: none) replaces it
   WorkspaceMapping left_mapping_;
   ManualDevice* mouse_ = nullptr;  // own_device_, while the mouse is the device
   std::unique_ptr<ServoLoop> servo_;
