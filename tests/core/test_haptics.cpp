@@ -493,7 +493,81 @@ TEST(Trajectory, FilesRoundTripAndBadLinesAreNamed) {
   EXPECT_EQ(with_tools.tool_changes[1].tool, "forceps");
   EXPECT_EQ(with_tools.tool_changes[2].tool, "hand");
   EXPECT_TRUE(read_trajectory_file(dir / "path.txt").tool_changes.empty());
+
+  // The stylus's orientation (issue 43): four numbers after the buttons, before the tool; kept by
+  // a save; at every point or none; a zero quaternion refused.
+  std::ofstream(dir / "turned.txt") << "0 0 0 0 0 1 0 0 0 scalpel\n1 0 0 -5 1 0 0 0 2\n";
+  const TrajectoryFile turned = read_trajectory_file(dir / "turned.txt");
+  ASSERT_EQ(turned.points.size(), 2u);
+  ASSERT_TRUE(turned.points[0].orientation && turned.points[1].orientation);
+  EXPECT_EQ(turned.points[1].orientation->coeffs(), Eigen::Vector4d(0, 0, 1, 0))  // x y z w
+      << "not normalised";
+  ASSERT_EQ(turned.tool_changes.size(), 1u);
+  EXPECT_EQ(turned.tool_changes[0].tool, "scalpel");
+  save_trajectory(dir / "turned-saved.txt", turned.points);
+  const auto saved = load_trajectory(dir / "turned-saved.txt");
+  ASSERT_TRUE(saved[1].orientation);
+  EXPECT_EQ(saved[1].orientation->coeffs(), turned.points[1].orientation->coeffs());
+  EXPECT_NE(problem_with("0 0 0 0 0 1 0 0 0\n1 0 0 0 0\n").find("no orientation where"),
+            std::string::npos);
+  EXPECT_NE(problem_with("0 0 0 0 0\n1 0 0 0 0 1 0 0 0\n").find("an orientation where"),
+            std::string::npos);
+  EXPECT_NE(problem_with("0 0 0 0 0 0 0 0 0\n").find("is not a rotation"), std::string::npos);
+  EXPECT_NE(problem_with("0 0 0 0 0 1 0\n").find("an orientation needs four numbers"),
+            std::string::npos);
+  EXPECT_NE(problem_with("0 0 0 0 0 1 0 0 x\n").find("'x' is not a number"), std::string::npos);
+  EXPECT_NE(problem_with("0 0 0 0 0 1 0 0 0 probe 3\n").find("more than ten fields ('3')"),
+            std::string::npos);
   std::filesystem::remove_all(dir);
+}
+
+// A scripted stylus turns on the servo clock: between two points its orientation is the
+// spherical interpolation of theirs; a replay of the frames gives them back.
+TEST(TrajectoryDevice, TurnsTheStylusBetweenPointsAndReplaysItsOrientation) {
+  const Eigen::Quaterniond a = Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond b(Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitX()));
+  TrajectoryDevice device("turning", {{0.0, {0, 0, 0}, 0, a}, {1.0, {0, 0, 0}, 0, b}});
+  DeviceSample sample;
+  device.read(0.25, sample);
+  ASSERT_TRUE(sample.orientation);
+  EXPECT_LT(sample.orientation->angularDistance(
+                Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))),
+            1e-12);
+  device.read(2.0, sample);
+  EXPECT_LT(sample.orientation->angularDistance(b), 1e-12);
+  std::vector<ServoFrame> frames(2);
+  frames[0].time_s = 5.0;
+  frames[1].time_s = 5.5;
+  frames[1].sample.orientation = b;
+  const auto points = trajectory_of_frames(frames);
+  EXPECT_FALSE(points[0].orientation);
+  ASSERT_TRUE(points[1].orientation);
+  EXPECT_EQ(points[1].orientation->coeffs(), b.coeffs());
+  // A script without orientations gives none: the tool keeps its set direction.
+  TrajectoryDevice flat("flat", {{0.0, {0, 0, 0}, 0}, {1.0, {1, 0, 0}, 0}});
+  flat.read(0.5, sample);
+  EXPECT_FALSE(sample.orientation);
+}
+
+// The tool follows the stylus (issue 43, item 2): turned by the mapping's rotation, its shaft
+// along the stylus; without an orientation it keeps the settings' direction.
+TEST(DeviceTool, TheToolTurnsWithTheStylusThroughTheMappingsRotation) {
+  WorkspaceMapping mapping;
+  mapping.rotation = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY());
+  mapping.scale = 1.5;
+  const Eigen::Quaterniond stylus(Eigen::AngleAxisd(-0.8, Eigen::Vector3d(1, 1, 0).normalized()));
+  DeviceToolSettings settings;
+  settings.kind = ToolKind::scalpel;
+  settings.orientation = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
+  const Tool turned = device_tool(settings, {0, 0, 0}, 0, mapping.scene_orientation(stylus));
+  EXPECT_LT(turned.pose.orientation.angularDistance(mapping.rotation * stylus), 1e-12);
+  // The blade points where the stylus points, in the scene.
+  const Eigen::Vector3d stylus_tip_direction =
+      mapping.rotation * (stylus * -Eigen::Vector3d::UnitZ());
+  EXPECT_LT((turned.pose.orientation * -Eigen::Vector3d::UnitZ() - stylus_tip_direction).norm(),
+            1e-12);
+  const Tool kept = device_tool(settings, {0, 0, 0}, 0);
+  EXPECT_LT(kept.pose.orientation.angularDistance(settings.orientation), 1e-12);
 }
 
 // A session's logged frames replayed: the trajectory starts at 0, and the device gives back each

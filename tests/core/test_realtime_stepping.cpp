@@ -640,6 +640,47 @@ TEST_F(RealtimeSteppingFixture, TwoScriptedDevicesMoveAToolEachAndEachFeelsItsOw
   EXPECT_FALSE(simulation.stats().halted);
 }
 
+// The tool follows the stylus (issue 43, item 2): a scripted stylus turning from upright to 60°
+// about x, through a mapping turned about y; the tool's orientation is the stylus's turned by
+// the mapping, frame by frame.
+TEST_F(RealtimeSteppingFixture, TheDevicesToolTurnsWithAScriptedStylus) {
+  const auto model = model_with({});
+  RealtimeSimulation simulation(model, make_rest_state(*model));
+  simulation.enable_tools(extract_surface(*mesh_));
+  const Eigen::Quaterniond upright = Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond tilted(Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitX()));
+  ServoLoop::Options options;
+  options.mapping.rotation = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY());
+  options.mapping.offset_m = {0.0, 0.0, 0.3};  // far above the liver: nothing is touched
+  TrajectoryDevice device("turning stylus", {{0.0, {0.0, 0.0, 0.0}, 0, upright},
+                                             {2.0, {0.0, 0.0, 0.0}, 0, tilted},
+                                             {60.0, {0.0, 0.0, 0.0}, 0, tilted}});
+  ServoLoop servo(device, options);
+  DeviceToolSettings scalpel;
+  scalpel.kind = ToolKind::scalpel;
+  simulation.set_haptic_servo(&servo);
+  simulation.set_device_tool(scalpel);
+  servo.start();
+  simulation.start();
+  int checked = 0;
+  run_until(simulation, 60.0, [&](const SimulationSnapshot& seen) {
+    const HandSnapshot& hand = seen.hand(Hand::right);
+    if (!hand.tool || !hand.device_sample || !hand.device_sample->orientation) return false;
+    EXPECT_LT(hand.tool->pose.orientation.angularDistance(options.mapping.rotation *
+                                                          *hand.device_sample->orientation),
+              1e-12);
+    ++checked;
+    return hand.device_sample->orientation->angularDistance(tilted) < 1e-9;
+  });
+  simulation.stop();
+  servo.stop();
+  EXPECT_GT(checked, 1) << "the tool was never seen with the stylus's orientation";
+  const HandSnapshot& last = simulation.snapshot().hand(Hand::right);
+  ASSERT_TRUE(last.tool);
+  EXPECT_LT(last.tool->pose.orientation.angularDistance(options.mapping.rotation * tilted), 1e-9)
+      << "the tool did not end turned as the stylus";
+}
+
 // A scripted device holds the forceps (issue 8): the servo's mapping puts the device's origin on
 // the forceps' origin over a marked node; the open jaws come down into the tissue, the action
 // button closes them on it, the

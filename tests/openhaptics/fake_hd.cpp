@@ -81,6 +81,8 @@ struct Fake {
   HDenum calibration = HD_CALIBRATION_OK;
   HDErrorInfo init_failure{0, 0, 0};
   int buttons = 0;
+  // The stylus's rotation in the device frame, column-major 3 × 3 (the gimbal angles).
+  double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   bool initialised = false;
   bool force_output = false;
   int init_calls = 0;
@@ -237,8 +239,10 @@ void hdGetDoublev(HDenum parameter, double* values) {
     case HD_CURRENT_VELOCITY:
       std::memcpy(values, f.velocity_mm_per_s, sizeof f.velocity_mm_per_s);
       return;
-    case HD_CURRENT_TRANSFORM:  // column-major, no rotation, translation in 12-14
-      for (int i = 0; i < 16; ++i) values[i] = i % 5 == 0 ? 1.0 : 0.0;
+    case HD_CURRENT_TRANSFORM:  // column-major: the rotation, translation in 12-14
+      for (int i = 0; i < 16; ++i) values[i] = i == 15 ? 1.0 : 0.0;
+      for (int column = 0; column < 3; ++column)
+        for (int row = 0; row < 3; ++row) values[4 * column + row] = f.rotation[3 * column + row];
       std::memcpy(values + 12, f.position_mm, sizeof f.position_mm);
       return;
     case HD_NOMINAL_MAX_FORCE:
@@ -328,6 +332,7 @@ void fake_hd_reset() {
   const std::lock_guard lock(f.mutex);
   f.model = Model{};
   f.calibration = HD_CALIBRATION_OK;
+  for (int i = 0; i < 9; ++i) f.rotation[i] = i % 4 == 0 ? 1.0 : 0.0;
   f.init_failure = {0, 0, 0};
   f.buttons = 0;
   f.errors.clear();
@@ -359,6 +364,13 @@ void fake_hd_set_calibration(HDenum status) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
   f.calibration = status;
+}
+
+// The stylus's rotation, column-major 3 × 3, as HD_CURRENT_TRANSFORM gives it.
+void fake_hd_set_stylus_rotation(const double column_major[9]) {
+  Fake& f = fake();
+  const std::lock_guard lock(f.mutex);
+  std::memcpy(f.rotation, column_major, sizeof f.rotation);
 }
 
 void fake_hd_set_buttons(int buttons) {

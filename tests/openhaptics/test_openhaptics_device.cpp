@@ -68,6 +68,12 @@ void set_calibration(unsigned status) {
 void set_buttons(int buttons) {
   hook<void (*)(int)>("fake_hd_set_buttons")(buttons);
 }
+void set_stylus_rotation(const Eigen::Matrix3d& rotation) {
+  const double column_major[9] = {rotation(0, 0), rotation(1, 0), rotation(2, 0),
+                                  rotation(0, 1), rotation(1, 1), rotation(2, 1),
+                                  rotation(0, 2), rotation(1, 2), rotation(2, 2)};
+  hook<void (*)(const double*)>("fake_hd_set_stylus_rotation")(column_major);
+}
 void inject_error(unsigned code, int internal_code) {
   hook<void (*)(unsigned, int)>("fake_hd_inject_error")(code, internal_code);
 }
@@ -408,6 +414,28 @@ TEST_F(OpenHapticsFake, WithoutTheOwnClockReadAndWriteRunTheirOwnFrames) {
   const DeviceStatus refused = device->write_force(Eigen::Vector3d(NAN, 0.0, 0.0));
   EXPECT_EQ(refused.fault, DeviceFault::recoverable);
   EXPECT_EQ(fake::last_force_n(), Eigen::Vector3d::Zero());
+}
+
+// The stylus's orientation (issue 43, item 2): the rotation of the end effector's transform
+// (HD_CURRENT_TRANSFORM, column-major) is the sample's orientation; at home, none turned.
+TEST_F(OpenHapticsFake, TheStylusOrientationIsReadFromTheDevicesTransform) {
+  const auto device = open();
+  ASSERT_NE(device, nullptr);
+  DeviceSample sample;
+  ASSERT_TRUE(device->read(0.0, sample).ok());
+  ASSERT_TRUE(sample.orientation) << "no orientation read";
+  EXPECT_LT(sample.orientation->angularDistance(Eigen::Quaterniond::Identity()), 1e-12);
+  const Eigen::Quaterniond turned(
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, -1.0, 0.4).normalized()));
+  fake::set_stylus_rotation(turned.toRotationMatrix());
+  ASSERT_TRUE(device->read(0.001, sample).ok());
+  ASSERT_TRUE(sample.orientation);
+  EXPECT_LT(sample.orientation->angularDistance(turned), 1e-12);
+  // Where the stylus points: its −z, turned.
+  EXPECT_LT(((*sample.orientation * -Eigen::Vector3d::UnitZ()) -
+             turned.toRotationMatrix() * -Eigen::Vector3d::UnitZ())
+                .norm(),
+            1e-12);
 }
 
 TEST_F(OpenHapticsFake, OpensTwiceInOneProcessAndTheRuntimeStaysLoaded) {

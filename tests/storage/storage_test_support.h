@@ -32,6 +32,12 @@ inline void expect_same_frames(const std::vector<ServoFrame>& read,
     ASSERT_EQ(read[i].sample.velocity_mm_per_s, written[i].sample.velocity_mm_per_s) << i;
     ASSERT_EQ(read[i].force_n, written[i].force_n) << "frame " << i;
     ASSERT_EQ(read[i].sample.buttons, written[i].sample.buttons) << "frame " << i;
+    ASSERT_EQ(read[i].sample.orientation.has_value(), written[i].sample.orientation.has_value())
+        << "frame " << i;
+    if (read[i].sample.orientation) {
+      ASSERT_EQ(read[i].sample.orientation->coeffs(), written[i].sample.orientation->coeffs())
+          << "frame " << i;
+    }
   }
 }
 

@@ -107,17 +107,33 @@ std::string open_error_as_nobody(const fs::path& file) {
 }
 
 TEST(FrameChunk, RoundTripsEveryBitAndRefusesBytesOfAnotherLayout) {
-  const std::vector<ServoFrame> frames = synthetic_frames(37, 3);
+  std::vector<ServoFrame> frames = synthetic_frames(37, 3);
+  // Every other frame with the stylus's orientation (issue 43: layout 2 keeps it).
+  for (std::size_t i = 0; i < frames.size(); i += 2)
+    frames[i].sample.orientation =
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * i, Eigen::Vector3d(1, 2, 3).normalized()));
   std::vector<std::uint8_t> bytes = encode_frame_chunk(frames);
-  EXPECT_EQ(bytes.size(), 8u + 37u * 84u);  // the documented layout's size
+  EXPECT_EQ(bytes.size(), 8u + 37u * 116u);  // the documented layout's size
+  EXPECT_EQ(bytes[3], '2');
   expect_same_frames(decode_frame_chunk(bytes), frames);
   // Little-endian whatever the machine: the count 37 in the header's second word.
   EXPECT_EQ(bytes[4], 37);
   EXPECT_EQ(bytes[5], 0);
   std::vector<std::uint8_t> short_chunk(bytes.begin(), bytes.end() - 1);
   EXPECT_THROW(decode_frame_chunk(short_chunk), StorageError);
-  bytes[3] = '2';
+  bytes[3] = '3';
   EXPECT_THROW(decode_frame_chunk(bytes), StorageError);
+  // Layout 1 (sessions written before): the same columns without the orientation's four.
+  std::vector<std::uint8_t> v1(8 + 37 * 84);
+  const std::vector<std::uint8_t> v2 = encode_frame_chunk(frames);
+  std::copy(v2.begin(), v2.begin() + 8 + 10 * 8 * 37, v1.begin());
+  std::copy(v2.end() - 37 * 4, v2.end(), v1.end() - 37 * 4);
+  v1[3] = '1';
+  std::vector<ServoFrame> without = frames;
+  for (ServoFrame& frame : without) frame.sample.orientation.reset();
+  expect_same_frames(decode_frame_chunk(v1), without);
+  v1.push_back(0);
+  EXPECT_THROW(decode_frame_chunk(v1), StorageError) << "a layout-1 chunk of the wrong size";
 }
 
 TEST(SessionStore, SixtySecondsAtOneKilohertzReadBackExactly) {

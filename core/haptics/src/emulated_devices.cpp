@@ -72,20 +72,33 @@ TrajectoryFile read_trajectory_file(const std::filesystem::path& file) {
     if (words.empty()) continue;  // blank or comment
     auto problem = [&](const std::string& what) {
       return std::runtime_error(file.string() + ":" + std::to_string(number) + ": " + what +
-                                " (expected: time_s x_mm y_mm z_mm buttons [tool])");
+                                " (expected: time_s x_mm y_mm z_mm buttons [qw qx qy qz] [tool])");
+    };
+    auto number_of = [&](const std::string& word) {
+      double value = 0.0;
+      const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
+      if (error != std::errc() || end != word.data() + word.size())
+        throw problem("'" + shown_word(word) + "' is not a number");
+      return value;
     };
     if (words.size() < 5) throw problem("not five numbers");
-    if (words.size() > 6) throw problem("more than six fields ('" + shown_word(words[6]) + "')");
-    if (words.size() == 6 && std::find(kTrajectoryTools.begin(), kTrajectoryTools.end(),
-                                       words[5]) == kTrajectoryTools.end())
-      throw problem("'" + shown_word(words[5]) + "' is no tool: hand, probe, forceps or scalpel");
+    // After the buttons: four numbers, the orientation; then a word, the tool.
+    const bool tool_sixth = words.size() >= 6 &&
+                            std::find(kTrajectoryTools.begin(), kTrajectoryTools.end(), words[5]) !=
+                                kTrajectoryTools.end();
+    const bool with_orientation = words.size() >= 9 && !tool_sixth;
+    const std::size_t tool_at = with_orientation ? 9 : 5;
+    if (!with_orientation && !tool_sixth && words.size() > 6)
+      throw problem("an orientation needs four numbers, qw qx qy qz");
+    if (words.size() > tool_at + 1)
+      throw problem((tool_at == 5 ? "more than six fields ('" : "more than ten fields ('") +
+                    shown_word(words[tool_at + 1]) + "')");
+    if (words.size() == tool_at + 1 && std::find(kTrajectoryTools.begin(), kTrajectoryTools.end(),
+                                                 words[tool_at]) == kTrajectoryTools.end())
+      throw problem("'" + shown_word(words[tool_at]) +
+                    "' is no tool: hand, probe, forceps or scalpel");
     double numbers[5];
-    for (int i = 0; i < 5; ++i) {
-      const std::string& word = words[i];
-      const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), numbers[i]);
-      if (error != std::errc() || end != word.data() + word.size())
-        throw problem("'" + word + "' is not a number");
-    }
+    for (int i = 0; i < 5; ++i) numbers[i] = number_of(words[i]);
     TrajectoryPoint point;
     point.time_s = numbers[0];
     point.position_mm = {numbers[1], numbers[2], numbers[3]};
@@ -97,9 +110,21 @@ TrajectoryFile read_trajectory_file(const std::filesystem::path& file) {
     if (!points.empty() && !(point.time_s > points.back().time_s))
       throw problem("time " + std::to_string(point.time_s) + " s does not come after " +
                     std::to_string(points.back().time_s) + " s");
+    if (with_orientation) {
+      const Eigen::Quaterniond q(number_of(words[5]), number_of(words[6]), number_of(words[7]),
+                                 number_of(words[8]));
+      const double norm = q.norm();
+      if (!std::isfinite(norm) || norm < 1e-6)
+        throw problem("the orientation " + words[5] + " " + words[6] + " " + words[7] + " " +
+                      words[8] + " is not a rotation (a quaternion of length 0 or not finite)");
+      point.orientation = q.normalized();
+    }
+    if (!points.empty() && points.back().orientation.has_value() != with_orientation)
+      throw problem(with_orientation ? "an orientation where the points before have none"
+                                     : "no orientation where the points before have one");
     point.buttons = static_cast<std::uint32_t>(buttons);
     points.push_back(point);
-    if (words.size() == 6) read.tool_changes.push_back({point.time_s, words[5]});
+    if (words.size() == tool_at + 1) read.tool_changes.push_back({point.time_s, words[tool_at]});
   }
   if (points.empty()) throw std::runtime_error(file.string() + ": no trajectory points");
   return read;
@@ -108,10 +133,15 @@ TrajectoryFile read_trajectory_file(const std::filesystem::path& file) {
 void save_trajectory(const std::filesystem::path& file,
                      const std::vector<TrajectoryPoint>& points) {
   std::ofstream out(file);
-  out << "# time_s x_mm y_mm z_mm buttons\n" << std::setprecision(17);
-  for (const TrajectoryPoint& p : points)
+  out << "# time_s x_mm y_mm z_mm buttons [qw qx qy qz]\n" << std::setprecision(17);
+  for (const TrajectoryPoint& p : points) {
     out << p.time_s << ' ' << p.position_mm.x() << ' ' << p.position_mm.y() << ' '
-        << p.position_mm.z() << ' ' << p.buttons << '\n';
+        << p.position_mm.z() << ' ' << p.buttons;
+    if (p.orientation)
+      out << ' ' << p.orientation->w() << ' ' << p.orientation->x() << ' ' << p.orientation->y()
+          << ' ' << p.orientation->z();
+    out << '\n';
+  }
   if (!out) throw std::runtime_error("cannot write the trajectory file " + file.string());
 }
 
@@ -121,7 +151,8 @@ std::vector<TrajectoryPoint> trajectory_of_frames(std::span<const ServoFrame> fr
   for (const ServoFrame& frame : frames) {
     const double time_s = frame.time_s - frames.front().time_s;
     if (!points.empty() && !(time_s > points.back().time_s)) continue;
-    points.push_back({time_s, frame.sample.position_mm, frame.sample.buttons});
+    points.push_back(
+        {time_s, frame.sample.position_mm, frame.sample.buttons, frame.sample.orientation});
   }
   return points;
 }
@@ -141,6 +172,7 @@ DeviceStatus TrajectoryDevice::read(double time_s, DeviceSample& sample) {
   while (cursor_ + 1 < points_.size() && points_[cursor_ + 1].time_s <= time_s) ++cursor_;
   const TrajectoryPoint& from = points_[cursor_];
   sample.buttons = from.buttons;
+  sample.orientation = from.orientation;
   if (cursor_ + 1 == points_.size() || time_s <= from.time_s) {
     sample.position_mm = from.position_mm;
     sample.velocity_mm_per_s.setZero();
@@ -150,6 +182,8 @@ DeviceStatus TrajectoryDevice::read(double time_s, DeviceSample& sample) {
   const double span_s = to.time_s - from.time_s;
   const double s = (time_s - from.time_s) / span_s;
   sample.position_mm = from.position_mm + s * (to.position_mm - from.position_mm);
+  if (from.orientation && to.orientation)
+    sample.orientation = from.orientation->slerp(s, *to.orientation);
   sample.velocity_mm_per_s = (to.position_mm - from.position_mm) / span_s;
   return {};
 }

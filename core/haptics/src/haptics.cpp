@@ -36,6 +36,9 @@ bool clamp_magnitude(Eigen::Vector3d& force, double limit) {
 Eigen::Vector3d WorkspaceMapping::scene_position_m(const Eigen::Vector3d& device_mm) const {
   return offset_m + scale * (rotation * (device_mm / kMmPerM));
 }
+Eigen::Quaterniond WorkspaceMapping::scene_orientation(const Eigen::Quaterniond& device) const {
+  return (rotation * device).normalized();
+}
 Eigen::Vector3d WorkspaceMapping::scene_velocity_m_per_s(
     const Eigen::Vector3d& device_mm_per_s) const {
   return scale * (rotation * (device_mm_per_s / kMmPerM));
@@ -272,12 +275,12 @@ LocalForceModel tool_force_model(std::span<const NodeSpring> springs, const Node
 }
 
 Tool device_tool(const DeviceToolSettings& settings, const Eigen::Vector3d& origin_m,
-                 std::uint32_t buttons) {
+                 std::uint32_t buttons, const std::optional<Eigen::Quaterniond>& stylus) {
   Tool tool;
   tool.kind = settings.kind;
   tool.geometry = settings.geometry;
   tool.pose.origin_m = origin_m;
-  tool.pose.orientation = settings.orientation.normalized();
+  tool.pose.orientation = (stylus ? *stylus : settings.orientation).normalized();
   const bool acting = (buttons & settings.action_buttons) != 0;
   tool.jaw_opening = acting ? 0.0 : 1.0;
   tool.blade_armed = acting;

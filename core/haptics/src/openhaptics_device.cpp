@@ -2,6 +2,8 @@
 
 #include <dlfcn.h>
 
+#include <Eigen/Dense>
+
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -35,6 +37,7 @@ constexpr unsigned short HD_MAX_SCHEDULER_PRIORITY = 65535;
 constexpr HDenum HD_CURRENT_BUTTONS = 0x2000;
 constexpr HDenum HD_CURRENT_POSITION = 0x2050;
 constexpr HDenum HD_CURRENT_VELOCITY = 0x2051;
+constexpr HDenum HD_CURRENT_TRANSFORM = 0x2052;
 constexpr HDenum HD_DEVICE_MODEL_TYPE = 0x2501;
 constexpr HDenum HD_USABLE_WORKSPACE_DIMENSIONS = 0x2551;
 constexpr HDenum HD_NOMINAL_MAX_STIFFNESS = 0x2602;  // N/mm
@@ -373,6 +376,19 @@ void OpenHapticsDevice::capture_sample() {
   latest_.velocity_mm_per_s =
       Eigen::Vector3d(velocity_mm_per_s[0], velocity_mm_per_s[1], velocity_mm_per_s[2]);
   latest_.buttons = static_cast<std::uint32_t>(buttons);
+  // The end effector's frame (column-major 4 × 4): at the home position it lines up with the
+  // device's base frame, +z toward the user, so the stylus's tip is along its −z, as a tool's
+  // working end is in the tool frame.
+  double transform[16] = {};
+  api_.hdGetDoublev(HD_CURRENT_TRANSFORM, transform);
+  Eigen::Matrix3d rotation;
+  for (int column = 0; column < 3; ++column)
+    for (int row = 0; row < 3; ++row) rotation(row, column) = transform[4 * column + row];
+  const Eigen::Quaterniond orientation(rotation);
+  if (rotation.allFinite() && std::abs(rotation.determinant() - 1.0) < 1e-3)
+    latest_.orientation = orientation.normalized();
+  else
+    latest_.orientation.reset();  // no rotation: the tool keeps its set direction
 }
 
 void OpenHapticsDevice::set_force(const Eigen::Vector3d& force_n) {

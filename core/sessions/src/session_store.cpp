@@ -2,6 +2,7 @@
 
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <sstream>
 
@@ -25,10 +26,13 @@ constexpr std::array<std::string_view, 13> kEventNames = {"grasp",
 
 // Layout 1: "LSF1", the frame count (u32), then one column per quantity, frame by frame: time,
 // position x, y, z, velocity x, y, z, force x, y, z (IEEE doubles), buttons (u32). Columns keep
-// like values together, which is what a compressing layout 2 would want.
-constexpr std::array<char, 4> kMagic = {'L', 'S', 'F', '1'};
+// like values together, which a compressing layout would want. Layout 2: "LSF2", the same with
+// four more double columns before the buttons, the stylus's orientation w, x, y, z (NaN: the
+// device gave none).
+constexpr std::array<char, 4> kMagicV1 = {'L', 'S', 'F', '1'};
+constexpr std::array<char, 4> kMagic = {'L', 'S', 'F', '2'};
 constexpr std::size_t kHeaderBytes = 8;
-constexpr std::size_t kBytesPerFrame = 10 * 8 + 4;
+constexpr std::size_t kDoublesV1 = 10, kDoubles = 14;
 
 void put_u32(std::uint8_t* out, std::uint32_t value) {
   for (int b = 0; b < 4; ++b) out[b] = static_cast<std::uint8_t>(value >> (8 * b));
@@ -55,6 +59,13 @@ void for_each_double(Frame& frame, Visit&& visit) {
   for (int k = 0; k < 3; ++k) visit(frame.sample.position_mm[k]);
   for (int k = 0; k < 3; ++k) visit(frame.sample.velocity_mm_per_s[k]);
   for (int k = 0; k < 3; ++k) visit(frame.force_n[k]);
+}
+
+// The orientation's columns: w, x, y, z, NaN without one.
+std::array<double, 4> orientation_columns(const DeviceSample& sample) {
+  if (!sample.orientation) return {NAN, NAN, NAN, NAN};
+  const Eigen::Quaterniond& q = *sample.orientation;
+  return {q.w(), q.x(), q.y(), q.z()};
 }
 
 }  // namespace
@@ -145,36 +156,50 @@ std::vector<MetricValue> trace_metric_values(const TraceMetrics& m) {
 
 std::vector<std::uint8_t> encode_frame_chunk(std::span<const ServoFrame> frames) {
   const std::size_t n = frames.size();
-  std::vector<std::uint8_t> bytes(kHeaderBytes + n * kBytesPerFrame);
+  std::vector<std::uint8_t> bytes(kHeaderBytes + n * (kDoubles * 8 + 4));
   std::memcpy(bytes.data(), kMagic.data(), kMagic.size());
   put_u32(bytes.data() + 4, static_cast<std::uint32_t>(n));
   for (std::size_t i = 0; i < n; ++i) {
     std::size_t column = 0;
-    for_each_double(frames[i], [&](double value) {
+    auto put = [&](double value) {
       put_f64(bytes.data() + kHeaderBytes + (column * n + i) * 8, value);
       ++column;
-    });
-    put_u32(bytes.data() + kHeaderBytes + 80 * n + i * 4, frames[i].sample.buttons);
+    };
+    for_each_double(frames[i], put);
+    for (double value : orientation_columns(frames[i].sample)) put(value);
+    put_u32(bytes.data() + kHeaderBytes + kDoubles * 8 * n + i * 4, frames[i].sample.buttons);
   }
   return bytes;
 }
 
 std::vector<ServoFrame> decode_frame_chunk(std::span<const std::uint8_t> bytes) {
-  if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0)
-    throw StorageError("a frame chunk does not start with the layout-1 mark \"LSF1\"");
+  const bool v1 = bytes.size() >= kHeaderBytes &&
+                  std::memcmp(bytes.data(), kMagicV1.data(), kMagicV1.size()) == 0;
+  if (bytes.size() < kHeaderBytes ||
+      (!v1 && std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0))
+    throw StorageError(
+        "a frame chunk does not start with the layout-1 or layout-2 mark (\"LSF1\", \"LSF2\")");
+  const std::size_t doubles = v1 ? kDoublesV1 : kDoubles;
   const std::size_t n = get_u32(bytes.data() + 4);
-  if (bytes.size() != kHeaderBytes + n * kBytesPerFrame)
+  const std::size_t expected = kHeaderBytes + n * (doubles * 8 + 4);
+  if (bytes.size() != expected)
     throw StorageError("a frame chunk of " + std::to_string(n) + " frames has " +
                        std::to_string(bytes.size()) + " bytes, expected " +
-                       std::to_string(kHeaderBytes + n * kBytesPerFrame));
+                       std::to_string(expected));
   std::vector<ServoFrame> frames(n);
   for (std::size_t i = 0; i < n; ++i) {
     std::size_t column = 0;
-    for_each_double(frames[i], [&](double& value) {
-      value = get_f64(bytes.data() + kHeaderBytes + (column * n + i) * 8);
+    auto get = [&]() {
+      const double value = get_f64(bytes.data() + kHeaderBytes + (column * n + i) * 8);
       ++column;
-    });
-    frames[i].sample.buttons = get_u32(bytes.data() + kHeaderBytes + 80 * n + i * 4);
+      return value;
+    };
+    for_each_double(frames[i], [&](double& value) { value = get(); });
+    if (!v1) {
+      const double w = get(), x = get(), y = get(), z = get();
+      if (!std::isnan(w)) frames[i].sample.orientation = Eigen::Quaterniond(w, x, y, z);
+    }
+    frames[i].sample.buttons = get_u32(bytes.data() + kHeaderBytes + doubles * 8 * n + i * 4);
   }
   return frames;
 }

@@ -440,11 +440,13 @@ void RealtimeSimulation::take_inputs() {
     ServoFrame frame;
     if (!haptic_servo_->newest_frame(which, frame)) continue;
     held.device_sample = frame.sample;
-    if (held.device_tool && frame.time_s >= held.device_tool_from_s)
-      take_tool(which, device_tool(
-                           *held.device_tool,
-                           haptic_servo_->mapping(which).scene_position_m(frame.sample.position_mm),
-                           frame.sample.buttons));
+    if (!held.device_tool || frame.time_s < held.device_tool_from_s) continue;
+    const WorkspaceMapping& mapping = haptic_servo_->mapping(which);
+    std::optional<Eigen::Quaterniond> stylus;
+    if (frame.sample.orientation) stylus = mapping.scene_orientation(*frame.sample.orientation);
+    take_tool(which,
+              device_tool(*held.device_tool, mapping.scene_position_m(frame.sample.position_mm),
+                          frame.sample.buttons, stylus));
   }
 }
 

@@ -106,7 +106,7 @@ void append_chunk(std::vector<Item>& read, std::int64_t first, std::int64_t layo
   if (first != static_cast<std::int64_t>(read.size()))
     throw StorageError(items + " " + std::to_string(read.size()) + " to " + std::to_string(first) +
                        " are missing");
-  if (layout != known_layout)
+  if (layout < 1 || layout > known_layout)  // each version reads every layout before its own
     throw StorageError("a chunk of " + items + " has layout " + std::to_string(layout) +
                            ", which this version cannot read",
                        StorageProblem::newer_version);

@@ -48,11 +48,20 @@ class ManualDevice final : public HapticDevice {
   std::uint64_t read_placement_ = 0;  // servo thread
 };
 
-// One point of a trajectory: where the device is at a time, and which buttons are down.
+// One point of a trajectory: where the device is at a time, which buttons are down, and the
+// stylus's orientation if the trajectory gives it (DeviceSample::orientation).
 struct TrajectoryPoint {
+  TrajectoryPoint() = default;
+  TrajectoryPoint(double time_s_in, const Eigen::Vector3d& position_mm_in, std::uint32_t buttons_in,
+                  const std::optional<Eigen::Quaterniond>& orientation_in = std::nullopt)
+      : time_s(time_s_in),
+        position_mm(position_mm_in),
+        buttons(buttons_in),
+        orientation(orientation_in) {}
   double time_s = 0.0;
   Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
   std::uint32_t buttons = 0;
+  std::optional<Eigen::Quaterniond> orientation;
 };
 
 // What the hand holds from a time on, as a trajectory file says: one of kTrajectoryTools.
@@ -67,11 +76,12 @@ struct TrajectoryFile {
   std::vector<TrajectoryToolChange> tool_changes;  // in time order; empty: the tool is not set
 };
 
-// A trajectory file: one point per line, `time_s x_mm y_mm z_mm buttons [tool]`,
-// whitespace-separated, times strictly increasing; `#` starts a comment. The optional tool (hand,
-// probe, forceps or scalpel) is what the hand holds from that point on, which the one playing the
-// trajectory puts in it (liversim-cli record). Throws std::runtime_error naming the file, the line
-// and what is wrong.
+// A trajectory file: one point per line, `time_s x_mm y_mm z_mm buttons [qw qx qy qz] [tool]`,
+// whitespace-separated, times strictly increasing; `#` starts a comment. The optional quaternion
+// is the stylus's orientation in the device frame (normalised as read); a file gives it at every
+// point or at none. The optional tool (hand, probe, forceps or scalpel) is what the hand holds
+// from that point on, which the one playing the trajectory puts in it (liversim-cli record).
+// Throws std::runtime_error naming the file, the line and what is wrong.
 TrajectoryFile read_trajectory_file(const std::filesystem::path& file);
 // Its points alone.
 std::vector<TrajectoryPoint> load_trajectory(const std::filesystem::path& file);
@@ -82,10 +92,11 @@ void save_trajectory(const std::filesystem::path& file, const std::vector<Trajec
 // rate. Frames whose time does not increase are skipped.
 std::vector<TrajectoryPoint> trajectory_of_frames(std::span<const ServoFrame> frames);
 
-// Plays a trajectory on the servo clock: positions interpolated linearly between points, the
-// velocity the slope there, the buttons of the point before. Before the first point it stays at
-// the first, after the last at the last. A scripted device follows a trajectory file; a replay
-// device follows the device input logged with a session, at its original rate.
+// Plays a trajectory on the servo clock: positions interpolated linearly between points (and
+// orientations spherically), the velocity the slope there, the buttons of the point before. Before
+// the first point it stays at the first, after the last at the last. A scripted device follows a
+// trajectory file; a replay device follows the device input logged with a session, at its original
+// rate.
 class TrajectoryDevice final : public HapticDevice {
  public:
   // Throws std::invalid_argument for an empty trajectory or times that do not increase.

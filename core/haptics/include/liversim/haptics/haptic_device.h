@@ -6,8 +6,10 @@
 // The servo thread calls read() and write_force() once per tick: neither may block or allocate.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace liversim {
@@ -26,6 +28,11 @@ struct DeviceSample {
   Eigen::Vector3d velocity_mm_per_s = Eigen::Vector3d::Zero();
   // Bit 0: first button (grasp / cut), bit 1: second; kRepositioned is no button.
   std::uint32_t buttons = 0;
+  // The stylus's orientation in the device frame (its gimbal angles), where the device reports
+  // one: the stylus frame's −z points from the hand to the stylus's tip, as a tool's working end
+  // does in the tool frame (tools.h). None (the mouse, a script without it): the tool keeps the
+  // direction its DeviceToolSettings set.
+  std::optional<Eigen::Quaterniond> orientation;
 };
 
 // Set in a sample's buttons when the device got to its position by a jump, not a motion (the

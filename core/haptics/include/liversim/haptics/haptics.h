@@ -35,6 +35,9 @@ struct WorkspaceMapping {
   Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();
 
   Eigen::Vector3d scene_position_m(const Eigen::Vector3d& device_mm) const;
+  // The stylus's orientation in the scene: turned by the same rotation as positions (a uniform
+  // scale does not turn anything).
+  Eigen::Quaterniond scene_orientation(const Eigen::Quaterniond& device) const;
   Eigen::Vector3d scene_velocity_m_per_s(const Eigen::Vector3d& device_mm_per_s) const;
   Eigen::Vector3d device_position_mm(const Eigen::Vector3d& scene_m) const;
   Eigen::Vector3d device_force_n(const Eigen::Vector3d& scene_force_n) const;
@@ -176,9 +179,11 @@ class HapticRenderer {
 LocalForceModel tool_force_model(std::span<const NodeSpring> springs, const NodeArray& position_m,
                                  const Eigen::Vector3d& tool_point_m, double servo_period_s);
 
-// How a haptic device holds a tool. The device reports a position only (the Omni's gimbal angles
-// are not used), so the shaft keeps a set direction; the device's point, through the workspace
-// mapping, is the tool's origin: the probe's ball centre, the forceps' jaw hinge, the blade's heel.
+// How a haptic device holds a tool. The device's point, through the workspace mapping, is the
+// tool's origin: the probe's ball centre, the forceps' jaw hinge, the blade's heel. Where the
+// device reports the stylus's orientation (the Omni's gimbal angles, a script that gives it), the
+// tool is turned with the stylus (its shaft along the stylus, the working end at the stylus's
+// tip); otherwise its shaft keeps `orientation`.
 struct DeviceToolSettings {
   ToolKind kind = ToolKind::probe;
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // tool frame → scene
@@ -188,8 +193,10 @@ struct DeviceToolSettings {
   ToolGeometry geometry;
 };
 
-// The tool at scene point `origin_m` with the device's `buttons` down.
+// The tool at scene point `origin_m` with the device's `buttons` down; turned as the stylus is in
+// the scene (`stylus`, WorkspaceMapping::scene_orientation), or, without it, by the settings.
 Tool device_tool(const DeviceToolSettings& settings, const Eigen::Vector3d& origin_m,
-                 std::uint32_t buttons);
+                 std::uint32_t buttons,
+                 const std::optional<Eigen::Quaterniond>& stylus = std::nullopt);
 
 }  // namespace liversim

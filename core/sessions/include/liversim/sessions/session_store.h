@@ -151,9 +151,12 @@ std::vector<MetricValue> trace_metric_values(const TraceMetrics& metrics);
 
 // Frames travel and are stored in chunks (one per commit): a documented, versioned byte layout
 // (docs/session-storage.md), little-endian whatever the machine. Exact: doubles keep every bit.
-inline constexpr int kFrameChunkLayout = 1;
+// Layout 2 adds the stylus's orientation (issue 43); chunks of layout 1 still read (no
+// orientation). A chunk is written in the newest layout.
+inline constexpr int kFrameChunkLayout = 2;
 std::vector<std::uint8_t> encode_frame_chunk(std::span<const ServoFrame> frames);
-// Throws StorageError when the bytes are not a layout-1 chunk (wrong magic, size or count).
+// Throws StorageError when the bytes are not a layout-1 or layout-2 chunk (wrong magic, size or
+// count).
 std::vector<ServoFrame> decode_frame_chunk(std::span<const std::uint8_t> bytes);
 
 // The simulation's input log travels and is stored in chunks too (layout 1, "LSI1",
