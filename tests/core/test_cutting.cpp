@@ -856,6 +856,39 @@ TEST(Cutting, ACutDeepenedInItsOwnGrooveCutsWhatOneDeepStrokeCuts) {
   EXPECT_TRUE(elements_are_sound(*again.model, again.state));
 }
 
+// Two strokes in one plane that meet part what neither does alone (issue 42, item 6: a lobe
+// thicker than the blade reaches is cut in two strokes): the block's top cut off at z = 2.5 cm
+// (mid-cube: the first cut makes nodes on the plane) by a blade whose edge reaches from x = −1 cm
+// to 3.6 cm, drawn across the block, then by one reaching from 3.55 cm to 7 cm. The first leaves
+// nodes on the plane at its front; the second, beyond its own edge there, counts them on the cut,
+// not above it (they used to be: a side distance of 0 went to +1, and the elements under them
+// stayed whole). The top then comes free, as one stroke across the whole width frees it.
+TEST(Cutting, TwoStrokesInOnePlaneThatMeetCutWhatOneStrokeAcrossCuts) {
+  const SimModel model = block_model();
+  const double z = 0.025;
+  const CutResult first =
+      cut_tissue(model, make_rest_state(model),
+                 sweep_of({-0.01, -0.01, z}, {0.036, -0.01, z}, {0.0, 0.07, 0.0}), cut_anything());
+  ASSERT_TRUE(first.cut());
+  EXPECT_TRUE(free_bodies(*first.model).empty()) << "half a cut freed the top";
+  const CutResult second =
+      cut_tissue(*first.model, first.state,
+                 sweep_of({0.0355, -0.01, z}, {0.07, -0.01, z}, {0.0, 0.07, 0.0}), cut_anything());
+  ASSERT_TRUE(second.cut());
+  const std::vector<FreeBody> freed = free_bodies(*second.model);
+  ASSERT_EQ(freed.size(), 1u) << "the two strokes did not free the top";
+  const double top_m3 = 0.06 * 0.05 * (0.04 - z);
+  EXPECT_NEAR(freed[0].rest_volume_m3, top_m3, 1e-9 * top_m3);
+  EXPECT_TRUE(boundary_is_manifold(*second.model));
+  EXPECT_TRUE(elements_are_sound(*second.model, second.state));
+  const CutResult once =
+      cut_tissue(model, make_rest_state(model),
+                 sweep_of({-0.01, -0.01, z}, {0.07, -0.01, z}, {0.0, 0.07, 0.0}), cut_anything());
+  ASSERT_TRUE(once.cut());
+  ASSERT_EQ(free_bodies(*once.model).size(), 1u);
+  EXPECT_NEAR(free_bodies(*once.model)[0].rest_volume_m3, top_m3, 1e-9 * top_m3);
+}
+
 // A blade under the surface cuts (issue 42, item 3): a sweep wholly inside the block, 4 cm across
 // and 3 cm tall, its edges inside cubes, opens a crack inside it. The nodes of the grid plane
 // x = 0.03 it crosses (y = 0.01 … 0.04, z = 0.01 … 0.03) snap onto it; the two off the crack's

@@ -1461,15 +1461,19 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   }
 
   // Which side of the sweep each node is on: 0 on it, else the side of the nearest triangle's
-  // plane.
+  // plane. A node on that plane beyond the sweep's edge is on neither side either: an earlier
+  // stroke in the same plane put it there (its crack's front), and counting it on one side would
+  // leave the elements it holds straddling for this stroke, uncut where two strokes meet.
   std::vector<std::int8_t> node_label(model.node_count, 2);  // 2: not yet known
   auto label_of = [&](NodeIndex n) {
     if (node_label[n] == 2) {
       const Eigen::Vector3d p = geometry.position_m.at(n);
       const auto [distance_m, nearest] = surface.nearest(p);
-      node_label[n] = distance_m <= surface.tolerance_m            ? 0
-                      : surface.side_distance_m(p, nearest) >= 0.0 ? 1
-                                                                   : -1;
+      const double side_m = surface.side_distance_m(p, nearest);
+      node_label[n] = distance_m <= surface.tolerance_m || std::abs(side_m) <= surface.tolerance_m
+                          ? 0
+                      : side_m >= 0.0 ? 1
+                                      : -1;
     }
     return node_label[n];
   };
