@@ -57,14 +57,18 @@ DeviceControl::DeviceControl(Workstation& station, MouseToolControl& mouse, Cont
   connect(context_.panel, &DevicePanel::leftToolChanged, this, [this] { leftToolChanged(); });
 }
 
-std::optional<DeviceToolSettings> DeviceControl::leftDeviceTool() const {
-  const std::optional<ToolKind> kind = context_.panel->leftTool();
-  if (!kind) return std::nullopt;
+DeviceToolSettings DeviceControl::heldAlongTheView(ToolKind kind) const {
   DeviceToolSettings settings;
-  settings.kind = *kind;
+  settings.kind = kind;
   settings.orientation = tool_orientation_from_view(context_.viewAxes());
   settings.action_buttons = haptics_.action_buttons;
   return settings;
+}
+
+std::optional<DeviceToolSettings> DeviceControl::leftDeviceTool() const {
+  const std::optional<ToolKind> kind = context_.panel->leftTool();
+  if (!kind) return std::nullopt;
+  return heldAlongTheView(*kind);
 }
 
 void DeviceControl::leftToolChanged() {
@@ -137,11 +141,7 @@ std::optional<DeviceToolSettings> DeviceControl::deviceTool() const {
   if (station_.mouse()) return mouse_.deviceTool();
   const auto kind = context_.tools ? context_.tools->tool() : std::nullopt;
   if (!kind) return std::nullopt;  // the hand: the device holds nothing
-  DeviceToolSettings settings;
-  settings.kind = *kind;
-  settings.orientation = tool_orientation_from_view(context_.viewAxes());
-  settings.action_buttons = haptics_.action_buttons;
-  return settings;
+  return heldAlongTheView(*kind);
 }
 
 bool DeviceControl::useDevice(DeviceChoice choice, const QString& trajectoryFile) {

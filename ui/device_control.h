@@ -71,6 +71,8 @@ class DeviceControl : public QObject {
   void showDeviceInUse();
   void save();
   void leftToolChanged();  // tells the station
+  // A device's hold of `kind`: its shaft along the view, the calibrated action buttons.
+  DeviceToolSettings heldAlongTheView(ToolKind kind) const;
 
   Workstation& station_;
   MouseToolControl& mouse_;

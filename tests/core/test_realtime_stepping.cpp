@@ -604,6 +604,7 @@ TEST_F(RealtimeSteppingFixture, TwoScriptedDevicesMoveAToolEachAndEachFeelsItsOw
   simulation.set_haptic_servo(&servo);
   simulation.set_device_tool(Hand::left, forceps);
   simulation.set_device_tool(Hand::right, probe);
+  simulation.log_inputs(true);
   servo.start();
   simulation.start();
   const SimulationSnapshot both = run_until(simulation, 60.0, [&](const SimulationSnapshot& s) {
@@ -638,6 +639,20 @@ TEST_F(RealtimeSteppingFixture, TwoScriptedDevicesMoveAToolEachAndEachFeelsItsOw
   EXPECT_GT(right_up, 0.0) << "the right device never felt its probe";
   EXPECT_GT(left_down, 0.0) << "the left device never felt its forceps";
   EXPECT_FALSE(simulation.stats().halted);
+  // The log keeps one tool a hand between cycles: each device moves its tool at every loop, and
+  // a tool no cycle used is replaced by the hand's next one, whatever the other hand took between.
+  std::array<int, 2> tools_since_cycle{};
+  int cycles = 0;
+  for (const SimulationInput& input : simulation.take_input_log()) {
+    if (input.kind == SimulationInput::Kind::cycle) {
+      tools_since_cycle = {};
+      ++cycles;
+    } else if (input.kind == SimulationInput::Kind::tool && input.tool) {
+      EXPECT_LE(++tools_since_cycle[hand_index(input.hand)], 1)
+          << "two tools of the " << hand_name(input.hand) << " hand before cycle " << cycles;
+    }
+  }
+  EXPECT_GT(cycles, 100);
 }
 
 // The tool follows the stylus (issue 43, item 2): a scripted stylus turning from upright to 60°

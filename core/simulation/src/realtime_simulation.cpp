@@ -579,15 +579,16 @@ std::vector<SimulationInput> RealtimeSimulation::take_input_log() {
 void RealtimeSimulation::log_input(SimulationInput input) {
   std::lock_guard lock(input_log_mutex_);
   // A device moves the tool at every loop, many times between cycles: a tool of the same kind
-  // replacing one that no cycle used has the same effect as both (change_tool), so it replaces it.
-  if (input.kind == SimulationInput::Kind::tool && input.tool && !input_log_.empty()) {
-    SimulationInput& last = input_log_.back();
-    if (last.kind == SimulationInput::Kind::tool && last.hand == input.hand && last.tool &&
-        last.tool->kind == input.tool->kind) {
-      last.tool = input.tool;
+  // in the same hand replacing one that no cycle used has the same effect as both (change_tool),
+  // so it replaces it. The other hand's tools taken since do not act on this hand's.
+  if (input.kind == SimulationInput::Kind::tool && input.tool)
+    for (auto last = input_log_.rbegin();
+         last != input_log_.rend() && last->kind == SimulationInput::Kind::tool; ++last) {
+      if (last->hand != input.hand) continue;
+      if (!last->tool || last->tool->kind != input.tool->kind) break;
+      last->tool = input.tool;
       return;
     }
-  }
   input_log_.push_back(std::move(input));
 }
 
