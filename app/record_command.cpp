@@ -261,9 +261,12 @@ int record(const RecordOptions& options) {
             << (stop_signal == SIGINT    ? ", ended by SIGINT"
                 : stop_signal == SIGTERM ? ", ended by SIGTERM"
                                          : "")
-            << "): " << summary.frame_count << " frames, servo " << number(rate_hz) << " Hz, "
-            << metrics->metrics.size() << " metrics stored in " << options.database.string()
-            << std::endl;
+            << "): " << summary.frame_count << " frames"
+            << (summary.left_hand
+                    ? " (and " + std::to_string(summary.left_frame_count) + " of the left hand)"
+                    : "")
+            << ", servo " << number(rate_hz) << " Hz, " << metrics->metrics.size()
+            << " metrics stored in " << options.database.string() << std::endl;
   return 0;
 }
 

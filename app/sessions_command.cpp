@@ -21,13 +21,14 @@ struct SessionsOptions {
   std::filesystem::path database;
   ServerConnectionOptions server;  // instead of a database: the training centre's server
   std::int64_t session = 0;
-  std::filesystem::path frames_csv, events_csv, metrics_csv;
+  std::filesystem::path frames_csv, left_frames_csv, events_csv, metrics_csv;
 };
 
 void print_list(SessionStore& store) {
   const std::vector<SessionSummary> sessions = store.sessions();
   std::cout << "id,trainee,scenario,scenario_sha256,device,started_unix_ms,ended_unix_ms,status,"
-               "frames,servo_rate_hz,servo_period_p99_ms,missed_deadlines,dropped_frames\n";
+               "frames,servo_rate_hz,servo_period_p99_ms,missed_deadlines,dropped_frames,"
+               "left_device,left_frames\n";
   for (const SessionSummary& s : sessions) {
     std::cout << s.id << ',' << csv_field(s.trainee) << ',' << csv_field(s.scenario_title) << ','
               << s.scenario_sha256 << ',' << csv_field(s.device) << ',' << s.started_unix_ms << ',';
@@ -38,16 +39,29 @@ void print_list(SessionStore& store) {
                 << s.servo->missed_deadlines << ',' << s.servo->dropped_frames;
     else
       std::cout << ",,,";
+    // The left hand's device (empty for a one-handed session).
+    std::cout << ',';
+    if (s.left_hand)
+      std::cout << csv_field(s.left_hand->device) << ',' << s.left_frame_count;
+    else
+      std::cout << ',';
     std::cout << '\n';
   }
 }
 
 int export_session(SessionStore& store, const SessionsOptions& o) {
-  bool found = false;
-  for (const SessionSummary& s : store.sessions()) found |= s.id == o.session;
+  const std::string where = o.server.url.empty() ? o.database.string() : o.server.url;
+  const SessionSummary* found = nullptr;
+  const std::vector<SessionSummary> sessions = store.sessions();
+  for (const SessionSummary& s : sessions)
+    if (s.id == o.session) found = &s;
   if (!found) {
-    std::cerr << "error: " << (o.server.url.empty() ? o.database.string() : o.server.url)
-              << " has no session " << o.session << '\n';
+    std::cerr << "error: " << where << " has no session " << o.session << '\n';
+    return 1;
+  }
+  if (!o.left_frames_csv.empty() && !found->left_hand) {
+    std::cerr << "error: session " << o.session << " of " << where
+              << " had no device in the left hand: it has no left-hand frames to export\n";
     return 1;
   }
   auto write = [&](const std::filesystem::path& file, auto&& what) {
@@ -62,6 +76,10 @@ int export_session(SessionStore& store, const SessionsOptions& o) {
   };
   if (!write(o.frames_csv,
              [&](std::ostream& out) { write_frames_csv(store.frames(o.session), out); }))
+    return 1;
+  if (!o.left_frames_csv.empty() && !write(o.left_frames_csv, [&](std::ostream& out) {
+        write_frames_csv(store.frames(o.session, Hand::left), out);
+      }))
     return 1;
   if (!o.events_csv.empty() && !write(o.events_csv, [&](std::ostream& out) {
         write_events_csv(store.events(o.session), out);
@@ -78,6 +96,7 @@ int export_session(SessionStore& store, const SessionsOptions& o) {
       }))
     return 1;
   std::cout << "wrote session " << o.session << " to " << o.frames_csv.string()
+            << (o.left_frames_csv.empty() ? "" : ", " + o.left_frames_csv.string())
             << (o.events_csv.empty() ? "" : ", " + o.events_csv.string())
             << (o.metrics_csv.empty() ? "" : ", " + o.metrics_csv.string()) << '\n';
   return 0;
@@ -109,7 +128,10 @@ std::function<std::optional<int>()> add_sessions_command(CLI::App& app) {
   exported->add_option("--session", options->session, "Session id (from `sessions list`)")
       ->required();
   exported->add_option("--frames", options->frames_csv, "Output CSV of the frames")->required();
-  exported->add_option("--events", options->events_csv, "Output CSV of the events");
+  exported->add_option("--left-frames", options->left_frames_csv,
+                       "Output CSV of the left hand's device's frames (a two-handed session)");
+  exported->add_option("--events", options->events_csv,
+                       "Output CSV of the events, with their hand");
   exported->add_option("--metrics", options->metrics_csv,
                        "Output CSV of the metrics against the scenario's rubric, and the score");
   return [=]() -> std::optional<int> {

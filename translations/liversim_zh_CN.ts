@@ -37,6 +37,10 @@
         <source>The force trace of session %1 was not read: reading was cancelled. Open the session again to read it.</source>
         <translation>会话 %1 的力曲线未读取：读取已取消。再次打开该会话即可读取。</translation>
     </message>
+    <message>
+        <source>Reading the left hand&apos;s frames of session %1…</source>
+        <translation>正在读取会话 %1 的左手帧…</translation>
+    </message>
 </context>
 <context>
     <name>liversim</name>
@@ -2534,6 +2538,22 @@ Simulated: %2.
         <source>The replay ends at %1 s, where gravity was switched (to %2): what followed was not logged for replay.</source>
         <translation>回放在 %1 秒处结束，此时重力被切换（为 %2）：之后的操作未记录用于回放。</translation>
     </message>
+    <message>
+        <source>Left hand, recorded (N)</source>
+        <translation>左手，记录 (N)</translation>
+    </message>
+    <message>
+        <source>Left hand, replayed (N)</source>
+        <translation>左手，回放 (N)</translation>
+    </message>
+    <message>
+        <source>Right hand, recorded (N)</source>
+        <translation>右手，记录 (N)</translation>
+    </message>
+    <message>
+        <source>Right hand, replayed (N)</source>
+        <translation>右手，回放 (N)</translation>
+    </message>
 </context>
 <context>
     <name>liversim::SessionReviewWindow</name>
@@ -2756,6 +2776,18 @@ Simulated: %2.
     <message>
         <source>Enter the grade first (e.g. pass, fail, B+).</source>
         <translation>请先输入评分（例如 通过、不通过、B+）。</translation>
+    </message>
+    <message>
+        <source>Left hand (N)</source>
+        <translation>左手 (N)</translation>
+    </message>
+    <message>
+        <source>Right hand (N)</source>
+        <translation>右手 (N)</translation>
+    </message>
+    <message>
+        <source> (left hand)</source>
+        <translation>（左手）</translation>
     </message>
 </context>
 <context>

@@ -72,7 +72,10 @@ std::optional<DeviceToolSettings> DeviceControl::leftDeviceTool() const {
 }
 
 void DeviceControl::leftToolChanged() {
-  if (ServoLoop* servo = station_.servo()) station_.device_tool_changed(Hand::left, servo->now_s());
+  if (ServoLoop* servo = station_.servo()) {
+    station_.device_tool_changed(Hand::left, servo->now_s());
+    station_.record_tool_choice(Hand::left);
+  }
 }
 
 void DeviceControl::setLeftHandTools(const std::vector<ToolKind>& tools) {

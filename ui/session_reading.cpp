@@ -8,10 +8,13 @@
 namespace liversim {
 
 std::optional<std::vector<ServoFrame>> readSessionFrames(SessionStore& store, std::int64_t session,
-                                                         QWidget* parent, int delayMs) {
+                                                         QWidget* parent, int delayMs, Hand hand) {
   constexpr int kSteps = 1000;
   QProgressDialog dialog(
-      QCoreApplication::translate("SessionReading", "Reading the frames of session %1…")
+      (hand == Hand::left
+           ? QCoreApplication::translate("SessionReading",
+                                         "Reading the left hand's frames of session %1…")
+           : QCoreApplication::translate("SessionReading", "Reading the frames of session %1…"))
           .arg(session),
       QCoreApplication::translate("SessionReading", "Cancel"), 0, kSteps, parent);
   dialog.setObjectName("sessionReadingProgress");
@@ -23,7 +26,7 @@ std::optional<std::vector<ServoFrame>> readSessionFrames(SessionStore& store, st
   dialog.setAutoClose(false);
   try {
     std::vector<ServoFrame> frames =
-        store.frames(session, [&](std::size_t read, std::size_t total) {
+        store.frames(session, hand, [&](std::size_t read, std::size_t total) {
           const double fraction =
               total > 0 ? std::min(1.0, static_cast<double>(read) / static_cast<double>(total))
                         : 0.0;

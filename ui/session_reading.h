@@ -18,11 +18,13 @@ namespace liversim {
 
 inline constexpr int kSessionReadingDialogDelayMs = 500;
 
-// The session's frames; nullopt when the user cancelled. Throws StorageError as frames() does.
-// `delayMs`: how long reading goes on before the dialog appears (tests show it at once).
-std::optional<std::vector<ServoFrame>> readSessionFrames(
-    SessionStore& store, std::int64_t session, QWidget* parent,
-    int delayMs = kSessionReadingDialogDelayMs);
+// The session's frames of the device in `hand`; nullopt when the user cancelled. Throws
+// StorageError as frames() does. `delayMs`: how long reading goes on before the dialog appears
+// (tests show it at once).
+std::optional<std::vector<ServoFrame>> readSessionFrames(SessionStore& store, std::int64_t session,
+                                                         QWidget* parent,
+                                                         int delayMs = kSessionReadingDialogDelayMs,
+                                                         Hand hand = Hand::right);
 
 // What a window says in place of a trace whose reading was cancelled.
 QString sessionReadingCancelledText(std::int64_t session);

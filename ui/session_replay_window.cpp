@@ -80,9 +80,16 @@ SessionReplayWindow::SessionReplayWindow(SessionStore* openStore, const QString&
   recordedForce_->setName(tr("Recorded force on the tissue (N)"));
   replayedForce_ = new QLineSeries();
   replayedForce_->setName(tr("Replayed force on the tool (N)"));
+  recordedLeftForce_ = new QLineSeries();
+  recordedLeftForce_->setName(tr("Left hand, recorded (N)"));
+  replayedLeftForce_ = new QLineSeries();
+  replayedLeftForce_->setName(tr("Left hand, replayed (N)"));
   cursor_ = new QLineSeries();
   cursor_->setName(tr("Replayed time"));
-  QChart* chart = force_chart({recordedForce_, replayedForce_, cursor_});
+  QChart* chart = force_chart(
+      {recordedForce_, replayedForce_, recordedLeftForce_, replayedLeftForce_, cursor_});
+  recordedLeftForce_->setVisible(false);
+  replayedLeftForce_->setVisible(false);
   chart_ = new QChartView(chart, this);
   chart_->setObjectName("replayForceChart");
   chart_->setRenderHint(QPainter::Antialiasing);
@@ -111,10 +118,20 @@ SessionReplayWindow::SessionReplayWindow(SessionStore* openStore, const QString&
                                                   SqliteSessionStore::Access::read_only);
     SessionStore& store = openStore != nullptr ? *openStore : *file;
     std::optional<double> scale;
+    std::optional<LeftHandDevice> left_hand;
     for (const SessionSummary& summary : store.sessions())
-      if (summary.id == session && summary.mapping) scale = summary.mapping->scale;
+      if (summary.id == session) {
+        if (summary.mapping) scale = summary.mapping->scale;
+        left_hand = summary.left_hand;
+      }
     const std::optional<std::vector<ServoFrame>> read = readSessionFrames(store, session, parent);
     if (!read) throw ReadingCancelled();
+    std::optional<std::vector<ServoFrame>> left_read;
+    if (left_hand) {
+      left_read =
+          readSessionFrames(store, session, parent, kSessionReadingDialogDelayMs, Hand::left);
+      if (!left_read) throw ReadingCancelled();
+    }
     const std::vector<ServoFrame>& frames = *read;
     setup = store.replay_setup(session);
     inputs = store.inputs(session);
@@ -143,6 +160,16 @@ SessionReplayWindow::SessionReplayWindow(SessionStore* openStore, const QString&
     const ForceCurve curve = force_curve(frames, scale ? 1.0 / *scale : 1.0, t0_s_);
     recordedForce_->replace(curve.points);
     largestForceN_ = std::max(curve.largest_n, 0.1);
+    if (left_read) {
+      twoHands_ = true;
+      recordedForce_->setName(tr("Right hand, recorded (N)"));
+      replayedForce_->setName(tr("Right hand, replayed (N)"));
+      const ForceCurve left_curve = force_curve(*left_read, 1.0 / left_hand->mapping.scale, t0_s_);
+      recordedLeftForce_->replace(left_curve.points);
+      largestForceN_ = std::max(largestForceN_, left_curve.largest_n);
+      recordedLeftForce_->setVisible(true);
+      replayedLeftForce_->setVisible(true);
+    }
   } catch (const StorageError& e) {
     problem_ = storageProblemText(tr("Session %1 cannot be read: %2").arg(session), e);
   } catch (const ReadingCancelled&) {
@@ -297,10 +324,12 @@ void SessionReplayWindow::showSnapshot() {
   const double t = positionS();
   cursor_->replace({QPointF(t, 0.0), QPointF(t, largestForceN_ * 1.1)});
   // The replayed force, one point a frame; a seek back starts the curve again.
-  if (replayedForce_->count() > 0 && replayedForce_->at(replayedForce_->count() - 1).x() > t)
-    replayedForce_->clear();
-  if (replayedForce_->count() == 0 || replayedForce_->at(replayedForce_->count() - 1).x() < t)
-    replayedForce_->append(t, snapshot.hand(Hand::right).force_n.norm());
+  const auto follow = [t](QLineSeries* series, double force_n) {
+    if (series->count() > 0 && series->at(series->count() - 1).x() > t) series->clear();
+    if (series->count() == 0 || series->at(series->count() - 1).x() < t) series->append(t, force_n);
+  };
+  follow(replayedForce_, snapshot.hand(Hand::right).force_n.norm());
+  if (twoHands_) follow(replayedLeftForce_, snapshot.hand(Hand::left).force_n.norm());
   viewport_->scheduleRender();
 }
 
@@ -336,6 +365,14 @@ int SessionReplayWindow::recordedForcePointCount() const {
 
 int SessionReplayWindow::replayedForcePointCount() const {
   return static_cast<int>(replayedForce_->count());
+}
+
+int SessionReplayWindow::recordedLeftForcePointCount() const {
+  return static_cast<int>(recordedLeftForce_->count());
+}
+
+int SessionReplayWindow::replayedLeftForcePointCount() const {
+  return static_cast<int>(replayedLeftForce_->count());
 }
 
 }  // namespace liversim

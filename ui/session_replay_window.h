@@ -74,6 +74,9 @@ class SessionReplayWindow : public QWidget {
   const LiverScene* scene() const { return scene_.get(); }  // null until ready()
   int recordedForcePointCount() const;
   int replayedForcePointCount() const;
+  // The left hand's curves, in a two-handed session (0 points otherwise).
+  int recordedLeftForcePointCount() const;
+  int replayedLeftForcePointCount() const;
 
  signals:
   void readyChanged(bool ready);
@@ -104,6 +107,9 @@ class SessionReplayWindow : public QWidget {
   QChartView* chart_ = nullptr;
   QLineSeries* recordedForce_ = nullptr;
   QLineSeries* replayedForce_ = nullptr;
+  QLineSeries* recordedLeftForce_ = nullptr;  // shown for a two-handed session
+  QLineSeries* replayedLeftForce_ = nullptr;
+  bool twoHands_ = false;
   QLineSeries* cursor_ = nullptr;
   double largestForceN_ = 0.1;
   QTimer timer_;

@@ -125,10 +125,13 @@ SessionReviewWindow::SessionReviewWindow(OpenedStore opened, const QString& sour
 
   forceSeries_ = new QLineSeries();
   forceSeries_->setName(tr("Force on the device (N)"));
+  leftForceSeries_ = new QLineSeries();
+  leftForceSeries_->setName(tr("Left hand (N)"));
   eventSeries_ = new QScatterSeries();
   eventSeries_->setName(tr("Events"));
   eventSeries_->setMarkerSize(8.0);
-  QChart* chart = force_chart({forceSeries_, eventSeries_});
+  QChart* chart = force_chart({forceSeries_, leftForceSeries_, eventSeries_});
+  leftForceSeries_->setVisible(false);
   forceChart_ = new QChartView(chart, this);
   forceChart_->setObjectName("forceChart");
   forceChart_->setRenderHint(QPainter::Antialiasing);
@@ -305,6 +308,8 @@ bool SessionReviewWindow::openSession(std::int64_t session) {
 
 void SessionReviewWindow::showOpenedSession() {
   forceSeries_->clear();
+  leftForceSeries_->clear();
+  leftForceSeries_->setVisible(false);
   eventSeries_->clear();
   eventList_->clear();
   metricTable_->setRowCount(0);
@@ -348,19 +353,37 @@ void SessionReviewWindow::showOpenedSession() {
     // The force on the tissue (the device's over the mapping's scale; the device's own for
     // sessions recorded without their mapping), each bucket of frames as its largest force.
     std::optional<double> scale;
+    std::optional<LeftHandDevice> left_hand;
     for (const SessionSummary& summary : sessions_)
-      if (summary.id == *opened_ && summary.mapping) scale = summary.mapping->scale;
-    forceSeries_->setName(scale ? tr("Force on the tissue (N)") : tr("Force on the device (N)"));
+      if (summary.id == *opened_) {
+        if (summary.mapping) scale = summary.mapping->scale;
+        left_hand = summary.left_hand;
+      }
+    forceSeries_->setName(left_hand ? tr("Right hand (N)")
+                          : scale   ? tr("Force on the tissue (N)")
+                                    : tr("Force on the device (N)"));
     const double force_factor = scale ? 1.0 / *scale : 1.0;
-    const std::optional<std::vector<ServoFrame>> read =
+    std::optional<std::vector<ServoFrame>> read =
         readSessionFrames(*store_, *opened_, this, readingDialogDelayMs_);
+    // A two-handed session's left hand, on the same clock and axes.
+    std::optional<std::vector<ServoFrame>> left_read;
+    if (read && left_hand) {
+      left_read = readSessionFrames(*store_, *opened_, this, readingDialogDelayMs_, Hand::left);
+      if (!left_read) read.reset();
+    }
     traceRead_ = read.has_value();
     forceChart_->chart()->setTitle(read ? QString() : sessionReadingCancelledText(*opened_));
     const std::vector<ServoFrame> frames = read.value_or(std::vector<ServoFrame>{});
     const double t0 = frames.empty() ? 0.0 : frames.front().time_s;
     const ForceCurve curve = force_curve(frames, force_factor, t0);
-    const double largest = curve.largest_n;
+    double largest = curve.largest_n;
     forceSeries_->replace(curve.points);
+    if (left_read) {
+      const ForceCurve left_curve = force_curve(*left_read, 1.0 / left_hand->mapping.scale, t0);
+      largest = std::max(largest, left_curve.largest_n);
+      leftForceSeries_->replace(left_curve.points);
+      leftForceSeries_->setVisible(true);
+    }
     // Event times are from the first frame: without the frames they are not listed either.
     const std::vector<SessionEvent> events =
         read ? store_->events(*opened_) : std::vector<SessionEvent>{};
@@ -374,10 +397,11 @@ void SessionReviewWindow::showOpenedSession() {
                      .arg(mark[0].x() * 1e3, 0, 'f', 1)
                      .arg(mark[0].y() * 1e3, 0, 'f', 1)
                      .arg(mark[0].z() * 1e3, 0, 'f', 1);
-      eventList_->addItem(QString("%1 s  %2  %3")
-                              .arg(e.time_s - t0, 0, 'f', 3)
-                              .arg(QString::fromUtf8(kind.data(), static_cast<int>(kind.size())))
-                              .arg(detail));
+      // In a two-handed session, the left hand's events say so.
+      const QString what = QString::fromUtf8(kind.data(), static_cast<int>(kind.size())) +
+                           (left_hand && e.hand == Hand::left ? tr(" (left hand)") : QString());
+      eventList_->addItem(
+          QString("%1 s  %2  %3").arg(e.time_s - t0, 0, 'f', 3).arg(what).arg(detail));
       eventSeries_->append(e.time_s - t0, 0.0);
     }
     const double end_s = frames.empty() ? 1.0 : std::max(frames.back().time_s - t0, 1e-3);
@@ -430,6 +454,10 @@ QString SessionReviewWindow::scoreText() const {
 
 int SessionReviewWindow::forcePointCount() const {
   return static_cast<int>(forceSeries_->count());
+}
+
+int SessionReviewWindow::leftForcePointCount() const {
+  return static_cast<int>(leftForceSeries_->count());
 }
 
 int SessionReviewWindow::eventCount() const {
@@ -518,12 +546,27 @@ bool SessionReviewWindow::exportCsv(const QString& folder) {
       setProblem(tr("Nothing was exported: reading session %1 was cancelled.").arg(*opened_));
       return false;
     }
+    bool two_hands = false;
+    for (const SessionSummary& s : sessions_)
+      if (s.id == *opened_) two_hands = s.left_hand.has_value();
+    std::optional<std::vector<ServoFrame>> left_read;
+    if (two_hands) {
+      left_read = readSessionFrames(*store_, *opened_, this, readingDialogDelayMs_, Hand::left);
+      if (!left_read) {
+        setProblem(tr("Nothing was exported: reading session %1 was cancelled.").arg(*opened_));
+        return false;
+      }
+    }
+    std::ostringstream left_frames;
     write_frames_csv(*read, frames);
+    if (left_read) write_frames_csv(*left_read, left_frames);
     write_events_csv(store_->events(*opened_), events);
     write_metrics_csv(store_->metrics(*opened_), rubric_, metrics);
-    const bool written = write_whole(base + "frames.csv", frames.str(), problem) &&
-                         write_whole(base + "events.csv", events.str(), problem) &&
-                         write_whole(base + "metrics.csv", metrics.str(), problem);
+    const bool written =
+        write_whole(base + "frames.csv", frames.str(), problem) &&
+        (!left_read || write_whole(base + "left-frames.csv", left_frames.str(), problem)) &&
+        write_whole(base + "events.csv", events.str(), problem) &&
+        write_whole(base + "metrics.csv", metrics.str(), problem);
     setProblem(written ? QString() : problem);
     return written;
   } catch (const StorageError& e) {

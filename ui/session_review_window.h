@@ -70,6 +70,8 @@ class SessionReviewWindow : public QWidget {
   const RubricResult& rubricResult() const { return rubric_; }
   QString scoreText() const;
   int forcePointCount() const;  // points of the force curve (downsampled: peaks kept)
+  // Points of the left hand's force curve: 0 for a one-handed session.
+  int leftForcePointCount() const;
   int eventCount() const;
   QStringList eventLines() const;  // as listed: time, kind, detail
   QString gradesText() const;      // the grades saved so far, oldest first
@@ -81,9 +83,10 @@ class SessionReviewWindow : public QWidget {
   bool saveGrade();
 
   // The opened session as CSV files in `folder` (session-N-frames.csv, -events.csv,
-  // -metrics.csv: docs/session-storage.md), and as a printable PDF report (its summary, metrics
-  // against the rubric, force plot, events and grades). False, saying why in problem(), when a
-  // file cannot be written; nothing is left half-written under the final name.
+  // -metrics.csv, and -left-frames.csv for a two-handed session: docs/session-storage.md), and as a
+  // printable PDF report (its summary, metrics against the rubric, force plot, events and grades).
+  // False, saying why in problem(), when a file cannot be written; nothing is left half-written
+  // under the final name.
   bool exportCsv(const QString& folder);
   bool exportPdf(const QString& file);
   // The opened session played back in a viewport (its own window, session_replay_window.h);
@@ -123,6 +126,7 @@ class SessionReviewWindow : public QWidget {
   QTableWidget* metricTable_ = nullptr;
   QChartView* forceChart_ = nullptr;
   QLineSeries* forceSeries_ = nullptr;
+  QLineSeries* leftForceSeries_ = nullptr;  // shown for a two-handed session
   QScatterSeries* eventSeries_ = nullptr;
   QListWidget* eventList_ = nullptr;
   QLineEdit* instructorEdit_ = nullptr;

@@ -1,5 +1,6 @@
 // Session events found from what the simulation showed at successive display frames (issue 10).
 #include "liversim/sessions/session_events.h"
+#include "liversim/sessions/session_recording.h"
 
 #include <gtest/gtest.h>
 
@@ -83,6 +84,53 @@ TEST(SessionEvents, AGraspOrExcessiveForceAlreadyOnAtTheStartIsReported) {
   const std::vector<SessionEventKind> expected{SessionEventKind::grasp,
                                                SessionEventKind::excessive_force};
   EXPECT_EQ(kinds(events), expected);
+}
+
+// Two hands (issue 43): each hand's grasps and forces are its own events, a cut is the hand's
+// whose blade cut, and what the scene does is reported once, under the right hand.
+TEST(SessionEvents, EachHandsGraspsForcesAndCutsAreTaggedWithTheHand) {
+  SessionEventWatch watch(nullptr);  // free practice: the default safe force
+  const double safe_n = TaskSpec{}.safe_force_n;
+  SimulationSnapshot shown;
+  RealtimeStats stats;
+  std::vector<SessionEvent> events;
+  watch.observe(0.0, shown, stats, false, events);
+  EXPECT_TRUE(events.empty());
+
+  // The left hand's forceps close and pull too hard; the right hand does nothing.
+  shown.hands[hand_index(Hand::left)].grasping = true;
+  shown.hands[hand_index(Hand::left)].force_n = Eigen::Vector3d(0.0, 0.0, safe_n + 0.5);
+  watch.observe(0.1, shown, stats, false, events);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].kind, SessionEventKind::grasp);
+  EXPECT_EQ(events[0].hand, Hand::left);
+  EXPECT_EQ(events[1].kind, SessionEventKind::excessive_force);
+  EXPECT_EQ(events[1].hand, Hand::left);
+
+  // The left hand's blade cuts (its forceps let go): a cut of the left hand, a release of the
+  // left hand; a recovery of the scene, once.
+  events.clear();
+  shown.hands[hand_index(Hand::left)].grasping = false;
+  shown.hands[hand_index(Hand::left)].blade_cutting = true;
+  shown.topology_version = 1;
+  stats.rollbacks = 1;
+  watch.observe(0.2, shown, stats, false, events);
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0].kind, SessionEventKind::cut);
+  EXPECT_EQ(events[0].hand, Hand::left);
+  EXPECT_EQ(events[1].kind, SessionEventKind::simulation_recovery);
+  EXPECT_EQ(events[1].hand, Hand::right);
+  EXPECT_EQ(events[2].kind, SessionEventKind::release);
+  EXPECT_EQ(events[2].hand, Hand::left);
+
+  // Both blades in the tissue: the cut is filed under the right hand.
+  events.clear();
+  shown.hands[hand_index(Hand::right)].blade_cutting = true;
+  shown.topology_version = 2;
+  watch.observe(0.3, shown, stats, false, events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, SessionEventKind::cut);
+  EXPECT_EQ(events[0].hand, Hand::right);
 }
 
 }  // namespace

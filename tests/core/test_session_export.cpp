@@ -16,11 +16,13 @@ TEST(SessionExport, FieldsWithCommasQuotesOrLineBreaksAreQuotedWithQuotesDoubled
   std::ostringstream out;
   write_events_csv(
       std::vector<SessionEvent>{{0.5, SessionEventKind::excessive_force, "1.6 N"},
-                                {1.25, SessionEventKind::lesion_breach, "T1, \"left\""}},
+                                {1.25, SessionEventKind::lesion_breach, "T1, \"left\""},
+                                {1.5, SessionEventKind::grasp, "", Hand::left}},
       out);
+  // Each event with its hand (issue 43).
   EXPECT_EQ(out.str(),
-            "time_s,kind,detail\n0.5,excessive_force,1.6 N\n1.25,lesion_breach,\"T1, "
-            "\"\"left\"\"\"\n");
+            "time_s,kind,detail,hand\n0.5,excessive_force,1.6 N,right\n1.25,lesion_breach,\"T1, "
+            "\"\"left\"\"\",right\n1.5,grasp,,left\n");
 }
 
 TEST(SessionExport, MetricsCarryTheirUnitCriterionAndPassAndTheScoreComesLast) {

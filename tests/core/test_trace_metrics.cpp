@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -352,6 +353,99 @@ TEST(TraceMetrics, TheHandsStretchCountsForNoTool) {
     EXPECT_NE(find_metric(value.name), nullptr) << value.name << " is not a gradable metric";
   EXPECT_EQ(values.at(1).name, "path_length_mm");
   EXPECT_EQ(values.at(1).value, metrics.path_length_mm);
+}
+
+// Per instrument (issue 43, item 5), on a trace whose answers follow by hand. Frames 2⁻¹⁰ s apart
+// and speeds of 20 mm/s keep every time and position exact. Still for 0.5 s; 10 mm along x in
+// 0.5 s (a straight movement); still for 0.5 s; 10 mm along y then 10 mm back along x, 0.5 s
+// each, without a pause (one movement of path 20 mm over a straight-line distance of 10√2 mm);
+// still for 0.5 s to the end at 3 s.
+std::vector<ServoFrame> two_movements_and_three_rests(double frame_s) {
+  std::vector<ServoFrame> frames;
+  for (int i = 0; i * frame_s <= 3.0; ++i) {
+    const double t_s = i * frame_s;
+    const auto moved = [&](double from_s, double to_s) {
+      return 20.0 * std::clamp(t_s - from_s, 0.0, to_s - from_s);
+    };
+    const Eigen::Vector3d x(moved(0.5, 1.0) - moved(2.0, 2.5), moved(1.5, 2.0), 0.0);
+    frames.push_back(frame_at(t_s, x));
+  }
+  return frames;
+}
+
+TEST(TraceMetrics, EconomyOfMotionAndIdleTimeHaveTheirHandComputedValues) {
+  const double frame_s = 1.0 / 1024.0;
+  const std::vector<ServoFrame> frames = two_movements_and_three_rests(frame_s);
+  const TraceMetrics metrics = compute_trace_metrics(frames, kProbeThroughout, {}, {});
+  EXPECT_EQ(metrics.movements, 2);
+  EXPECT_NEAR(metrics.path_length_mm, 30.0, 1e-12);
+  ASSERT_TRUE(metrics.economy_of_motion);
+  // (10 + 20) mm of path over 10 + 10√2 mm of straight lines.
+  EXPECT_NEAR(*metrics.economy_of_motion, 30.0 / (10.0 + 10.0 * std::numbers::sqrt2), 1e-12);
+  // The three rests of 0.5 s, each longer than the pause (0.2 s).
+  EXPECT_NEAR(metrics.idle_time_s, 1.5, 1e-12);
+  // The mapping scales path and straight line alike: the economy stays.
+  WorkspaceMapping scaled;
+  scaled.scale = 2.5;
+  const TraceMetrics at_scale = compute_trace_metrics(frames, kProbeThroughout, scaled, {});
+  EXPECT_NEAR(*at_scale.economy_of_motion, *metrics.economy_of_motion, 1e-12);
+  // A straight stroke has economy 1; a tool that never moves has none, and is idle throughout.
+  const std::vector<ServoFrame> straight(frames.begin() + 400, frames.begin() + 1100);
+  EXPECT_NEAR(*compute_trace_metrics(straight, kProbeThroughout, {}, {}).economy_of_motion, 1.0,
+              1e-12);
+  const std::vector<ServoFrame> still(frames.begin(), frames.begin() + 500);
+  const TraceMetrics resting = compute_trace_metrics(still, kProbeThroughout, {}, {});
+  EXPECT_FALSE(resting.economy_of_motion);
+  EXPECT_NEAR(resting.idle_time_s, 499 * frame_s, 1e-12);
+  // Rests shorter than the pause are not idle.
+  TraceMetricSettings long_pause;
+  long_pause.pause_s = 0.6;
+  EXPECT_EQ(compute_trace_metrics(frames, kProbeThroughout, {}, long_pause).idle_time_s, 0.0);
+}
+
+// Both hands: the right hand moves over [0.5, 1] s and [1.5, 2.5] s (the trace above); the left
+// hand stays still and presses 0.5 N on the tissue from 0.75 s to 2 s, its force rising and
+// falling within one frame interval δ, where it is above the contact force (0.02 N) for 0.96 δ.
+// Both work over [0.75 − 0.96δ, 1] and [1.5, 2 + 0.96δ]; either works for 1.5 s (the right
+// hand) plus the left hand's 1.25 + 1.92δ less the overlap: 2 s.
+TEST(TraceMetrics, BothHandsWorkingIsTheOverlapOfEachHandsWorkOverTheirUnion) {
+  const double frame_s = 1.0 / 1024.0;
+  const std::vector<ServoFrame> right = two_movements_and_three_rests(frame_s);
+  std::vector<ServoFrame> left;
+  for (const ServoFrame& r : right) {
+    const bool pressing = r.time_s >= 0.75 && r.time_s <= 2.0;
+    left.push_back(frame_at(r.time_s, Eigen::Vector3d(-40.0, 0.0, 0.0),
+                            Eigen::Vector3d(0.0, 0.0, pressing ? 0.5 : 0.0)));
+  }
+  const BimanualMetrics both = compute_bimanual_metrics({right, {}}, {left, {}}, {});
+  const double crossing_s = 0.96 * frame_s;
+  EXPECT_NEAR(both.both_working_s, 0.75 + 2.0 * crossing_s, 1e-12);
+  EXPECT_NEAR(both.either_working_s, 2.0, 1e-12);
+  EXPECT_NEAR(both.both_working_fraction, (0.75 + 2.0 * crossing_s) / 2.0, 1e-12);
+  // The left hand's own figures: never moved, pressed 0.5 N.
+  const TraceMetrics left_metrics = compute_trace_metrics(left, {}, {}, {});
+  EXPECT_EQ(left_metrics.path_length_mm, 0.0);
+  EXPECT_EQ(left_metrics.peak_force_n, 0.5);
+  const std::vector<MetricValue> values = left_hand_metric_values(left_metrics);
+  for (const MetricValue& value : values) {
+    EXPECT_EQ(value.name.rfind("left_", 0), 0u) << value.name;
+    EXPECT_NE(find_metric(value.name), nullptr) << value.name << " is not a gradable metric";
+  }
+  EXPECT_NE(find_metric("both_hands_working_fraction"), nullptr);
+  // A hand that never works: nothing together.
+  std::vector<ServoFrame> idle_left = left;
+  for (ServoFrame& f : idle_left) f.force_n.setZero();
+  const BimanualMetrics alone = compute_bimanual_metrics({right, {}}, {idle_left, {}}, {});
+  EXPECT_EQ(alone.both_working_s, 0.0);
+  EXPECT_EQ(alone.both_working_fraction, 0.0);
+  // Bad input names the hand.
+  left[3].force_n.x() = std::numeric_limits<double>::quiet_NaN();
+  try {
+    compute_bimanual_metrics({right, {}}, {left, {}}, {});
+    ADD_FAILURE() << "a NaN force was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("left hand: servo frame 3: force_n", 0), 0u) << e.what();
+  }
 }
 
 }  // namespace

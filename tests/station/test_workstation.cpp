@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -188,7 +189,8 @@ TEST_F(StationTest, ADeviceSessionIsRecordedWithItsFramesToolFiguresAndMetrics) 
       (frames.back().sample.position_mm - frames.front().sample.position_mm).norm();
   EXPECT_NEAR(path->value, straight_mm, 1e-9 * straight_mm);
   // Free practice: the trace's metrics, damage and resected volume; what was reported was stored.
-  EXPECT_EQ(metrics.size(), trace_metric_values(TraceMetrics{}).size() + 2);
+  // (economy of motion too: the tool moved)
+  EXPECT_EQ(metrics.size(), trace_metric_values(TraceMetrics{}).size() + 3);
   EXPECT_EQ(metrics_[0].metrics.size(), metrics.size());
   EXPECT_FALSE(metrics_[0].rubric.score_percent) << "free practice has no rubric";
 
@@ -357,9 +359,11 @@ TEST_F(StationTest, ADeviceInTheLeftHandMovesItsOwnToolBesideTheRightHandsDevice
   EXPECT_EQ(right.tool->kind, ToolKind::probe);
   EXPECT_LT((left.tool->pose.origin_m - left_mapping.scene_position_m(above_mm)).norm(), 1e-12);
   EXPECT_LT((right.tool->pose.origin_m - above_mm * 1e-3).norm(), 1e-12);
-  // The left hand's tool changed by its device's holder: from the change on, it holds nothing.
+  // The left hand's tool changed by its device's holder (as the Device panel does): from the
+  // change on, it holds nothing.
   left_tool_.reset();
   station_->device_tool_changed(Hand::left, station_->servo()->now_s());
+  station_->record_tool_choice(Hand::left);
   ASSERT_TRUE(frameUntil([&] { return !snapshot().hand(Hand::left).tool; }));
   EXPECT_TRUE(snapshot().hand(Hand::right).tool) << "the right hand's tool went too";
   ASSERT_FALSE(station_->use_device(DeviceChoice::mouse, WorkspaceMapping{}));
@@ -369,6 +373,29 @@ TEST_F(StationTest, ADeviceInTheLeftHandMovesItsOwnToolBesideTheRightHandsDevice
   for (const SimulationInput& input : station_->sessions()->inputs(session))
     left_tools += input.kind == SimulationInput::Kind::tool && input.hand == Hand::left;
   EXPECT_GE(left_tools, 2) << "the left hand's forceps and their putting down are not in the log";
+
+  // The session recorded both devices (issue 43, item 3): each hand's frames, the left hand's
+  // device and mapping, and each tool choice under its hand.
+  std::optional<SessionSummary> recorded;
+  for (const SessionSummary& s : station_->sessions()->sessions())
+    if (s.id == session) recorded = s;
+  ASSERT_TRUE(recorded);
+  EXPECT_EQ(recorded->status, SessionStatus::complete);
+  EXPECT_EQ(recorded->device, "Scripted: trajectory.txt");
+  ASSERT_TRUE(recorded->left_hand);
+  EXPECT_EQ(recorded->left_hand->device, "Scripted: left.txt");
+  EXPECT_EQ(recorded->left_hand->mapping.offset_m, left_mapping.offset_m);
+  EXPECT_GT(recorded->left_frame_count, 0);
+  EXPECT_EQ(static_cast<std::int64_t>(station_->sessions()->frames(session, Hand::left).size()),
+            recorded->left_frame_count);
+  ASSERT_TRUE(recorded->left_servo);
+  EXPECT_GT(recorded->left_servo->ticks, 0u);
+  std::vector<std::pair<Hand, std::string>> tool_choices;
+  for (const SessionEvent& e : station_->sessions()->events(session))
+    if (e.kind == SessionEventKind::tool_selected) tool_choices.emplace_back(e.hand, e.detail);
+  EXPECT_EQ(tool_choices,
+            (std::vector<std::pair<Hand, std::string>>{
+                {Hand::right, "probe"}, {Hand::left, "forceps"}, {Hand::left, "hand"}}));
 }
 
 // A live integrator change carries the liver on where it is (carry_state), mid-press, and is a

@@ -276,7 +276,7 @@ int user_version(const fs::path& file) {
 // the migration to the current version, and a session added after has everything the current
 // version stores.
 TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
-  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 6) << "add a file of the version before";
+  ASSERT_EQ(SqliteSessionStore::kSchemaVersion, 7) << "add a file of the version before";
   struct Earlier {
     int version;
     double peak_force_n;
@@ -284,11 +284,12 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     std::optional<double> mapping_scale;
     std::int64_t frame_count = 202;
   };
-  for (const Earlier& earlier : {Earlier{1, 0.75, "probe", "v1 grade", std::nullopt},
-                                 Earlier{2, 0.5, "scalpel", "v2 grade", 2.0},
-                                 Earlier{3, 0.25, "forceps", "v3 grade", 3.0, 201},
-                                 Earlier{4, 0.125, "scalpel", "v4 grade", 4.0},
-                                 Earlier{5, 0.0625, "probe", "v5 grade", 5.0}}) {
+  for (const Earlier& earlier :
+       {Earlier{1, 0.75, "probe", "v1 grade", std::nullopt},
+        Earlier{2, 0.5, "scalpel", "v2 grade", 2.0},
+        Earlier{3, 0.25, "forceps", "v3 grade", 3.0, 201},
+        Earlier{4, 0.125, "scalpel", "v4 grade", 4.0}, Earlier{5, 0.0625, "probe", "v5 grade", 5.0},
+        Earlier{6, 0.03125, "forceps", "v6 grade", 6.0, 207}}) {
     const std::string name = "sessions-v" + std::to_string(earlier.version) + ".sqlite";
     SCOPED_TRACE(name);
     const fs::path file = fresh_database("migrated-from-v" + std::to_string(earlier.version));
@@ -303,6 +304,10 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     mapping.scale = 1.5;
     mapping.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()));
     mapping.offset_m = {0.01, -0.02, 0.03};
+    WorkspaceMapping left_mapping = mapping;
+    left_mapping.scale = 2.5;
+    left_mapping.offset_m = {-0.04, 0.0, 0.0};
+    const std::vector<ServoFrame> left_frames = synthetic_frames(120, 7);
     ReplaySetup replay;
     replay.built_in_liver_tets = 2500;
     replay.integrator.kind = IntegratorKind::dopri5;
@@ -315,8 +320,10 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
       SessionStart start = start_of("Trainee C", "{}");
       start.mapping = mapping;
       start.replay = replay;
+      start.left_hand = LeftHandDevice{"Left Omni", left_mapping};
       added = store.begin_session(start);
       store.append_inputs(added, std::span(&cycle, 1));
+      store.append_frames(added, Hand::left, left_frames);
       store.commit();
     }
     EXPECT_EQ(user_version(file), SqliteSessionStore::kSchemaVersion);
@@ -337,6 +344,11 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
               (std::vector<MetricValue>{{"peak_force_n", earlier.peak_force_n}}));
     ASSERT_EQ(store.events(sessions[0].id).size(), 1u);
     EXPECT_EQ(store.events(sessions[0].id)[0].detail, earlier.event_detail);
+    // Version 7: a session before it had one hand, the right one, whose events they are.
+    EXPECT_EQ(store.events(sessions[0].id)[0].hand, Hand::right);
+    EXPECT_FALSE(sessions[0].left_hand);
+    EXPECT_EQ(sessions[0].left_frame_count, 0);
+    EXPECT_TRUE(store.frames(sessions[0].id, Hand::left).empty());
     ASSERT_EQ(store.grades(sessions[0].id).size(), 1u);
     EXPECT_EQ(store.grades(sessions[0].id)[0].comment, earlier.grade_comment);
     // Grades of earlier versions stay, but their instructors have no account yet.
@@ -363,7 +375,103 @@ TEST(SessionStore, FilesOfEveryEarlierSchemaVersionAreMigratedWithNothingLost) {
     EXPECT_EQ(read->loop_step_s, 6.75e-4);
     ASSERT_EQ(store.inputs(added).size(), 1u);
     EXPECT_EQ(store.inputs(added)[0].servo_time_s, 0.25);
+    // ... and its left hand's device.
+    ASSERT_TRUE(sessions[1].left_hand);
+    EXPECT_EQ(sessions[1].left_hand->device, "Left Omni");
+    EXPECT_EQ(sessions[1].left_hand->mapping.scale, 2.5);
+    EXPECT_EQ(sessions[1].left_hand->mapping.offset_m, left_mapping.offset_m);
+    EXPECT_EQ(sessions[1].left_frame_count, 120);
+    expect_same_frames(store.frames(added, Hand::left), left_frames);
   }
+}
+
+// Two devices (issue 43): each hand's frames are kept apart and read back exactly, with the left
+// hand's device, mapping and servo figures, and every event with its hand. A one-handed session
+// takes no left-hand frames or figures, and says so.
+TEST(SessionStore, ATwoHandedSessionKeepsEachHandsFramesFiguresAndEvents) {
+  const fs::path file = fresh_database("two-hands");
+  const std::vector<ServoFrame> right = synthetic_frames(700, 3);
+  const std::vector<ServoFrame> left = synthetic_frames(450, 4);
+  ReleasedFrames right_source{right}, left_source{left};
+  SqliteSessionStore store(file);
+  SessionStart start = start_of("Trainee A", "{}");
+  WorkspaceMapping left_mapping;
+  left_mapping.scale = 3.0;
+  left_mapping.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitZ()));
+  left_mapping.offset_m = {-0.06, 0.01, 0.0};
+  start.left_hand = LeftHandDevice{"Scripted: left.txt", left_mapping};
+  SessionRecorder recorder(store, start, right_source.source(), left_source.source(),
+                           SessionRecorder::Options{0.01});
+  const std::vector<SessionEvent> events = {
+      {0.1, SessionEventKind::tool_selected, "scalpel", Hand::right},
+      {0.1, SessionEventKind::tool_selected, "forceps", Hand::left},
+      {0.3, SessionEventKind::grasp, "", Hand::left},
+      {0.4, SessionEventKind::cut, "resected 0 mm3", Hand::right},
+      {0.5, SessionEventKind::device_fault, "the left device stopped", Hand::left}};
+  for (const SessionEvent& event : events) recorder.record_event(event);
+  // In steps, so that the writer commits chunks of each hand at different counts.
+  for (int step = 0; step < 10; ++step) {
+    right_source.release(70);
+    left_source.release(45);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  SessionServoFigures figures, left_figures;
+  figures.ticks = left_figures.ticks = 700;
+  figures.rate_hz = left_figures.rate_hz = 1000.0;
+  left_figures.device_faults = 1;
+  left_figures.force_clamps = 12;
+  ASSERT_TRUE(recorder.finish(1'795'000'001'000, figures, left_figures)) << recorder.error();
+  EXPECT_EQ(recorder.frames_written(), 700);
+  EXPECT_EQ(recorder.left_frames_written(), 450);
+
+  SqliteSessionStore read(file, SqliteSessionStore::Access::read_only);
+  expect_same_frames(read.frames(recorder.session()), right);
+  expect_same_frames(read.frames(recorder.session(), Hand::left), left);
+  EXPECT_EQ(read.events(recorder.session()), events);
+  const SessionSummary summary = read.sessions().at(0);
+  EXPECT_EQ(summary.device, "Scripted");
+  EXPECT_EQ(summary.frame_count, 700);
+  ASSERT_TRUE(summary.left_hand);
+  EXPECT_EQ(summary.left_hand->device, "Scripted: left.txt");
+  EXPECT_EQ(summary.left_hand->mapping.scale, 3.0);
+  EXPECT_EQ(summary.left_hand->mapping.rotation.coeffs(), left_mapping.rotation.coeffs());
+  EXPECT_EQ(summary.left_hand->mapping.offset_m, left_mapping.offset_m);
+  EXPECT_EQ(summary.left_frame_count, 450);
+  EXPECT_EQ(summary.servo, figures);
+  EXPECT_EQ(summary.left_servo, left_figures);
+  // The right hand's tools over the session are its own, not the left hand's forceps.
+  const std::vector<ToolInterval> right_tools = tool_intervals(events, Hand::right);
+  ASSERT_EQ(right_tools.size(), 1u);
+  EXPECT_EQ(right_tools[0].tool, ToolKind::scalpel);
+  const std::vector<ToolInterval> left_tools = tool_intervals(events, Hand::left);
+  ASSERT_EQ(left_tools.size(), 1u);
+  EXPECT_EQ(left_tools[0].tool, ToolKind::forceps);
+
+  // A one-handed session: no left hand to add frames or figures to.
+  const std::int64_t one_hand = store.begin_session(start_of("Trainee B", "{}"));
+  const auto message = [&](auto&& action) {
+    try {
+      action();
+    } catch (const StorageError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message([&] {
+              store.append_frames(one_hand, Hand::left, left);
+            }).find("begun without a left-hand device"),
+            std::string::npos);
+  store.commit();
+  EXPECT_NE(message([&] {
+              store.end_session(one_hand, 1, figures, left_figures);
+            }).find("has no left-hand device"),
+            std::string::npos);
+  EXPECT_TRUE(store.frames(one_hand, Hand::left).empty());
+  EXPECT_FALSE(store.sessions().at(1).left_hand);
+  // A recorder is given left-hand frames exactly when its session has a left hand.
+  EXPECT_THROW(SessionRecorder(store, start_of("Trainee C", "{}"), right_source.source(),
+                               left_source.source(), SessionRecorder::Options{}),
+               std::invalid_argument);
 }
 
 // The simulation's input log goes in chunks, one per commit, and reads back whole and in order,
@@ -496,6 +604,7 @@ TEST(SessionReplay, AStoredLoopStepThatIsNoStepIsRefusedByName) {
     fs::copy_file(
         fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v6-scalpel-cuts-loop-step.sqlite",
         file);
+    { SqliteSessionStore migrated(file); }  // a file of an earlier version: migrated first
     run_sql(file, (std::string("UPDATE session_replays SET loop_step_s = ") + bad).c_str());
     SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
     const std::optional<ReplaySetup> setup = store.replay_setup(1);
@@ -752,9 +861,11 @@ TEST(SessionStore, RefusesFilesItCannotUseWithTheFileAndTheReasonNamed) {
   // Written by a newer LiverSim.
   const fs::path newer = fresh_database("newer");
   { SqliteSessionStore store(newer); }
-  run_sql(newer, "PRAGMA user_version = 7");
+  const std::string newer_version = std::to_string(SqliteSessionStore::kSchemaVersion + 1);
+  run_sql(newer, ("PRAGMA user_version = " + newer_version).c_str());
   message = open_error(newer);
-  EXPECT_NE(message.find("newer LiverSim (schema version 7"), std::string::npos) << message;
+  EXPECT_NE(message.find("newer LiverSim (schema version " + newer_version), std::string::npos)
+      << message;
   EXPECT_EQ(open_problem(newer), StorageProblem::newer_version);
   EXPECT_EQ(open_problem(fresh_database("no-such-folder") / "sessions.sqlite"),
             StorageProblem::unreachable);

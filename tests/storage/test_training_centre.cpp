@@ -148,7 +148,8 @@ TEST(ServerUrl, ReadsBackWhatItWritesAndRefusesPasswordsAndNonsense) {
 TEST_F(TrainingCentre, AFinishedSessionIsUploadedExactlyOnceWithEveryBit) {
   SqliteSessionStore local(fresh_database("upload"));
   const Recorded a = record_session(local, "Trainee A", 1000, 1);
-  const Recorded b = record_session(local, "Trainee B", 333, 2);
+  // With a device in each hand: the left hand's frames, mapping, figures and events go too.
+  const Recorded b = record_session(local, "Trainee B", 333, 2, 222);
   PostgresSessionStore central(workstation(), kWorkstationPassword);
 
   const SyncReport first = synchronise(local, central);
@@ -171,6 +172,15 @@ TEST_F(TrainingCentre, AFinishedSessionIsUploadedExactlyOnceWithEveryBit) {
     ASSERT_TRUE(there[k].mapping);
     EXPECT_EQ(there[k].mapping->scale, 1.25);
     expect_same_frames(central.frames(there[k].id), r.frames);
+    EXPECT_EQ(there[k].left_hand.has_value(), !r.left_frames.empty());
+    EXPECT_EQ(there[k].left_frame_count, static_cast<std::int64_t>(r.left_frames.size()));
+    EXPECT_EQ(there[k].left_servo, r.left_servo);
+    if (there[k].left_hand) {
+      EXPECT_EQ(there[k].left_hand->device, "Scripted left");
+      EXPECT_EQ(there[k].left_hand->mapping.scale, 2.0);
+      EXPECT_EQ(there[k].left_hand->mapping.offset_m, Eigen::Vector3d(-0.05, 0.0, 0.01));
+    }
+    expect_same_frames(central.frames(there[k].id, Hand::left), r.left_frames);
     EXPECT_EQ(central.inputs(there[k].id).size(), r.inputs.size());
     EXPECT_EQ(central.inputs(there[k].id).back().servo_time_s, r.inputs.back().servo_time_s);
     EXPECT_EQ(central.events(there[k].id), r.events);
@@ -203,7 +213,8 @@ TEST_F(TrainingCentre, AFinishedSessionIsUploadedExactlyOnceWithEveryBit) {
   EXPECT_EQ(central.sessions().size(), 2u);
   EXPECT_EQ(count_rows(*server_, "sessions"), 2);
   EXPECT_EQ(count_rows(*server_, "frame_chunks"), chunks);
-  EXPECT_EQ(count_rows(*server_, "events"), 4);
+  EXPECT_EQ(count_rows(*server_, "left_hand_frame_chunks"), 6);  // 222 frames by 40
+  EXPECT_EQ(count_rows(*server_, "events"), 6);
   EXPECT_EQ(count_rows(*server_, "metrics"), 4);
 }
 
@@ -562,7 +573,9 @@ TEST(TrainingCentreSchema, AServerIsMigratedWithNothingLostAndANewerOneIsRefused
       "INSERT INTO scenarios (sha256, title, content) VALUES ('h', 'Old', '{}');"
       "INSERT INTO sessions (uuid, trainee_id, scenario_id, device, started_unix_ms, status, "
       "frame_count) VALUES ('6f1c2f43-5a2b-4d3e-8f00-0123456789ab', 1, 1, 'Omni', 1, "
-      "'complete', 0); INSERT INTO metrics VALUES (1, 'peak_force_n', 2.5); COMMIT;");
+      "'complete', 0); INSERT INTO metrics VALUES (1, 'peak_force_n', 2.5);"
+      "INSERT INTO events (session_id, time_s, kind, detail) VALUES (1, 0.5, 'grasp', '');"
+      "COMMIT;");
   ASSERT_EQ(at_v1, "");
   try {
     PostgresSessionStore central(server.as("ws-01"), kWorkstationPassword);
@@ -579,6 +592,10 @@ TEST(TrainingCentreSchema, AServerIsMigratedWithNothingLostAndANewerOneIsRefused
   EXPECT_EQ(central.sessions()[0].uuid, "6f1c2f43-5a2b-4d3e-8f00-0123456789ab");
   EXPECT_EQ(central.metrics(central.sessions()[0].id),
             (std::vector<MetricValue>{{"peak_force_n", 2.5}}));
+  // Version 4: a session before it had one hand, the right one, and so had its events.
+  EXPECT_FALSE(central.sessions()[0].left_hand);
+  EXPECT_EQ(central.events(central.sessions()[0].id),
+            (std::vector<SessionEvent>{{0.5, SessionEventKind::grasp, "", Hand::right}}));
   EXPECT_TRUE(central.published_scenarios().empty());
 
   ASSERT_EQ(run_sql_as(admin, password, "UPDATE liversim_schema SET version = 99"), "");

@@ -11,6 +11,8 @@
 // copy it over tests/baselines/instructor_report.png.
 #include "liversim/scenario/scenario.h"
 #include "liversim/storage/sqlite_session_store.h"
+#include "recorded_session.h"
+#include "session_replay_window.h"
 #include "session_review_window.h"
 #include "translations.h"
 
@@ -19,6 +21,7 @@
 #include <QByteArray>
 #include <QChart>
 #include <QChartView>
+#include <QDir>
 #include <QFile>
 #include <QImage>
 #include <QTemporaryDir>
@@ -29,7 +32,9 @@
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <vector>
@@ -227,6 +232,72 @@ TEST(InstructorReportBaseline, TheReviewOfASessionMatchesTheBaseline) {
     return;
   }
   fs::remove(output);  // passed: nothing to inspect
+}
+
+// A session of two devices (issue 43): the review plots each hand's force, says which events are
+// the left hand's, and exports the left hand's frames beside the right's; a one-handed session
+// shows and writes only its own.
+TEST(InstructorReview, ATwoHandedSessionShowsAndExportsEachHand) {
+  installTranslations(QStringLiteral("en"));
+  QTemporaryDir folder;
+  ASSERT_TRUE(folder.isValid());
+  const QString database = folder.filePath("sessions.sqlite");
+  testing::Recorded one_hand, two_hands;
+  {
+    SqliteSessionStore store(database.toStdString());
+    one_hand = testing::record_session(store, "Trainee A", 300, 1);
+    two_hands = testing::record_session(store, "Trainee B", 333, 2, 222);
+  }
+  SessionReviewWindow window(database, std::nullopt, std::nullopt);
+  window.setAttribute(Qt::WA_DontShowOnScreen);
+  window.show();
+  ASSERT_TRUE(window.problem().isEmpty()) << window.problem().toStdString();
+  const auto read = [](const QString& file) {
+    std::ifstream in(file.toStdString());
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const auto lines = [](const std::string& text) {
+    return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+  };
+
+  ASSERT_TRUE(window.openSession(two_hands.id));
+  EXPECT_GT(window.forcePointCount(), 0);
+  EXPECT_GT(window.leftForcePointCount(), 0);
+  const QStringList left_events = window.eventLines().filter("(left hand)");
+  ASSERT_EQ(left_events.size(), 2) << window.eventLines().join('\n').toStdString();
+  EXPECT_TRUE(left_events[0].contains("tool_selected (left hand)  forceps"))
+      << left_events[0].toStdString();
+  EXPECT_TRUE(left_events[1].contains("grasp (left hand)")) << left_events[1].toStdString();
+  const QString exported = folder.filePath("two-hands");
+  ASSERT_TRUE(QDir().mkpath(exported));
+  ASSERT_TRUE(window.exportCsv(exported)) << window.problem().toStdString();
+  const QString base = exported + QString("/session-%1-").arg(two_hands.id);
+  EXPECT_EQ(lines(read(base + "frames.csv")), two_hands.frames.size() + 1);
+  EXPECT_EQ(lines(read(base + "left-frames.csv")), two_hands.left_frames.size() + 1);
+  EXPECT_NE(read(base + "events.csv").find(",grasp,,left\n"), std::string::npos);
+  {
+    // The replay window plots each hand's recorded force (its scene is built on a worker, which
+    // its closing waits for).
+    SessionReplayWindow replay(database, two_hands.id);
+    EXPECT_GT(replay.recordedForcePointCount(), 0);
+    EXPECT_GT(replay.recordedLeftForcePointCount(), 0);
+  }
+
+  ASSERT_TRUE(window.openSession(one_hand.id));
+  EXPECT_GT(window.forcePointCount(), 0);
+  EXPECT_EQ(window.leftForcePointCount(), 0);
+  EXPECT_TRUE(window.eventLines().filter("(left hand)").isEmpty());
+  {
+    SessionReplayWindow replay(database, one_hand.id);
+    EXPECT_GT(replay.recordedForcePointCount(), 0);
+    EXPECT_EQ(replay.recordedLeftForcePointCount(), 0);
+  }
+  const QString exported_one = folder.filePath("one-hand");
+  ASSERT_TRUE(QDir().mkpath(exported_one));
+  ASSERT_TRUE(window.exportCsv(exported_one)) << window.problem().toStdString();
+  EXPECT_TRUE(QFile::exists(exported_one + QString("/session-%1-frames.csv").arg(one_hand.id)));
+  EXPECT_FALSE(
+      QFile::exists(exported_one + QString("/session-%1-left-frames.csv").arg(one_hand.id)));
 }
 
 }  // namespace

@@ -88,6 +88,9 @@ constexpr MetricInfo kMetrics[] = {
     {"task_time_s", "s", "time from the first tool contact to the end of the task"},
     {"path_length_mm", "mm", "distance the tool tip travelled"},
     {"movements", "", "separate tool movements (motion between pauses)"},
+    {"economy_of_motion", "",
+     "path of the movements over their straight-line distance (1: straight)"},
+    {"idle_time_s", "s", "time the tool was still for at least the pause time"},
     {"peak_force_n", "N", "largest force on the tissue"},
     {"mean_force_n", "N", "mean force while in contact"},
     {"rms_force_n", "N", "root mean square force while in contact"},
@@ -105,6 +108,19 @@ constexpr MetricInfo kMetrics[] = {
     {"specimen_margin_mm", "mm", "least distance from the specimen's cut faces to the lesion"},
     {"specimen_r0", "",
      "1 when the specimen holds the whole lesion with the task's margin, else 0"},
+    // The left hand's device, in a session with one in each hand (issue 43).
+    {"left_path_length_mm", "mm", "distance the left hand's tool tip travelled"},
+    {"left_movements", "", "separate movements of the left hand's tool"},
+    {"left_economy_of_motion", "", "the left hand's economy of motion"},
+    {"left_idle_time_s", "s", "time the left hand's tool was still for at least the pause time"},
+    {"left_peak_force_n", "N", "largest force of the left hand's tool on the tissue"},
+    {"left_mean_force_n", "N", "mean force of the left hand's tool while in contact"},
+    {"left_rms_force_n", "N", "root mean square force of the left hand's tool while in contact"},
+    {"left_time_above_safe_force_s", "s", "time the left hand's force exceeded the safe threshold"},
+    {"left_force_integral_n_s", "N·s", "the left hand's force integrated over the session"},
+    {"left_peak_force_rate_n_per_s", "N/s", "fastest change of the left hand's force"},
+    {"both_hands_working_fraction", "",
+     "share of the time either hand worked (moved or touched) when both did"},
 };
 
 // ---- Reading: a cursor over one JSON object that knows its path and collects errors.

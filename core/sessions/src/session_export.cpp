@@ -26,9 +26,10 @@ void write_frames_csv(std::span<const ServoFrame> frames, std::ostream& out) {
 }
 
 void write_events_csv(std::span<const SessionEvent> events, std::ostream& out) {
-  out << std::setprecision(17) << "time_s,kind,detail\n";
+  out << std::setprecision(17) << "time_s,kind,detail,hand\n";
   for (const SessionEvent& e : events)
-    out << e.time_s << ',' << session_event_name(e.kind) << ',' << csv_field(e.detail) << '\n';
+    out << e.time_s << ',' << session_event_name(e.kind) << ',' << csv_field(e.detail) << ','
+        << hand_name(e.hand) << '\n';
 }
 
 void write_metrics_csv(std::span<const MetricValue> metrics, const RubricResult& rubric,

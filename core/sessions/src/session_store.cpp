@@ -109,10 +109,10 @@ SessionServoFigures servo_figures(const ServoStats& stats, std::uint64_t dropped
   return f;
 }
 
-std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events) {
+std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events, Hand hand) {
   std::vector<ToolInterval> intervals;
   for (const SessionEvent& event : events) {
-    if (event.kind != SessionEventKind::tool_selected) continue;
+    if (event.kind != SessionEventKind::tool_selected || event.hand != hand) continue;
     // The hand, or a name no tool has: no tool.
     const ToolInterval interval{event.time_s, tool_kind(event.detail)};
     // Two choices at one instant (the servo clock's resolution): the later one holds.
@@ -143,15 +143,29 @@ std::vector<Eigen::Vector3d> lesion_marks(std::span<const SessionEvent> events) 
 }
 
 std::vector<MetricValue> trace_metric_values(const TraceMetrics& m) {
-  return {{"task_time_s", m.task_time_s},
-          {"path_length_mm", m.path_length_mm},
-          {"movements", static_cast<double>(m.movements)},
-          {"peak_force_n", m.peak_force_n},
-          {"mean_force_n", m.mean_force_n},
-          {"rms_force_n", m.rms_force_n},
-          {"time_above_safe_force_s", m.time_above_safe_force_s},
-          {"force_integral_n_s", m.force_integral_n_s},
-          {"peak_force_rate_n_per_s", m.peak_force_rate_n_per_s}};
+  std::vector<MetricValue> values{{"task_time_s", m.task_time_s},
+                                  {"path_length_mm", m.path_length_mm},
+                                  {"movements", static_cast<double>(m.movements)},
+                                  {"idle_time_s", m.idle_time_s},
+                                  {"peak_force_n", m.peak_force_n},
+                                  {"mean_force_n", m.mean_force_n},
+                                  {"rms_force_n", m.rms_force_n},
+                                  {"time_above_safe_force_s", m.time_above_safe_force_s},
+                                  {"force_integral_n_s", m.force_integral_n_s},
+                                  {"peak_force_rate_n_per_s", m.peak_force_rate_n_per_s}};
+  // Measured only when the tool moved.
+  if (m.economy_of_motion) values.push_back({"economy_of_motion", *m.economy_of_motion});
+  return values;
+}
+
+std::vector<MetricValue> left_hand_metric_values(const TraceMetrics& m) {
+  std::vector<MetricValue> values;
+  for (MetricValue& value : trace_metric_values(m)) {
+    if (value.name == "task_time_s") continue;  // the session's, from its first contact
+    value.name = "left_" + value.name;
+    values.push_back(std::move(value));
+  }
+  return values;
 }
 
 std::vector<std::uint8_t> encode_frame_chunk(std::span<const ServoFrame> frames) {

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace liversim {
 namespace {
@@ -118,6 +120,23 @@ TraceMetrics compute_trace_metrics(std::span<const ServoFrame> frames,
   bool moved = false;  // a movement has begun
   double last_motion_end_s = 0.0;
 
+  // Economy of motion: each stroke's path and its start-to-end distance (scene mm). A stroke is a
+  // movement, cut short by a jump (a reposition).
+  struct Stroke {
+    bool active = false;
+    Eigen::Vector3d from_mm = Eigen::Vector3d::Zero();  // its start
+    Eigen::Vector3d to_mm = Eigen::Vector3d::Zero();    // the end of its last moving interval
+    double path_mm = 0.0;        // to the end of its last moving interval (scene)
+    double still_path_mm = 0.0;  // drift since then (scene): its own if it moves on
+  } stroke;
+  double strokes_path_mm = 0.0, strokes_chord_mm = 0.0;
+  const auto close_stroke = [&] {
+    if (!stroke.active) return;
+    strokes_path_mm += stroke.path_mm;
+    strokes_chord_mm += mapping.scale * (stroke.to_mm - stroke.from_mm).norm();
+    stroke.active = false;
+  };
+
   metrics.peak_force_n = tissue_force_n(frames.front());
   if (metrics.peak_force_n > settings.contact_force_n) first_contact_s = first_s;
 
@@ -147,11 +166,11 @@ TraceMetrics compute_trace_metrics(std::span<const ServoFrame> frames,
     }
 
     // A jump (the mouse putting the tool down elsewhere) is no path.
+    const bool jump = (frames[i + 1].sample.buttons & kRepositioned) != 0;
     const double length_mm =
-        (frames[i + 1].sample.buttons & kRepositioned)
-            ? 0.0
-            : mapping.scale *
-                  (frames[i + 1].sample.position_mm - frames[i].sample.position_mm).norm();
+        jump ? 0.0
+             : mapping.scale *
+                   (frames[i + 1].sample.position_mm - frames[i].sample.position_mm).norm();
     metrics.path_length_mm += length_mm;
     advance_tool_to(start_s);
     const std::ptrdiff_t tool_at_start = tool_index;
@@ -168,21 +187,117 @@ TraceMetrics compute_trace_metrics(std::span<const ServoFrame> frames,
     }
 
     if (length_mm / dt_s > settings.moving_speed_mm_per_s) {
-      if (!moved || start_s - last_motion_end_s >= settings.pause_s) {
+      // The still time before it: idle when it lasted at least the pause.
+      const double still_s = start_s - (moved ? last_motion_end_s : first_s);
+      if (still_s >= settings.pause_s) metrics.idle_time_s += still_s;
+      const bool new_movement = !moved || start_s - last_motion_end_s >= settings.pause_s;
+      if (new_movement) {
         ++metrics.movements;
         // A movement counts for the tool in use when it began.
         if (tool_at_start >= 0 && tools[tool_at_start].tool)
           ++metrics.per_tool[*tools[tool_at_start].tool].movements;
       }
+      if (new_movement || !stroke.active) {
+        close_stroke();
+        stroke = {true, frames[i].sample.position_mm, frames[i].sample.position_mm, 0.0, 0.0};
+      }
+      stroke.path_mm += stroke.still_path_mm + length_mm;
+      stroke.still_path_mm = 0.0;
+      stroke.to_mm = frames[i + 1].sample.position_mm;
       moved = true;
       last_motion_end_s = end_s;
+    } else if (jump) {
+      close_stroke();
+    } else if (stroke.active) {
+      stroke.still_path_mm += length_mm;
     }
   }
+  close_stroke();
+  if (strokes_chord_mm > 0.0) metrics.economy_of_motion = strokes_path_mm / strokes_chord_mm;
+  if (const double still_s = last_s - (moved ? last_motion_end_s : first_s);
+      still_s >= settings.pause_s)
+    metrics.idle_time_s += still_s;
   if (first_contact_s) metrics.task_time_s = last_s - *first_contact_s;
   if (contact_s > 0.0) {
     metrics.mean_force_n = contact_force_integral_n_s / contact_s;
     metrics.rms_force_n = std::sqrt(contact_force_squared_integral / contact_s);
   }
+  return metrics;
+}
+
+namespace {
+
+// The spans of a hand's trace when it works: its tip moves, or it touches the tissue (the part of
+// each interval in contact, crossings interpolated). In time order, touching spans merged.
+std::vector<std::pair<double, double>> working_spans(const HandTrace& hand,
+                                                     const TraceMetricSettings& settings) {
+  std::vector<std::pair<double, double>> spans;
+  const auto add = [&](double from_s, double to_s) {
+    if (!(to_s > from_s)) return;
+    if (!spans.empty() && from_s <= spans.back().second)
+      spans.back().second = std::max(spans.back().second, to_s);
+    else
+      spans.emplace_back(from_s, to_s);
+  };
+  const std::span<const ServoFrame> frames = hand.frames;
+  for (std::size_t i = 0; i + 1 < frames.size(); ++i) {
+    const double start_s = frames[i].time_s, end_s = frames[i + 1].time_s;
+    const double dt_s = end_s - start_s;
+    const bool jump = (frames[i + 1].sample.buttons & kRepositioned) != 0;
+    const double length_mm =
+        jump ? 0.0
+             : hand.mapping.scale *
+                   (frames[i + 1].sample.position_mm - frames[i].sample.position_mm).norm();
+    if (length_mm / dt_s > settings.moving_speed_mm_per_s) {
+      add(start_s, end_s);
+      continue;
+    }
+    const double a = frames[i].force_n.norm() / hand.mapping.scale;
+    const double b = frames[i + 1].force_n.norm() / hand.mapping.scale;
+    const PartAbove contact = part_above(a, b, dt_s, settings.contact_force_n);
+    if (contact.duration_s <= 0.0) continue;
+    if (a > settings.contact_force_n)
+      add(start_s, start_s + contact.duration_s);  // in contact from the start
+    else
+      add(end_s - contact.duration_s, end_s);
+  }
+  return spans;
+}
+
+double total_s(const std::vector<std::pair<double, double>>& spans) {
+  double total = 0.0;
+  for (const auto& [from_s, to_s] : spans) total += to_s - from_s;
+  return total;
+}
+
+}  // namespace
+
+BimanualMetrics compute_bimanual_metrics(const HandTrace& right, const HandTrace& left,
+                                         const TraceMetricSettings& settings) {
+  for (const auto& [hand, name] : {std::pair{&right, "right hand"}, {&left, "left hand"}}) {
+    try {
+      check_inputs(hand->frames, {}, hand->mapping, settings);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string(name) + ": " + e.what());
+    }
+  }
+  const auto right_spans = working_spans(right, settings);
+  const auto left_spans = working_spans(left, settings);
+  BimanualMetrics metrics;
+  // The overlap of two ordered lists of disjoint spans.
+  std::size_t r = 0, l = 0;
+  while (r < right_spans.size() && l < left_spans.size()) {
+    const double from_s = std::max(right_spans[r].first, left_spans[l].first);
+    const double to_s = std::min(right_spans[r].second, left_spans[l].second);
+    if (to_s > from_s) metrics.both_working_s += to_s - from_s;
+    if (right_spans[r].second < left_spans[l].second)
+      ++r;
+    else
+      ++l;
+  }
+  metrics.either_working_s = total_s(right_spans) + total_s(left_spans) - metrics.both_working_s;
+  if (metrics.either_working_s > 0.0)
+    metrics.both_working_fraction = metrics.both_working_s / metrics.either_working_s;
   return metrics;
 }
 

@@ -46,7 +46,7 @@ bool ScriptedTools::advance(double elapsed_s, double now_s, Workstation& station
     held_ = changes_[next_++].second;
   if (held_ == before) return false;
   station.device_tool_changed(hand_, now_s);
-  if (hand_ == Hand::right) station.record_tool_choice();
+  station.record_tool_choice(hand_);
   return true;
 }
 

@@ -507,11 +507,14 @@ std::string Workstation::open_omni(const std::string& library) {
   return omni_problem_;
 }
 
+std::string Workstation::right_device_name() const {
+  if (own_device_) return own_device_->name();
+  if (device_ == DeviceChoice::openhaptics && omni_) return omni_->name();
+  return "haptic device";
+}
+
 std::string Workstation::device_name() const {
-  const std::string left = left_device_ ? "; left hand: " + left_device_->name() : "";
-  if (own_device_) return own_device_->name() + left;
-  if (device_ == DeviceChoice::openhaptics && omni_) return omni_->name() + left;
-  return "haptic device" + left;
+  return right_device_name() + (left_device_ ? "; left hand: " + left_device_->name() : "");
 }
 
 void Workstation::clear_left_device() {
@@ -646,6 +649,13 @@ void Workstation::detach_device() {
 
 void Workstation::check_device() {
   if (!servo_) return;
+  // The left hand's device stops its own force only; its fault is recorded once.
+  if (recorder_ && !left_fault_recorded_ && servo_->has_device(Hand::left))
+    if (const std::string left_fault = servo_->device_fault(Hand::left); !left_fault.empty()) {
+      left_fault_recorded_ = true;
+      recorder_->record_event(
+          {servo_->now_s(), SessionEventKind::device_fault, left_fault, Hand::left});
+    }
   const std::string fault = servo_->device_fault();
   if (fault.empty()) return;
   if (recorder_) recorder_->record_event({servo_->now_s(), SessionEventKind::device_fault, fault});
@@ -731,20 +741,29 @@ bool Workstation::begin_recording() {
   // Free practice stores only its element count: a tissue or gravity changed in it cannot be
   // built again.
   if (scenario_ || (setup_.built_in_liver_tets && !free_practice_changed_)) start.replay = replay;
-  start.device = device_name();
+  start.device = right_device_name();
   start.started_unix_ms = unix_ms_now();
   start.mapping = servo_->mapping();
   ServoLoop* servo = servo_.get();
+  const bool two_hands = servo->has_device(Hand::left);
+  if (two_hands) start.left_hand = LeftHandDevice{left_device_name(), servo->mapping(Hand::left)};
   dropped_before_recording_ = skip_earlier_servo_frames(*servo);
+  left_dropped_before_recording_ = two_hands ? skip_earlier_servo_frames(*servo, Hand::left) : 0;
   recording_failure_said_ = false;
+  left_fault_recorded_ = false;
   try {
+    SessionRecorder::FrameSource left;
+    if (two_hands)
+      left = [servo](ServoFrame& frame) { return servo->next_logged_frame(Hand::left, frame); };
     recorder_ = std::make_unique<SessionRecorder>(
-        *sessions_, start, [servo](ServoFrame& frame) { return servo->next_logged_frame(frame); });
+        *sessions_, start,
+        [servo](ServoFrame& frame) { return servo->next_logged_frame(Hand::right, frame); },
+        std::move(left), SessionRecorder::Options{});
   } catch (const StorageError& e) {
     if (listener_.recording_refused) listener_.recording_refused(e);
     return false;
   }
-  record_tool_choice();
+  for (const Hand hand : kHands) record_tool_choice(hand);
   // The session starts from rest, its simulation's input logged, so that it can be replayed.
   restart_from_rest();
   // Damage, lift and resection need the simulation: tracked while the session runs.
@@ -761,19 +780,25 @@ bool Workstation::end_recording() {
   const ServoStats stats = servo_ ? servo_->stats() : ServoStats{};
   const std::uint64_t dropped =
       servo_ ? servo_->dropped_log_frames() - dropped_before_recording_ : 0;
+  std::optional<SessionServoFigures> left_figures;
+  if (servo_ && servo_->has_device(Hand::left))
+    left_figures = servo_figures(servo_->stats(Hand::left), servo_->dropped_log_frames(Hand::left) -
+                                                                left_dropped_before_recording_);
   const std::int64_t session = recorder_->session();
   event_watch_.reset();
   std::optional<OutcomeTracking> outcome = simulation_->outcome();
   simulation_->stop_tracking_outcome();
-  if (!recorder_->finish(unix_ms_now(), servo_figures(stats, dropped))) {
+  if (!recorder_->finish(unix_ms_now(), servo_figures(stats, dropped), left_figures)) {
     const std::string error = recorder_->error();
     recorder_.reset();
     if (listener_.session_not_saved) listener_.session_not_saved(error);
     return false;
   }
   recorder_.reset();
+  std::optional<WorkspaceMapping> left_mapping;
+  if (servo_ && servo_->has_device(Hand::left)) left_mapping = servo_->mapping(Hand::left);
   compute_session_metrics(session, std::move(outcome),
-                          servo_ ? servo_->mapping() : WorkspaceMapping{});
+                          servo_ ? servo_->mapping() : WorkspaceMapping{}, left_mapping);
   return true;
 }
 
@@ -782,12 +807,12 @@ std::optional<std::int64_t> Workstation::recording_session() const {
   return recorder_->session();
 }
 
-void Workstation::record_tool_choice() {
-  if (!recorder_ || !servo_) return;
-  const std::optional<DeviceToolSettings> tool = device_tool();
+void Workstation::record_tool_choice(Hand hand) {
+  if (!recorder_ || !servo_ || !servo_->has_device(hand)) return;
+  const std::optional<DeviceToolSettings> tool = device_tool(hand);
   // The hand holds no tool (tool_intervals reads any other name as none).
   recorder_->record_event({servo_->now_s(), SessionEventKind::tool_selected,
-                           tool ? std::string(tool_name(tool->kind)) : "hand"});
+                           tool ? std::string(tool_name(tool->kind)) : "hand", hand});
 }
 
 std::optional<Eigen::Vector3d> Workstation::mark_lesion_under_tool() {
@@ -809,7 +834,8 @@ int Workstation::take_out_specimens() {
 
 void Workstation::compute_session_metrics(std::int64_t session,
                                           std::optional<OutcomeTracking> outcome,
-                                          const WorkspaceMapping& mapping) {
+                                          const WorkspaceMapping& mapping,
+                                          const std::optional<WorkspaceMapping>& left_mapping) {
   // The metrics of its trace, from what was stored, and of its simulation
   // (docs/session-metrics.md): a long session is hundreds of megabytes of frames, so they are
   // read and computed on a worker with its own connection, off the owner's thread.
@@ -818,13 +844,13 @@ void Workstation::compute_session_metrics(std::int64_t session,
   std::optional<Scenario> scenario;
   if (scenario_) scenario = scenario_->scenario;
   metrics_worker_.start([this, file = sessions_file_, session, outcome = std::move(outcome),
-                         scenario = std::move(scenario), mapping] {
+                         scenario = std::move(scenario), mapping, left_mapping] {
     SessionMetricsOutcome result;
     result.session = session;
     try {
       SqliteSessionStore store{file};
-      result.metrics =
-          store_session_metrics(store, session, outcome, scenario ? &*scenario : nullptr, mapping);
+      result.metrics = store_session_metrics(
+          store, session, outcome, scenario ? &*scenario : nullptr, mapping, left_mapping);
       result.stored = true;
       if (scenario) result.rubric = grade_against_rubric(scenario->rubric, result.metrics);
     } catch (const StorageError& e) {

@@ -242,12 +242,59 @@ constexpr const char* kServerSchemaV3 = R"sql(
 ALTER TABLE session_replays ADD COLUMN loop_step_s double precision;
 )sql";
 
+// Version 4: the left hand (sqlite_session_store.cpp's version 7): its device, mapping, frame count
+// and servo figures in sessions, its frames in chunks of their own, and the hand of each event.
+constexpr const char* kServerSchemaV4 = R"sql(
+ALTER TABLE sessions ADD COLUMN left_device text;
+ALTER TABLE sessions ADD COLUMN left_frame_count bigint NOT NULL DEFAULT 0;
+ALTER TABLE sessions ADD COLUMN left_mapping_scale double precision;
+ALTER TABLE sessions ADD COLUMN left_mapping_rotation_w double precision;
+ALTER TABLE sessions ADD COLUMN left_mapping_rotation_x double precision;
+ALTER TABLE sessions ADD COLUMN left_mapping_rotation_y double precision;
+ALTER TABLE sessions ADD COLUMN left_mapping_rotation_z double precision;
+ALTER TABLE sessions ADD COLUMN left_mapping_offset_x_m double precision;
+ALTER TABLE sessions ADD COLUMN left_mapping_offset_y_m double precision;
+ALTER TABLE sessions ADD COLUMN left_mapping_offset_z_m double precision;
+ALTER TABLE sessions ADD COLUMN left_servo_ticks bigint;
+ALTER TABLE sessions ADD COLUMN left_servo_rate_hz double precision;
+ALTER TABLE sessions ADD COLUMN left_servo_period_p50_ms double precision;
+ALTER TABLE sessions ADD COLUMN left_servo_period_p99_ms double precision;
+ALTER TABLE sessions ADD COLUMN left_servo_period_max_ms double precision;
+ALTER TABLE sessions ADD COLUMN left_missed_deadlines bigint;
+ALTER TABLE sessions ADD COLUMN left_force_clamps bigint;
+ALTER TABLE sessions ADD COLUMN left_stiffness_clamps bigint;
+ALTER TABLE sessions ADD COLUMN left_rate_limited bigint;
+ALTER TABLE sessions ADD COLUMN left_watchdog_trips bigint;
+ALTER TABLE sessions ADD COLUMN left_device_faults bigint;
+ALTER TABLE sessions ADD COLUMN left_dropped_frames bigint;
+CREATE TABLE left_hand_frame_chunks (
+  session_id bigint NOT NULL REFERENCES sessions (id),
+  first_frame bigint NOT NULL,
+  frame_count bigint NOT NULL,
+  first_time_s double precision NOT NULL,
+  last_time_s double precision NOT NULL,
+  layout bigint NOT NULL,
+  data bytea NOT NULL,
+  PRIMARY KEY (session_id, first_frame)
+);
+ALTER TABLE events ADD COLUMN hand text NOT NULL DEFAULT 'right'
+  CHECK (hand IN ('right', 'left'));
+CREATE TRIGGER only_to_ones_own_session BEFORE INSERT ON left_hand_frame_chunks
+  FOR EACH ROW EXECUTE FUNCTION liversim_check_may_add();
+GRANT SELECT ON left_hand_frame_chunks TO liversim_workstation, liversim_instructor;
+GRANT INSERT ON left_hand_frame_chunks TO liversim_workstation;
+GRANT UPDATE (left_frame_count, left_servo_ticks, left_servo_rate_hz, left_servo_period_p50_ms,
+  left_servo_period_p99_ms, left_servo_period_max_ms, left_missed_deadlines, left_force_clamps,
+  left_stiffness_clamps, left_rate_limited, left_watchdog_trips, left_device_faults,
+  left_dropped_frames) ON sessions TO liversim_workstation;
+)sql";
+
 struct Migration {
   std::array<const char*, 2> steps;
 };
-constexpr std::array<Migration, 3> kServerMigrations = {
+constexpr std::array<Migration, 4> kServerMigrations = {
     Migration{{kServerSchemaV1, kServerSchemaV1Parts}}, Migration{{kServerSchemaV2, nullptr}},
-    Migration{{kServerSchemaV3, nullptr}}};
+    Migration{{kServerSchemaV3, nullptr}}, Migration{{kServerSchemaV4, nullptr}}};
 static_assert(kServerMigrations.size() == PostgresSessionStore::kSchemaVersion);
 
 // Type OIDs of the parameters and columns (pg_type.h: server headers, not libpq's).
@@ -668,12 +715,13 @@ void store_replay(Connection& c, std::int64_t session, const ReplaySetup& replay
 
 void store_events(Connection& c, std::int64_t session, std::span<const SessionEvent> events) {
   for (const SessionEvent& event : events)
-    c.run("INSERT INTO events (session_id, time_s, kind, detail) VALUES ($1, $2, $3, $4)",
+    c.run("INSERT INTO events (session_id, time_s, kind, detail, hand) VALUES ($1, $2, $3, $4, $5)",
           Params()
               .add(session)
               .add(event.time_s)
               .add(session_event_name(event.kind))
-              .add(std::string_view(event.detail)),
+              .add(std::string_view(event.detail))
+              .add(hand_name(event.hand)),
           "storing an event");
 }
 
@@ -817,14 +865,24 @@ bool PostgresSessionStore::receive_session(const SessionTransfer& session) {
         .add(session.input_count);
     add_servo(row, s.servo);
     add_mapping(row, s.mapping);
+    std::optional<std::string_view> left_device;
+    std::optional<WorkspaceMapping> left_mapping;
+    if (s.left_hand) {
+      left_device = s.left_hand->device;
+      left_mapping = s.left_hand->mapping;
+    }
+    row.add(left_device).add(s.left_frame_count);
+    add_mapping(row, left_mapping);
+    add_servo(row, s.left_servo);
+    std::string values = "$1::text::uuid";
+    for (int k = 2; k <= 51; ++k) values += ", $" + std::to_string(k);
     const std::string insert =
         std::string(
             "INSERT INTO sessions (uuid, trainee_id, scenario_id, device, "
             "started_unix_ms, ended_unix_ms, status, frame_count, input_count, ") +
-        kServoColumns + ", " + kMappingColumns +
-        ") VALUES ($1::text::uuid, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, "
-        "$15, $16, $17, $18, $19, $20, $21, $22, $23, $24, $25, $26, $27, $28, $29) "
-        "ON CONFLICT (uuid) DO NOTHING RETURNING id";
+        kServoColumns + ", " + kMappingColumns + ", left_device, left_frame_count, " +
+        stored_rows::kLeftMappingColumns + ", " + stored_rows::kLeftServoColumns + ") VALUES (" +
+        values + ") ON CONFLICT (uuid) DO NOTHING RETURNING id";
     Result added = c.run(insert.c_str(), row, "adding the session");
     if (added.rows() == 0) {  // another upload of it committed meanwhile
       c.roll_back();
@@ -860,6 +918,10 @@ bool PostgresSessionStore::receive_session(const SessionTransfer& session) {
         "COPY frame_chunks (session_id, first_frame, frame_count, first_time_s, "
         "last_time_s, layout, data) FROM STDIN (FORMAT binary)",
         "sending the frames", session.frame_chunks, true);
+    copy_chunks(
+        "COPY left_hand_frame_chunks (session_id, first_frame, frame_count, first_time_s, "
+        "last_time_s, layout, data) FROM STDIN (FORMAT binary)",
+        "sending the left hand's frames", session.left_frame_chunks, true);
     copy_chunks(
         "COPY input_chunks (session_id, first_input, input_count, layout, data) "
         "FROM STDIN (FORMAT binary)",
@@ -950,28 +1012,45 @@ std::int64_t PostgresSessionStore::begin_session(const SessionStart& start) {
                              ") VALUES ($1::text::uuid, $2, $3, $4, $5, 'recording', $6, $7, "
                              "$8, $9, $10, $11, $12, $13) RETURNING id";
   const std::int64_t id = c.run(insert.c_str(), row, "adding the session").integer(0, 0);
+  if (const auto& left = start.left_hand) {
+    Params left_row;
+    left_row.add(id).add(std::string_view(left->device));
+    add_mapping(left_row, left->mapping);
+    c.run(("UPDATE sessions SET left_device = $2, (" + stored_rows::kLeftMappingColumns +
+           ") = ($3, $4, $5, $6, $7, $8, $9, $10) WHERE id = $1")
+              .c_str(),
+          left_row, "adding the session's left hand");
+  }
   if (start.replay) store_replay(c, id, *start.replay);
   c.commit();
   return id;
 }
 
-void PostgresSessionStore::append_frames(std::int64_t session, std::span<const ServoFrame> frames) {
+void PostgresSessionStore::append_frames(std::int64_t session, Hand hand,
+                                         std::span<const ServoFrame> frames) {
   if (frames.empty()) return;
   Connection& c = *connection_;
   c.begin_if_needed();
+  const bool left = hand == Hand::left;
+  if (left && c.run("SELECT 1 FROM sessions WHERE id = $1 AND left_device IS NOT NULL",
+                    Params().add(session), "looking up session " + std::to_string(session))
+                      .rows() != 1)
+    throw c.error("session " + std::to_string(session) +
+                  " was begun without a left-hand device: it takes no left-hand frames");
   const std::vector<std::uint8_t> bytes = encode_frame_chunk(frames);
-  c.run(
-      "INSERT INTO frame_chunks (session_id, first_frame, frame_count, first_time_s, "
-      "last_time_s, layout, data) VALUES ($1, $2, $3, $4, $5, $6, $7)",
-      Params()
-          .add(session)
-          .add(claim_items(c, session, "frame_count", frames.size()))
-          .add(static_cast<std::int64_t>(frames.size()))
-          .add(frames.front().time_s)
-          .add(frames.back().time_s)
-          .add(std::int64_t{kFrameChunkLayout})
-          .add(std::span<const std::uint8_t>(bytes)),
-      "storing frames");
+  c.run(left ? "INSERT INTO left_hand_frame_chunks (session_id, first_frame, frame_count, "
+               "first_time_s, last_time_s, layout, data) VALUES ($1, $2, $3, $4, $5, $6, $7)"
+             : "INSERT INTO frame_chunks (session_id, first_frame, frame_count, first_time_s, "
+               "last_time_s, layout, data) VALUES ($1, $2, $3, $4, $5, $6, $7)",
+        Params()
+            .add(session)
+            .add(claim_items(c, session, left ? "left_frame_count" : "frame_count", frames.size()))
+            .add(static_cast<std::int64_t>(frames.size()))
+            .add(frames.front().time_s)
+            .add(frames.back().time_s)
+            .add(std::int64_t{kFrameChunkLayout})
+            .add(std::span<const std::uint8_t>(bytes)),
+        "storing frames");
 }
 
 void PostgresSessionStore::append_events(std::int64_t session,
@@ -1004,9 +1083,28 @@ void PostgresSessionStore::commit() {
 }
 
 void PostgresSessionStore::end_session(std::int64_t session, std::int64_t ended_unix_ms,
-                                       const SessionServoFigures& servo) {
+                                       const SessionServoFigures& servo,
+                                       const std::optional<SessionServoFigures>& left_servo) {
   Connection& c = *connection_;
   c.begin_if_needed();
+  // The left hand's figures first: once complete, the row is no longer the workstation's to
+  // update (the policy only_while_recording).
+  if (left_servo) {
+    Params left_row;
+    left_row.add(session);
+    add_servo(left_row, left_servo);
+    std::string values = "$2";
+    for (int k = 3; k <= 13; ++k) values += ", $" + std::to_string(k);
+    Result left = c.run(("UPDATE sessions SET (" + stored_rows::kLeftServoColumns + ") = (" +
+                         values + ") WHERE id = $1 AND left_device IS NOT NULL RETURNING id")
+                            .c_str(),
+                        left_row, "ending the session's left hand");
+    if (left.rows() != 1) {
+      c.roll_back();
+      throw c.error("session " + std::to_string(session) +
+                    " has no left-hand device that this login records");
+    }
+  }
   Params row;
   row.add(session).add(ended_unix_ms);
   add_servo(row, servo);
@@ -1182,22 +1280,28 @@ std::vector<Item> joined_chunks(Connection& c, const char* sql, std::int64_t ses
 
 }  // namespace
 
-std::vector<ServoFrame> PostgresSessionStore::frames(std::int64_t session,
+std::vector<ServoFrame> PostgresSessionStore::frames(std::int64_t session, Hand hand,
                                                      const ReadingProgress& progress) {
+  const bool left = hand == Hand::left;
   std::size_t total = 0;
   if (progress)
     total = static_cast<std::size_t>(
         connection_
-            ->run("SELECT COALESCE(SUM(frame_count), 0)::bigint FROM frame_chunks "
-                  "WHERE session_id = $1",
+            ->run(left ? "SELECT COALESCE(SUM(frame_count), 0)::bigint FROM "
+                         "left_hand_frame_chunks WHERE session_id = $1"
+                       : "SELECT COALESCE(SUM(frame_count), 0)::bigint FROM frame_chunks "
+                         "WHERE session_id = $1",
                   Params().add(session), "counting frames")
             .integer(0, 0));
   return joined_chunks<ServoFrame>(*connection_,
-                                   "SELECT first_frame, layout, data FROM frame_chunks "
-                                   "WHERE session_id = $1 AND first_frame >= $2 "
-                                   "ORDER BY first_frame LIMIT 200",
-                                   session, "frames", kFrameChunkLayout, decode_frame_chunk,
-                                   progress, total);
+                                   left ? "SELECT first_frame, layout, data FROM "
+                                          "left_hand_frame_chunks WHERE session_id = $1 AND "
+                                          "first_frame >= $2 ORDER BY first_frame LIMIT 200"
+                                        : "SELECT first_frame, layout, data FROM frame_chunks "
+                                          "WHERE session_id = $1 AND first_frame >= $2 "
+                                          "ORDER BY first_frame LIMIT 200",
+                                   session, left ? "left-hand frames" : "frames", kFrameChunkLayout,
+                                   decode_frame_chunk, progress, total);
 }
 
 std::vector<SimulationInput> PostgresSessionStore::inputs(std::int64_t session) {
@@ -1210,7 +1314,7 @@ std::vector<SimulationInput> PostgresSessionStore::inputs(std::int64_t session) 
 
 std::vector<SessionEvent> PostgresSessionStore::events(std::int64_t session) {
   Result rows = connection_->run(
-      "SELECT time_s, kind, detail FROM events WHERE session_id = $1 ORDER BY time_s, id",
+      "SELECT time_s, kind, detail, hand FROM events WHERE session_id = $1 ORDER BY time_s, id",
       Params().add(session), "reading events");
   std::vector<SessionEvent> result;
   for (int r = 0; r < rows.rows(); ++r) {
@@ -1219,7 +1323,12 @@ std::vector<SessionEvent> PostgresSessionStore::events(std::int64_t session) {
     if (!known)
       throw connection_->error("session " + std::to_string(session) +
                                " has an event of unknown kind \"" + kind + "\"");
-    result.push_back({rows.real(r, 0), *known, rows.text(r, 2)});
+    const std::string hand = rows.text(r, 3);
+    const std::optional<Hand> of = hand_named(hand);
+    if (!of)
+      throw connection_->error("session " + std::to_string(session) +
+                               " has an event of an unknown hand \"" + hand + "\"");
+    result.push_back({rows.real(r, 0), *known, rows.text(r, 2), *of});
   }
   return result;
 }

@@ -171,8 +171,48 @@ constexpr const char* kSchemaV5 =
 // count of them); NULL for the sessions before, which replay with the model's stable step.
 constexpr const char* kSchemaV6 = "ALTER TABLE session_replays ADD COLUMN loop_step_s REAL;";
 
-constexpr std::array<const char*, 6> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3,
-                                                    kSchemaV4, kSchemaV5, kSchemaV6};
+// Version 7: the left hand (issue 43). A session of two devices keeps the left one's name,
+// mapping, frame count and servo figures beside the right one's, and its frames in chunks of
+// their own; each event names the hand it is of (those before are the right hand's, the only one
+// then).
+constexpr const char* kSchemaV7 = R"sql(
+ALTER TABLE sessions ADD COLUMN left_device TEXT;
+ALTER TABLE sessions ADD COLUMN left_frame_count INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE sessions ADD COLUMN left_mapping_scale REAL;
+ALTER TABLE sessions ADD COLUMN left_mapping_rotation_w REAL;
+ALTER TABLE sessions ADD COLUMN left_mapping_rotation_x REAL;
+ALTER TABLE sessions ADD COLUMN left_mapping_rotation_y REAL;
+ALTER TABLE sessions ADD COLUMN left_mapping_rotation_z REAL;
+ALTER TABLE sessions ADD COLUMN left_mapping_offset_x_m REAL;
+ALTER TABLE sessions ADD COLUMN left_mapping_offset_y_m REAL;
+ALTER TABLE sessions ADD COLUMN left_mapping_offset_z_m REAL;
+ALTER TABLE sessions ADD COLUMN left_servo_ticks INTEGER;
+ALTER TABLE sessions ADD COLUMN left_servo_rate_hz REAL;
+ALTER TABLE sessions ADD COLUMN left_servo_period_p50_ms REAL;
+ALTER TABLE sessions ADD COLUMN left_servo_period_p99_ms REAL;
+ALTER TABLE sessions ADD COLUMN left_servo_period_max_ms REAL;
+ALTER TABLE sessions ADD COLUMN left_missed_deadlines INTEGER;
+ALTER TABLE sessions ADD COLUMN left_force_clamps INTEGER;
+ALTER TABLE sessions ADD COLUMN left_stiffness_clamps INTEGER;
+ALTER TABLE sessions ADD COLUMN left_rate_limited INTEGER;
+ALTER TABLE sessions ADD COLUMN left_watchdog_trips INTEGER;
+ALTER TABLE sessions ADD COLUMN left_device_faults INTEGER;
+ALTER TABLE sessions ADD COLUMN left_dropped_frames INTEGER;
+CREATE TABLE left_hand_frame_chunks (
+  session_id INTEGER NOT NULL REFERENCES sessions (id),
+  first_frame INTEGER NOT NULL,
+  frame_count INTEGER NOT NULL,
+  first_time_s REAL NOT NULL,
+  last_time_s REAL NOT NULL,
+  layout INTEGER NOT NULL,
+  data BLOB NOT NULL,
+  PRIMARY KEY (session_id, first_frame)
+) WITHOUT ROWID;
+ALTER TABLE events ADD COLUMN hand TEXT NOT NULL DEFAULT 'right' CHECK (hand IN ('right', 'left'));
+)sql";
+
+constexpr std::array<const char*, 7> kMigrations = {kSchemaV1, kSchemaV2, kSchemaV3, kSchemaV4,
+                                                    kSchemaV5, kSchemaV6, kSchemaV7};
 static_assert(kMigrations.size() == SqliteSessionStore::kSchemaVersion);
 
 enum StatementId {
@@ -184,6 +224,12 @@ enum StatementId {
   kFrameCount,
   kAddChunk,
   kCountFrames,
+  kHasLeftHand,
+  kLeftFrameCount,
+  kAddLeftChunk,
+  kCountLeftFrames,
+  kLeftChunks,
+  kLeftChunkFrameSum,
   kAddEvent,
   kEndSession,
   kSessions,
@@ -583,6 +629,18 @@ std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
   }
   add.run("adding the session");
   const std::int64_t session = sqlite3_last_insert_rowid(db_);
+  if (const auto& left = start.left_hand) {
+    const WorkspaceMapping& m = left->mapping;
+    Statement add_left(
+        *this, ("UPDATE sessions SET left_device = ?2, (" + stored_rows::kLeftMappingColumns +
+                ") = (?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10) WHERE id = ?1")
+                   .c_str());
+    add_left.bind(1, session).bind(2, std::string_view(left->device));
+    const double values[] = {m.scale,        m.rotation.w(), m.rotation.x(), m.rotation.y(),
+                             m.rotation.z(), m.offset_m.x(), m.offset_m.y(), m.offset_m.z()};
+    for (int k = 0; k < 8; ++k) add_left.bind(3 + k, values[k]);
+    add_left.run("adding the session's left hand");
+  }
   if (const auto& replay = start.replay) {
     Statement& add_replay =
         prepared(kAddReplay,
@@ -611,17 +669,31 @@ std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
   return session;
 }
 
-void SqliteSessionStore::append_frames(std::int64_t session, std::span<const ServoFrame> frames) {
+void SqliteSessionStore::append_frames(std::int64_t session, Hand hand,
+                                       std::span<const ServoFrame> frames) {
   if (frames.empty()) return;
   begin_if_needed();
+  const bool left = hand == Hand::left;
+  const std::string looking = "looking up session " + std::to_string(session);
+  if (left && prepared(kHasLeftHand, "SELECT left_device IS NOT NULL FROM sessions WHERE id = ?1")
+                      .bind(1, session)
+                      .single_integer(looking.c_str()) == 0)
+    throw error("session " + std::to_string(session) +
+                " was begun without a left-hand device: it takes no left-hand frames");
   const std::int64_t first =
-      prepared(kFrameCount, "SELECT frame_count FROM sessions WHERE id = ?1")
-          .bind(1, session)
-          .single_integer(("looking up session " + std::to_string(session)).c_str());
+      left ? prepared(kLeftFrameCount, "SELECT left_frame_count FROM sessions WHERE id = ?1")
+                 .bind(1, session)
+                 .single_integer(looking.c_str())
+           : prepared(kFrameCount, "SELECT frame_count FROM sessions WHERE id = ?1")
+                 .bind(1, session)
+                 .single_integer(looking.c_str());
   const std::vector<std::uint8_t> bytes = encode_frame_chunk(frames);
-  prepared(kAddChunk,
-           "INSERT INTO frame_chunks (session_id, first_frame, frame_count, first_time_s, "
-           "last_time_s, layout, data) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)")
+  (left ? prepared(kAddLeftChunk,
+                   "INSERT INTO left_hand_frame_chunks (session_id, first_frame, frame_count, "
+                   "first_time_s, last_time_s, layout, data) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)")
+        : prepared(kAddChunk,
+                   "INSERT INTO frame_chunks (session_id, first_frame, frame_count, first_time_s, "
+                   "last_time_s, layout, data) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)"))
       .bind(1, session)
       .bind(2, first)
       .bind(3, static_cast<std::int64_t>(frames.size()))
@@ -630,7 +702,10 @@ void SqliteSessionStore::append_frames(std::int64_t session, std::span<const Ser
       .bind(6, std::int64_t{kFrameChunkLayout})
       .bind(7, std::span<const std::uint8_t>(bytes))
       .run("storing frames");
-  prepared(kCountFrames, "UPDATE sessions SET frame_count = frame_count + ?2 WHERE id = ?1")
+  (left
+       ? prepared(kCountLeftFrames,
+                  "UPDATE sessions SET left_frame_count = left_frame_count + ?2 WHERE id = ?1")
+       : prepared(kCountFrames, "UPDATE sessions SET frame_count = frame_count + ?2 WHERE id = ?1"))
       .bind(1, session)
       .bind(2, static_cast<std::int64_t>(frames.size()))
       .run("counting frames");
@@ -640,12 +715,14 @@ void SqliteSessionStore::append_events(std::int64_t session, std::span<const Ses
   if (events.empty()) return;
   begin_if_needed();
   Statement& add = prepared(
-      kAddEvent, "INSERT INTO events (session_id, time_s, kind, detail) VALUES (?1, ?2, ?3, ?4)");
+      kAddEvent,
+      "INSERT INTO events (session_id, time_s, kind, detail, hand) VALUES (?1, ?2, ?3, ?4, ?5)");
   for (const SessionEvent& event : events)
     add.bind(1, session)
         .bind(2, event.time_s)
         .bind(3, session_event_name(event.kind))
         .bind(4, std::string_view(event.detail))
+        .bind(5, hand_name(event.hand))
         .run("storing an event");
 }
 
@@ -711,31 +788,51 @@ std::vector<SimulationInput> SqliteSessionStore::inputs(std::int64_t session) {
 }
 
 void SqliteSessionStore::end_session(std::int64_t session, std::int64_t ended_unix_ms,
-                                     const SessionServoFigures& servo) {
+                                     const SessionServoFigures& servo,
+                                     const std::optional<SessionServoFigures>& left_servo) {
+  // Checked before anything is written: a refusal leaves the session as it was.
+  if (left_servo &&
+      prepared(kHasLeftHand, "SELECT left_device IS NOT NULL FROM sessions WHERE id = ?1")
+              .bind(1, session)
+              .single_integer(("looking up session " + std::to_string(session)).c_str()) == 0)
+    throw error("session " + std::to_string(session) + " has no left-hand device");
   begin_if_needed();
-  auto count = [](std::uint64_t value) { return static_cast<std::int64_t>(value); };
-  prepared(kEndSession,
-           "UPDATE sessions SET status = 'complete', ended_unix_ms = ?2, servo_ticks = ?3, "
-           "servo_rate_hz = ?4, servo_period_p50_ms = ?5, servo_period_p99_ms = ?6, "
-           "servo_period_max_ms = ?7, missed_deadlines = ?8, force_clamps = ?9, "
-           "stiffness_clamps = ?10, rate_limited = ?11, watchdog_trips = ?12, "
-           "device_faults = ?13, dropped_frames = ?14 WHERE id = ?1")
-      .bind(1, session)
-      .bind(2, ended_unix_ms)
-      .bind(3, count(servo.ticks))
-      .bind(4, servo.rate_hz)
-      .bind(5, servo.period_p50_ms)
-      .bind(6, servo.period_p99_ms)
-      .bind(7, servo.period_max_ms)
-      .bind(8, count(servo.missed_deadlines))
-      .bind(9, count(servo.force_clamps))
-      .bind(10, count(servo.stiffness_clamps))
-      .bind(11, count(servo.rate_limited))
-      .bind(12, count(servo.watchdog_trips))
-      .bind(13, count(servo.device_faults))
-      .bind(14, count(servo.dropped_frames))
-      .run("ending the session");
+  // The twelve figures, kServoColumns' order, from parameter `first` on.
+  const auto bind_figures = [](Statement& statement, int first, const SessionServoFigures& f) {
+    const auto count = [](std::uint64_t value) { return static_cast<std::int64_t>(value); };
+    statement.bind(first, count(f.ticks))
+        .bind(first + 1, f.rate_hz)
+        .bind(first + 2, f.period_p50_ms)
+        .bind(first + 3, f.period_p99_ms)
+        .bind(first + 4, f.period_max_ms)
+        .bind(first + 5, count(f.missed_deadlines))
+        .bind(first + 6, count(f.force_clamps))
+        .bind(first + 7, count(f.stiffness_clamps))
+        .bind(first + 8, count(f.rate_limited))
+        .bind(first + 9, count(f.watchdog_trips))
+        .bind(first + 10, count(f.device_faults))
+        .bind(first + 11, count(f.dropped_frames));
+  };
+  Statement& end =
+      prepared(kEndSession,
+               "UPDATE sessions SET status = 'complete', ended_unix_ms = ?2, servo_ticks = ?3, "
+               "servo_rate_hz = ?4, servo_period_p50_ms = ?5, servo_period_p99_ms = ?6, "
+               "servo_period_max_ms = ?7, missed_deadlines = ?8, force_clamps = ?9, "
+               "stiffness_clamps = ?10, rate_limited = ?11, watchdog_trips = ?12, "
+               "device_faults = ?13, dropped_frames = ?14 WHERE id = ?1");
+  end.bind(1, session).bind(2, ended_unix_ms);
+  bind_figures(end, 3, servo);
+  end.run("ending the session");
   if (sqlite3_changes(db_) != 1) throw error("there is no session " + std::to_string(session));
+  if (left_servo) {
+    Statement end_left(*this, ("UPDATE sessions SET (" + stored_rows::kLeftServoColumns +
+                               ") = (?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13) "
+                               "WHERE id = ?1")
+                                  .c_str());
+    end_left.bind(1, session);
+    bind_figures(end_left, 2, *left_servo);
+    end_left.run("ending the session's left hand");
+  }
   commit();
   if (sessions_recording_ > 0 && --sessions_recording_ == 0) release_recording_lock();
 }
@@ -918,26 +1015,36 @@ std::vector<Item> SqliteSessionStore::chunks_of(std::int64_t session, Statement&
   return result;
 }
 
-std::vector<ServoFrame> SqliteSessionStore::frames(std::int64_t session,
+std::vector<ServoFrame> SqliteSessionStore::frames(std::int64_t session, Hand hand,
                                                    const ReadingProgress& progress) {
+  const bool left = hand == Hand::left;
   std::size_t total = 0;
   if (progress) {
     total = static_cast<std::size_t>(
-        prepared(kChunkFrameSum,
-                 "SELECT COALESCE(SUM(frame_count), 0) FROM frame_chunks WHERE session_id = ?1")
+        (left ? prepared(kLeftChunkFrameSum,
+                         "SELECT COALESCE(SUM(frame_count), 0) FROM left_hand_frame_chunks "
+                         "WHERE session_id = ?1")
+              : prepared(kChunkFrameSum,
+                         "SELECT COALESCE(SUM(frame_count), 0) FROM frame_chunks "
+                         "WHERE session_id = ?1"))
             .bind(1, session)
             .single_integer("counting frames"));
   }
-  return chunks_of<ServoFrame>(session,
-                               prepared(kChunks,
-                                        "SELECT first_frame, layout, data FROM frame_chunks "
-                                        "WHERE session_id = ?1 ORDER BY first_frame"),
-                               "frames", kFrameChunkLayout, decode_frame_chunk, progress, total);
+  return chunks_of<ServoFrame>(
+      session,
+      left ? prepared(kLeftChunks,
+                      "SELECT first_frame, layout, data FROM left_hand_frame_chunks "
+                      "WHERE session_id = ?1 ORDER BY first_frame")
+           : prepared(kChunks,
+                      "SELECT first_frame, layout, data FROM frame_chunks "
+                      "WHERE session_id = ?1 ORDER BY first_frame"),
+      left ? "left-hand frames" : "frames", kFrameChunkLayout, decode_frame_chunk, progress, total);
 }
 
 std::vector<SessionEvent> SqliteSessionStore::events(std::int64_t session) {
   Statement& rows = prepared(
-      kEvents, "SELECT time_s, kind, detail FROM events WHERE session_id = ?1 ORDER BY time_s, id");
+      kEvents,
+      "SELECT time_s, kind, detail, hand FROM events WHERE session_id = ?1 ORDER BY time_s, id");
   rows.bind(1, session);
   std::vector<SessionEvent> result;
   while (rows.step("reading events")) {
@@ -948,7 +1055,14 @@ std::vector<SessionEvent> SqliteSessionStore::events(std::int64_t session) {
       throw error("session " + std::to_string(session) + " has an event of unknown kind \"" + kind +
                   "\"");
     }
-    result.push_back({rows.real(0), *known, rows.text(2)});
+    const std::string hand = rows.text(3);
+    const std::optional<Hand> of = hand_named(hand);
+    if (!of) {
+      rows.reset();
+      throw error("session " + std::to_string(session) + " has an event of an unknown hand \"" +
+                  hand + "\"");
+    }
+    result.push_back({rows.real(0), *known, rows.text(2), *of});
   }
   rows.reset();
   return result;
@@ -1026,6 +1140,10 @@ SessionTransfer SqliteSessionStore::transfer_of(std::int64_t session) {
   transfer.frame_chunks = chunks(
       "SELECT first_frame, frame_count, layout, data, first_time_s, last_time_s FROM "
       "frame_chunks WHERE session_id = ?1 ORDER BY first_frame",
+      true);
+  transfer.left_frame_chunks = chunks(
+      "SELECT first_frame, frame_count, layout, data, first_time_s, last_time_s FROM "
+      "left_hand_frame_chunks WHERE session_id = ?1 ORDER BY first_frame",
       true);
   transfer.input_chunks = chunks(
       "SELECT first_input, input_count, layout, data FROM input_chunks WHERE session_id = ?1 "

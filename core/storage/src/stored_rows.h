@@ -10,6 +10,7 @@
 #include <iterator>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace liversim::stored_rows {
@@ -29,6 +30,22 @@ inline constexpr const char* kMappingColumns =
     "mapping_scale, mapping_rotation_w, mapping_rotation_x, mapping_rotation_y, "
     "mapping_rotation_z, mapping_offset_x_m, mapping_offset_y_m, mapping_offset_z_m";
 
+// A comma-separated column list with each name prefixed (the left hand's columns are the right
+// hand's with "left_" before them).
+inline std::string prefixed_columns(std::string_view columns, std::string_view prefix) {
+  std::string result(prefix);
+  for (const char c : columns) {
+    result += c;
+    if (c == ' ') result += prefix;
+  }
+  return result;
+}
+
+// The left hand's device (schema 7 on, PostgreSQL 4 on): its name (null: a one-handed session),
+// frame count, mapping and servo figures, in sessions.
+inline const std::string kLeftMappingColumns = prefixed_columns(kMappingColumns, "left_");
+inline const std::string kLeftServoColumns = prefixed_columns(kServoColumns, "left_");
+
 // The sessions with what a SessionSummary holds, read by session_summary(); the caller adds its
 // WHERE (parameter 1: a trainee's name or null for all) and ORDER BY.
 inline const std::string kSessionSummarySelect =
@@ -38,8 +55,43 @@ inline const std::string kSessionSummarySelect =
     "s.stiffness_clamps, s.rate_limited, s.watchdog_trips, s.device_faults, s.dropped_frames, "
     "s.mapping_scale, s.mapping_rotation_w, s.mapping_rotation_x, s.mapping_rotation_y, "
     "s.mapping_rotation_z, s.mapping_offset_x_m, s.mapping_offset_y_m, s.mapping_offset_z_m, "
-    "CAST(s.uuid AS TEXT) FROM sessions s JOIN people p ON p.id = s.trainee_id "
+    "CAST(s.uuid AS TEXT), s.left_device, s.left_frame_count, " +
+    prefixed_columns(kLeftMappingColumns, "s.") + ", " + prefixed_columns(kLeftServoColumns, "s.") +
+    " FROM sessions s JOIN people p ON p.id = s.trainee_id "
     "JOIN scenarios c ON c.id = s.scenario_id ";
+
+// Servo figures from the 12 columns from `first` on (kServoColumns' order).
+template <typename Row>
+SessionServoFigures servo_figures_of(const Row& row, int first) {
+  const auto count = [&](int column) {
+    return static_cast<std::uint64_t>(row.integer(first + column));
+  };
+  SessionServoFigures f;
+  f.ticks = count(0);
+  f.rate_hz = row.real(first + 1);
+  f.period_p50_ms = row.real(first + 2);
+  f.period_p99_ms = row.real(first + 3);
+  f.period_max_ms = row.real(first + 4);
+  f.missed_deadlines = count(5);
+  f.force_clamps = count(6);
+  f.stiffness_clamps = count(7);
+  f.rate_limited = count(8);
+  f.watchdog_trips = count(9);
+  f.device_faults = count(10);
+  f.dropped_frames = count(11);
+  return f;
+}
+
+// A mapping from the 8 columns from `first` on (kMappingColumns' order).
+template <typename Row>
+WorkspaceMapping mapping_of(const Row& row, int first) {
+  WorkspaceMapping m;
+  m.scale = row.real(first);
+  m.rotation = Eigen::Quaterniond(row.real(first + 1), row.real(first + 2), row.real(first + 3),
+                                  row.real(first + 4));
+  m.offset_m = Eigen::Vector3d(row.real(first + 5), row.real(first + 6), row.real(first + 7));
+  return m;
+}
 
 template <typename Row>
 SessionSummary session_summary(const Row& row) {
@@ -56,31 +108,14 @@ SessionSummary session_summary(const Row& row) {
              : status == "recording" ? SessionStatus::recording
                                      : SessionStatus::incomplete;
   s.frame_count = row.integer(8);
-  if (!row.is_null(9)) {
-    const auto count = [&](int column) { return static_cast<std::uint64_t>(row.integer(column)); };
-    SessionServoFigures f;
-    f.ticks = count(9);
-    f.rate_hz = row.real(10);
-    f.period_p50_ms = row.real(11);
-    f.period_p99_ms = row.real(12);
-    f.period_max_ms = row.real(13);
-    f.missed_deadlines = count(14);
-    f.force_clamps = count(15);
-    f.stiffness_clamps = count(16);
-    f.rate_limited = count(17);
-    f.watchdog_trips = count(18);
-    f.device_faults = count(19);
-    f.dropped_frames = count(20);
-    s.servo = f;
-  }
-  if (!row.is_null(21)) {
-    WorkspaceMapping m;
-    m.scale = row.real(21);
-    m.rotation = Eigen::Quaterniond(row.real(22), row.real(23), row.real(24), row.real(25));
-    m.offset_m = Eigen::Vector3d(row.real(26), row.real(27), row.real(28));
-    s.mapping = m;
-  }
+  if (!row.is_null(9)) s.servo = servo_figures_of(row, 9);
+  if (!row.is_null(21)) s.mapping = mapping_of(row, 21);
   if (!row.is_null(29)) s.uuid = row.text(29);
+  if (!row.is_null(30)) {
+    s.left_hand = LeftHandDevice{row.text(30), mapping_of(row, 32)};
+    s.left_frame_count = row.integer(31);
+    if (!row.is_null(40)) s.left_servo = servo_figures_of(row, 40);
+  }
   return s;
 }
 

@@ -27,10 +27,15 @@ class SessionRecorder {
   using FrameSource = std::function<bool(ServoFrame&)>;
 
   // Begins the session in `store` (throws StorageError if it cannot) and starts the writer.
+  // `next_left_frame`: the left hand's device's frames, for a session begun with a left hand
+  // (SessionStart::left_hand); empty otherwise.
   SessionRecorder(SessionStore& store, const SessionStart& start, FrameSource next_frame,
-                  Options options);
+                  FrameSource next_left_frame, Options options);
+  SessionRecorder(SessionStore& store, const SessionStart& start, FrameSource next_frame,
+                  Options options)
+      : SessionRecorder(store, start, std::move(next_frame), {}, options) {}
   SessionRecorder(SessionStore& store, const SessionStart& start, FrameSource next_frame)
-      : SessionRecorder(store, start, std::move(next_frame), Options{}) {}
+      : SessionRecorder(store, start, std::move(next_frame), {}, Options{}) {}
   ~SessionRecorder();  // as finish() without figures: the session stays incomplete
   SessionRecorder(const SessionRecorder&) = delete;
   SessionRecorder& operator=(const SessionRecorder&) = delete;
@@ -43,15 +48,18 @@ class SessionRecorder {
   // a ReplaySetup; stored with the next commit.
   void record_inputs(std::vector<SimulationInput> inputs);
 
-  // Writes what is waiting, ends the session as complete with these figures and stops the
-  // writer. Returns false (see error()) if storage failed at any point.
-  bool finish(std::int64_t ended_unix_ms, const SessionServoFigures& servo);
+  // Writes what is waiting, ends the session as complete with these figures (`left_servo`: the
+  // left hand's device's, in a two-handed session) and stops the writer. Returns false (see
+  // error()) if storage failed at any point.
+  bool finish(std::int64_t ended_unix_ms, const SessionServoFigures& servo,
+              const std::optional<SessionServoFigures>& left_servo = std::nullopt);
 
   // Empty while storage works; else what failed, naming the database.
   std::string error() const;
   // The storage failure that stopped the writer, with its kind; none while it writes.
   std::optional<StorageError> failure() const;
   std::int64_t frames_written() const { return frames_written_.load(); }
+  std::int64_t left_frames_written() const { return left_frames_written_.load(); }
 
  private:
   void run();
@@ -61,9 +69,11 @@ class SessionRecorder {
 
   SessionStore& store_;
   FrameSource next_frame_;
+  FrameSource next_left_frame_;
   Options options_;
   std::int64_t session_ = 0;
   std::vector<ServoFrame> frame_batch_;
+  std::vector<ServoFrame> left_frame_batch_;
   std::vector<SessionEvent> event_batch_;
   std::vector<SimulationInput> input_batch_;
 
@@ -74,6 +84,7 @@ class SessionRecorder {
   std::optional<StorageError> failure_;
   bool stop_ = false;
   std::atomic<std::int64_t> frames_written_{0};
+  std::atomic<std::int64_t> left_frames_written_{0};
   std::thread writer_;
 };
 

@@ -25,10 +25,10 @@ namespace liversim {
 // names the scene it ran.
 std::string free_practice_text(std::size_t tet_count);
 
-// A session's frames are those the servo logs from now on: drops the frames it queued before
-// (since it started; the mouse's until its first press). Returns how many frames its log has
-// dropped so far: the session's dropped-frame figure counts from there.
-std::uint64_t skip_earlier_servo_frames(ServoLoop& servo);
+// A session's frames are those the servo logs from now on: drops the frames the device in `hand`
+// queued before (since it started; the mouse's until its first press). Returns how many frames its
+// log has dropped so far: the session's dropped-frame figure counts from there.
+std::uint64_t skip_earlier_servo_frames(ServoLoop& servo, Hand hand = Hand::right);
 
 // From the simulation's next cycle on, tracks what the session does to the tissue (damage, the
 // retracted lobe's lift, resection) with the scenario's thresholds; none: free practice's
@@ -37,7 +37,9 @@ void track_session_outcome(RealtimeSimulation& simulation, const Scenario* scena
 
 // The events a session's display frames show: SessionEventDetector's at the task's safe force
 // (free practice: the default), and each of the scenario's lesions that the cut surface meets,
-// once.
+// once. A grasp, a release or an excessive force is of the hand whose tool it was; a cut, of the
+// hand whose blade was cutting (the right one's when both were); the rest, of the scene (filed
+// under the right hand).
 class SessionEventWatch {
  public:
   explicit SessionEventWatch(const Scenario* scenario);
@@ -48,6 +50,7 @@ class SessionEventWatch {
 
  private:
   SessionEventDetector detector_;
+  SessionEventDetector left_detector_;  // the left hand's grasps and forces only
   std::vector<LesionSpec> lesions_;
   std::set<std::string> breached_;  // lesions a cut has met, reported once each
 };
@@ -55,11 +58,12 @@ class SessionEventWatch {
 // The metrics of a session that has ended: of its trace, from the frames and tool choices the
 // store holds (a long session's hundreds of megabytes are read here, so a UI calls this off its
 // thread), and of its simulation's outcome when it was tracked; stored with the session and
-// returned. `scenario`: the one it ran (none: free practice); `mapping`: its device → scene.
-// Throws StorageError.
-std::vector<MetricValue> store_session_metrics(SessionStore& store, std::int64_t session,
-                                               const std::optional<OutcomeTracking>& outcome,
-                                               const Scenario* scenario,
-                                               const WorkspaceMapping& mapping);
+// returned. `scenario`: the one it ran (none: free practice); `mapping`: its device → scene;
+// `left_mapping`: the left hand's device's, in a session with one in each hand (its figures are
+// then the left_ metrics, and both_hands_working_fraction). Throws StorageError.
+std::vector<MetricValue> store_session_metrics(
+    SessionStore& store, std::int64_t session, const std::optional<OutcomeTracking>& outcome,
+    const Scenario* scenario, const WorkspaceMapping& mapping,
+    const std::optional<WorkspaceMapping>& left_mapping = std::nullopt);
 
 }  // namespace liversim

@@ -75,6 +75,10 @@ struct SessionEvent {
   double time_s = 0.0;  // servo clock, as the frames
   SessionEventKind kind = SessionEventKind::grasp;
   std::string detail;
+  // Whose tool or device it is of (schema 7 on; every event before is the right hand's, the only
+  // one then). Events of the whole scene (a recovery, a change of material, a specimen taken out)
+  // are filed under the right hand, the one every session has.
+  Hand hand = Hand::right;
   bool operator==(const SessionEvent&) const = default;
 };
 
@@ -82,6 +86,12 @@ struct SessionEvent {
 // database marks it incomplete); complete: ended normally.
 enum class SessionStatus { recording, complete, incomplete };
 std::string_view session_status_name(SessionStatus status);
+
+// The second device of a two-handed session (issue 43): the left hand's.
+struct LeftHandDevice {
+  std::string device;        // its name
+  WorkspaceMapping mapping;  // its device → scene
+};
 
 struct SessionStart {
   std::string trainee;  // a person of role trainee, added on first use
@@ -94,6 +104,8 @@ struct SessionStart {
   // How to build the session's scene again (schema 3 on); none: the session cannot be replayed
   // (its simulation input is not recorded).
   std::optional<ReplaySetup> replay;
+  // A device in the left hand too (schema 7 on): its frames are recorded beside the right's.
+  std::optional<LeftHandDevice> left_hand = std::nullopt;
 };
 
 // The servo's figures of a session (ServoStats reduced to what is kept).
@@ -120,6 +132,11 @@ struct SessionSummary {
   std::int64_t frame_count = 0;
   std::optional<SessionServoFigures> servo;  // set when the session ended normally
   std::optional<WorkspaceMapping> mapping;   // none for sessions recorded before schema 2
+  // The left hand's device, its frames and, once ended, its servo figures (schema 7 on): none
+  // for a one-handed session. `device`, `frame_count`, `servo` above are the right hand's.
+  std::optional<LeftHandDevice> left_hand;
+  std::int64_t left_frame_count = 0;
+  std::optional<SessionServoFigures> left_servo;
 };
 
 // A gradable metric's value (gradable_metrics() in scenario.h names them and their units).
@@ -139,15 +156,19 @@ struct SessionGrade {
   bool operator==(const SessionGrade&) const = default;
 };
 
-// The tools in use over a session, from its tool_selected events ("hand" or an unknown name ends
-// the tool before).
-std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events);
+// The tools a hand used over a session, from its tool_selected events ("hand" or an unknown name
+// ends the tool before).
+std::vector<ToolInterval> tool_intervals(std::span<const SessionEvent> events,
+                                         Hand hand = Hand::right);
 // A lesion_marked event's detail for a rest point, and the marks of a session's events (a detail
 // that is not three finite numbers is skipped).
 std::string mark_detail(const Eigen::Vector3d& rest_point_m);
 std::vector<Eigen::Vector3d> lesion_marks(std::span<const SessionEvent> events);
-// The metrics of the session's trace (trace_metrics.h), under their gradable names.
+// The metrics of the session's trace (trace_metrics.h), under their gradable names: the right
+// hand's (the session's device) unprefixed; the left hand's device's with "left_" before them
+// (but for task_time_s, which is the session's).
 std::vector<MetricValue> trace_metric_values(const TraceMetrics& metrics);
+std::vector<MetricValue> left_hand_metric_values(const TraceMetrics& metrics);
 
 // Frames travel and are stored in chunks (one per commit): a documented, versioned byte layout
 // (docs/session-storage.md), little-endian whatever the machine. Exact: doubles keep every bit.
@@ -201,15 +222,26 @@ class SessionStore {
 
   // A new session, status recording, committed at once; returns its id.
   virtual std::int64_t begin_session(const SessionStart& start) = 0;
-  // The session's next frames (in order, after those appended before) and events.
-  virtual void append_frames(std::int64_t session, std::span<const ServoFrame> frames) = 0;
+  // The session's next frames of a hand's device (in order, after those appended before) and
+  // events. A left hand's frames need a session begun with a left-hand device.
+  void append_frames(std::int64_t session, std::span<const ServoFrame> frames) {
+    append_frames(session, Hand::right, frames);
+  }
+  virtual void append_frames(std::int64_t session, Hand hand,
+                             std::span<const ServoFrame> frames) = 0;
   virtual void append_events(std::int64_t session, std::span<const SessionEvent> events) = 0;
   // The simulation's next inputs (in order), for a session begun with a ReplaySetup.
   virtual void append_inputs(std::int64_t session, std::span<const SimulationInput> inputs) = 0;
   virtual void commit() = 0;
-  // Ends the session normally: status complete, end time and servo figures; commits.
+  // Ends the session normally: status complete, end time and servo figures (the left hand's
+  // device's too, in a two-handed session); commits.
+  void end_session(std::int64_t session, std::int64_t ended_unix_ms,
+                   const SessionServoFigures& servo) {
+    end_session(session, ended_unix_ms, servo, std::nullopt);
+  }
   virtual void end_session(std::int64_t session, std::int64_t ended_unix_ms,
-                           const SessionServoFigures& servo) = 0;
+                           const SessionServoFigures& servo,
+                           const std::optional<SessionServoFigures>& left_servo) = 0;
 
   // The session's metrics, computed at its end (a name stored again replaces its value); commits.
   virtual void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) = 0;
@@ -237,8 +269,15 @@ class SessionStore {
   // Only the sessions of the trainee of that name: what a trainee's own history shows.
   virtual std::vector<SessionSummary> sessions_of_trainee(std::string_view trainee) = 0;
   virtual std::vector<MetricValue> metrics(std::int64_t session) = 0;  // by name
-  std::vector<ServoFrame> frames(std::int64_t session) { return frames(session, {}); }
-  virtual std::vector<ServoFrame> frames(std::int64_t session, const ReadingProgress& progress) = 0;
+  // A hand's frames (the right hand's: the session's device).
+  std::vector<ServoFrame> frames(std::int64_t session, Hand hand = Hand::right) {
+    return frames(session, hand, {});
+  }
+  std::vector<ServoFrame> frames(std::int64_t session, const ReadingProgress& progress) {
+    return frames(session, Hand::right, progress);
+  }
+  virtual std::vector<ServoFrame> frames(std::int64_t session, Hand hand,
+                                         const ReadingProgress& progress) = 0;
   virtual std::vector<SessionEvent> events(std::int64_t session) = 0;
   // What a replay needs: how the scene was built (none: not recorded) and the input log.
   virtual std::optional<ReplaySetup> replay_setup(std::int64_t session) = 0;

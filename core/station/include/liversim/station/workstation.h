@@ -245,7 +245,9 @@ class Workstation {
   void clear_left_device();
   // The left hand's device, empty without one.
   std::string left_device_name() const;
-  // The device's name, as sessions record it.
+  // The right hand's device's name, as sessions record it.
+  std::string right_device_name() const;
+  // Both hands' devices, as the interface names them.
   std::string device_name() const;
   ServoLoop* servo() const { return servo_.get(); }
   // The mouse while it is the device (place() and set() move it), else null.
@@ -276,8 +278,8 @@ class Workstation {
   std::optional<std::int64_t> recording_session() const;
   // Frames of the session under way committed so far (0 without one).
   std::int64_t recorded_frames() const { return recorder_ ? recorder_->frames_written() : 0; }
-  // The tool the device holds now as a session event.
-  void record_tool_choice();
+  // The tool the device in `hand` holds now as a session event (none without a device there).
+  void record_tool_choice(Hand hand = Hand::right);
   // Palpation: the rest point of the liver under the tool as the trainee's mark of the lesion (a
   // lesion_marked event). None without a session or a tool in the scene.
   std::optional<Eigen::Vector3d> mark_lesion_under_tool();
@@ -334,7 +336,8 @@ class Workstation {
   void check_device();
   void record_frame_events(const SimulationSnapshot& snapshot, bool cut);
   void compute_session_metrics(std::int64_t session, std::optional<OutcomeTracking> outcome,
-                               const WorkspaceMapping& mapping);
+                               const WorkspaceMapping& mapping,
+                               const std::optional<WorkspaceMapping>& left_mapping);
   void deliver_metrics();
   void restart_training_centre();
 
@@ -382,6 +385,8 @@ class Workstation {
   std::optional<SessionEventWatch> event_watch_;
   bool recording_failure_said_ = false;
   std::uint64_t dropped_before_recording_ = 0;
+  std::uint64_t left_dropped_before_recording_ = 0;
+  bool left_fault_recorded_ = false;
   std::vector<SessionEvent> frame_events_;  // scratch of frame()
 
   BackgroundJob metrics_worker_;

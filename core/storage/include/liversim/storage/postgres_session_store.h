@@ -36,7 +36,7 @@ enum class ServerLoginKind { workstation, instructor };
 class PostgresSessionStore final : public SessionStore {
  public:
   // The schema version this build reads and writes (table liversim_schema on the server).
-  static constexpr int kSchemaVersion = 3;
+  static constexpr int kSchemaVersion = 4;
 
   // Connects as settings.user with this password (empty: libpq finds one in ~/.pgpass or uses a
   // client certificate). Throws StorageError naming the server: unreachable (no answer, TLS
@@ -80,12 +80,15 @@ class PostgresSessionStore final : public SessionStore {
   // SessionStore. Writing sessions directly is what an upload does, in steps; a workstation's
   // login may only add to a session it began, while it is recording.
   std::int64_t begin_session(const SessionStart& start) override;
-  void append_frames(std::int64_t session, std::span<const ServoFrame> frames) override;
+  using SessionStore::append_frames;
+  void append_frames(std::int64_t session, Hand hand, std::span<const ServoFrame> frames) override;
   void append_events(std::int64_t session, std::span<const SessionEvent> events) override;
   void append_inputs(std::int64_t session, std::span<const SimulationInput> inputs) override;
   void commit() override;
+  using SessionStore::end_session;
   void end_session(std::int64_t session, std::int64_t ended_unix_ms,
-                   const SessionServoFigures& servo) override;
+                   const SessionServoFigures& servo,
+                   const std::optional<SessionServoFigures>& left_servo) override;
   void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) override;
 
   // Instructor accounts are server logins: the password is checked by the server (SCRAM), and the
@@ -103,7 +106,8 @@ class PostgresSessionStore final : public SessionStore {
   std::vector<SessionSummary> sessions_of_trainee(std::string_view trainee) override;
   std::vector<MetricValue> metrics(std::int64_t session) override;
   using SessionStore::frames;
-  std::vector<ServoFrame> frames(std::int64_t session, const ReadingProgress& progress) override;
+  std::vector<ServoFrame> frames(std::int64_t session, Hand hand,
+                                 const ReadingProgress& progress) override;
   std::vector<SessionEvent> events(std::int64_t session) override;
   std::string scenario_text(std::int64_t session) override;
   std::optional<ReplaySetup> replay_setup(std::int64_t session) override;

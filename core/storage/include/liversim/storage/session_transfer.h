@@ -36,6 +36,7 @@ struct SessionTransfer {
   std::vector<SessionEvent> events;
   std::vector<MetricValue> metrics;
   ChunkSource frame_chunks;
+  ChunkSource left_frame_chunks;  // none for a one-handed session (summary.left_hand)
   ChunkSource input_chunks;
 };
 

@@ -19,7 +19,7 @@ class SqliteSessionStore final : public SessionStore {
   enum class Access { read_write, read_only };
 
   // The schema version this build writes; files at older versions are migrated on opening.
-  static constexpr int kSchemaVersion = 6;
+  static constexpr int kSchemaVersion = 7;
 
   // Opens the file, creating it (read_write) if it does not exist. Throws StorageError naming the
   // file when it cannot be opened, is not a LiverSim database, is damaged, is read-only while
@@ -39,12 +39,15 @@ class SqliteSessionStore final : public SessionStore {
   void limit_pages_for_testing(std::int64_t pages);
 
   std::int64_t begin_session(const SessionStart& start) override;
-  void append_frames(std::int64_t session, std::span<const ServoFrame> frames) override;
+  using SessionStore::append_frames;
+  void append_frames(std::int64_t session, Hand hand, std::span<const ServoFrame> frames) override;
   void append_events(std::int64_t session, std::span<const SessionEvent> events) override;
   void append_inputs(std::int64_t session, std::span<const SimulationInput> inputs) override;
   void commit() override;
+  using SessionStore::end_session;
   void end_session(std::int64_t session, std::int64_t ended_unix_ms,
-                   const SessionServoFigures& servo) override;
+                   const SessionServoFigures& servo,
+                   const std::optional<SessionServoFigures>& left_servo) override;
 
   void store_metrics(std::int64_t session, std::span<const MetricValue> metrics) override;
 
@@ -62,7 +65,8 @@ class SqliteSessionStore final : public SessionStore {
   std::vector<SessionSummary> sessions_of_trainee(std::string_view trainee) override;
   std::vector<MetricValue> metrics(std::int64_t session) override;
   using SessionStore::frames;
-  std::vector<ServoFrame> frames(std::int64_t session, const ReadingProgress& progress) override;
+  std::vector<ServoFrame> frames(std::int64_t session, Hand hand,
+                                 const ReadingProgress& progress) override;
   std::vector<SessionEvent> events(std::int64_t session) override;
   std::string scenario_text(std::int64_t session) override;
   std::optional<ReplaySetup> replay_setup(std::int64_t session) override;
