@@ -606,6 +606,10 @@
         <source> In the left hand, %1 moves the tool chosen below.</source>
         <translation>左手由 %1 移动下方所选的器械。</translation>
     </message>
+    <message>
+        <source>The Omni cannot be the left hand&apos;s: %1</source>
+        <translation>Omni 不能用作左手设备：%1</translation>
+    </message>
 </context>
 <context>
     <name>liversim::DevicePanel</name>
@@ -708,6 +712,14 @@
     <message>
         <source>Scalpel</source>
         <translation>手术刀</translation>
+    </message>
+    <message>
+        <source>Phantom Omni (“Left Device”)</source>
+        <translation>Phantom Omni（“Left Device”）</translation>
+    </message>
+    <message>
+        <source>%1 (“Left Device”)</source>
+        <translation>%1（“Left Device”）</translation>
     </message>
 </context>
 <context>

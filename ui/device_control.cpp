@@ -44,16 +44,21 @@ DeviceControl::DeviceControl(Workstation& station, MouseToolControl& mouse, Cont
       useDevice(device, file);
   });
   connect(context_.panel, &DevicePanel::calibrateRequested, this, [this] { openCalibration(); });
-  connect(context_.panel, &DevicePanel::leftDeviceChosen, this, [this](bool scripted) {
-    if (!scripted) return clearLeftDevice();
-    const QString file = QFileDialog::getOpenFileName(
-        context_.window, tr("Trajectory for the left hand"), haptics_.trajectory_file,
-        tr("Trajectories (*.txt *.trajectory);;All files (*)"));
-    if (file.isEmpty())  // cancelled: the left hand stays as it was
-      context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()));
-    else
-      useLeftDevice(file);
-  });
+  connect(context_.panel, &DevicePanel::leftDeviceChosen, this,
+          [this](DevicePanel::LeftDevice chosen) {
+            if (chosen == DevicePanel::LeftDevice::none) return clearLeftDevice();
+            if (chosen == DevicePanel::LeftDevice::omni) {
+              useLeftOmni();
+              return;
+            }
+            const QString file = QFileDialog::getOpenFileName(
+                context_.window, tr("Trajectory for the left hand"), haptics_.trajectory_file,
+                tr("Trajectories (*.txt *.trajectory);;All files (*)"));
+            if (file.isEmpty())  // cancelled: the left hand stays as it was
+              showLeftDeviceInUse();
+            else
+              useLeftDevice(file);
+          });
   connect(context_.panel, &DevicePanel::leftToolChanged, this, [this] { leftToolChanged(); });
 }
 
@@ -87,7 +92,7 @@ void DeviceControl::setLeftHandTools(const std::vector<ToolKind>& tools) {
 bool DeviceControl::useLeftDevice(const QString& trajectoryFile) {
   auto refuse = [&](const QString& why) {
     context_.panel->showStatus(why, true);
-    context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()));
+    showLeftDeviceInUse();
     return false;
   };
   std::vector<TrajectoryPoint> script;
@@ -112,15 +117,44 @@ bool DeviceControl::useLeftDevice(const QString& trajectoryFile) {
     station_.clear_left_device();
     return refuse(context_.panel->statusText());
   }
-  context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()));
+  showLeftDeviceInUse();
   return true;
+}
+
+bool DeviceControl::useLeftOmni() {
+  auto refuse = [&](const QString& why) {
+    context_.panel->showStatus(why, true);
+    showLeftDeviceInUse();
+    return false;
+  };
+  if (station_.left_device_is_omni()) return true;  // in the left hand already
+  if (!haptics_.mapping_set) {
+    haptics_.mapping =
+        first_use_mapping(station_.simulation().snapshot().position_m, context_.viewAxes());
+    haptics_.mapping_set = true;
+    save();
+  }
+  if (const std::optional<DeviceRefusal> refusal =
+          station_.use_left_omni(kLeftOmniConfiguration, haptics_.mapping))
+    return refuse(tr("The Omni cannot be the left hand's: %1").arg(qstring(refusal->detail)));
+  if (!useDevice(station_.device())) {
+    station_.clear_left_device();
+    return refuse(context_.panel->statusText());
+  }
+  showLeftDeviceInUse();
+  return true;
+}
+
+void DeviceControl::showLeftDeviceInUse() {
+  context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()),
+                                 station_.left_device_is_omni());
 }
 
 void DeviceControl::clearLeftDevice() {
   if (station_.left_device_name().empty()) return context_.panel->showLeftDevice({});
   station_.clear_left_device();
   useDevice(station_.device());
-  context_.panel->showLeftDevice(QString::fromStdString(station_.left_device_name()));
+  showLeftDeviceInUse();
 }
 
 void DeviceControl::useLastDevice() {
@@ -200,7 +234,7 @@ void DeviceControl::showDeviceInUse() {
   panel.setCalibrationAvailable(!mouse);
   panel.showServoStats(nullptr);
   const std::string left = station_.left_device_name();
-  panel.showLeftDevice(QString::fromStdString(left));
+  panel.showLeftDevice(QString::fromStdString(left), station_.left_device_is_omni());
   const QString leftHand =
       left.empty() ? QString()
                    : tr(" In the left hand, %1 moves the tool chosen below.").arg(qstring(left));

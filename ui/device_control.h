@@ -21,6 +21,10 @@ namespace liversim {
 
 class CalibrationDialog;
 class DevicePanel;
+
+// The Touch Setup name of the Omni the left hand's entry opens: a second Omni is configured under
+// it (the first is "Default Device").
+inline constexpr const char* kLeftOmniConfiguration = "Left Device";
 class ToolPanel;
 
 class DeviceControl : public QObject {
@@ -61,6 +65,8 @@ class DeviceControl : public QObject {
   // none. The servo is made again with it, which restarts the device in use (and its session).
   // False, saying why in the panel, when it cannot be played; the left hand then stays as it was.
   bool useLeftDevice(const QString& trajectoryFile);
+  // The same with the Omni Touch Setup names kLeftOmniConfiguration (a second Omni).
+  bool useLeftOmni();
   void clearLeftDevice();
   // What the left hand's device holds: the panel's tool, its shaft along the view.
   std::optional<DeviceToolSettings> leftDeviceTool() const;
@@ -69,6 +75,7 @@ class DeviceControl : public QObject {
 
  private:
   void showDeviceInUse();
+  void showLeftDeviceInUse();
   void save();
   void leftToolChanged();  // tells the station
   // A device's hold of `kind`: its shaft along the view, the calibrated action buttons.

@@ -48,6 +48,8 @@ DevicePanel::DevicePanel(QWidget* parent) : QWidget(parent) {
   leftDevice_->setObjectName("leftHandDevice");
   leftDevice_->addItem(tr("None"));
   leftDevice_->addItem(tr("Scripted trajectory…"));
+  // A second Omni, as Touch Setup names it (OpenHaptics opens devices by their configured name).
+  leftDevice_->addItem(tr("Phantom Omni (“Left Device”)"));
   form->addRow(tr("Device:"), leftDevice_);
   leftTool_ = new QComboBox(left);
   leftTool_->setObjectName("leftHandTool");
@@ -56,7 +58,7 @@ DevicePanel::DevicePanel(QWidget* parent) : QWidget(parent) {
   setLeftHandTools({kToolKinds.begin(), kToolKinds.end()});
   setLeftTool(ToolKind::forceps);
   connect(leftDevice_, &QComboBox::activated, this,
-          [this](int index) { emit leftDeviceChosen(index == 1); });
+          [this](int index) { emit leftDeviceChosen(static_cast<LeftDevice>(index)); });
   connect(leftTool_, &QComboBox::activated, this, [this] { emit leftToolChanged(); });
   layout->addStretch(1);
   showServoStats(nullptr);
@@ -139,13 +141,22 @@ QString DevicePanel::servoText() const {
   return servo_->text();
 }
 
-void DevicePanel::showLeftDevice(const QString& name) {
-  leftDevice_->setCurrentIndex(name.isEmpty() ? 0 : 1);
-  leftDevice_->setItemText(1, name.isEmpty() ? tr("Scripted trajectory…") : name);
+void DevicePanel::showLeftDevice(const QString& name, bool omni) {
+  const LeftDevice shown = name.isEmpty() ? LeftDevice::none
+                           : omni         ? LeftDevice::omni
+                                          : LeftDevice::scripted;
+  leftDevice_->setItemText(1, shown == LeftDevice::scripted ? name : tr("Scripted trajectory…"));
+  leftDevice_->setItemText(2, shown == LeftDevice::omni ? tr("%1 (“Left Device”)").arg(name)
+                                                        : tr("Phantom Omni (“Left Device”)"));
+  leftDevice_->setCurrentIndex(static_cast<int>(shown));
 }
 
 bool DevicePanel::leftDeviceShown() const {
-  return leftDevice_->currentIndex() == 1;
+  return shownLeftDevice() != LeftDevice::none;
+}
+
+DevicePanel::LeftDevice DevicePanel::shownLeftDevice() const {
+  return static_cast<LeftDevice>(leftDevice_->currentIndex());
 }
 
 std::optional<ToolKind> DevicePanel::leftTool() const {

@@ -42,9 +42,12 @@ class DevicePanel : public QWidget {
 
   static QString servoSummary(const ServoStats& stats);
 
-  // The left hand: whether a device is in it (its name, shown), and the tool it holds.
-  void showLeftDevice(const QString& name);
+  // The left hand: whether a device is in it (its name, shown; `omni`: an Omni, else a scripted
+  // trajectory), and the tool it holds.
+  enum class LeftDevice { none, scripted, omni };
+  void showLeftDevice(const QString& name, bool omni = false);
   bool leftDeviceShown() const;
+  LeftDevice shownLeftDevice() const;
   std::optional<ToolKind> leftTool() const;
   void setLeftTool(std::optional<ToolKind> tool);
   // The tools a scenario allows (the hand always is); a held tool no longer offered is put down.
@@ -53,8 +56,8 @@ class DevicePanel : public QWidget {
  signals:
   void deviceChosen(liversim::DeviceChoice device);
   void calibrateRequested();
-  // The left hand's device: a scripted trajectory asked for (true) or none.
-  void leftDeviceChosen(bool scripted);
+  // The left hand's device asked for.
+  void leftDeviceChosen(liversim::DevicePanel::LeftDevice device);
   void leftToolChanged();
 
  private:

@@ -884,6 +884,10 @@ Eigen::Quaterniond MainWindow::deviceAxesFromView() const {
                                Eigen::Vector3d(up[0], up[1], up[2]));
 }
 
+bool MainWindow::useLeftHandOmni() {
+  return devices_->useLeftOmni();
+}
+
 bool MainWindow::useLeftHandDevice(const QString& trajectoryFile) {
   if (trajectoryFile.isEmpty()) {
     devices_->clearLeftDevice();

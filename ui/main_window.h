@@ -122,6 +122,8 @@ class MainWindow : public QMainWindow {
   // The left hand's device (Device panel, "Left hand"): a scripted trajectory file played beside
   // the device in use (empty: none). False, saying why in the panel, when it cannot be played.
   bool useLeftHandDevice(const QString& trajectoryFile);
+  // A second Omni in the left hand (Touch Setup's "Left Device"), as the panel's entry chooses it.
+  bool useLeftHandOmni();
   DeviceChoice device() const { return station_->device(); }
   ServoLoop* servo() const { return station_->servo(); }
   const HapticPreferences& hapticPreferences() const;

@@ -1,9 +1,14 @@
 // A stand-in for the vendor's OpenHaptics HD runtime, built as a libHD.so of its own so that the
 // driver's dlopen path runs in CI. It exports the HD functions the driver uses, with OpenHaptics
-// 3.x's C signatures and constants, and emulates one PHANTOM Omni:
+// 3.x's C signatures and constants, and emulates a PHANTOM Omni configured as "Default Device"
+// and, once a test configures it (fake_hd_configure_second_device), a second one under another
+// name, as Touch Setup names a second Omni (a left hand's):
 // - a scheduler thread calls the scheduled callbacks at about 1 kHz;
-// - the stylus runs round a 20 mm circle (kCentreMm, kRadiusMm, kTurnRadPerS) with the matching
-//   velocity, latched at hdBeginFrame like the device's state;
+// - each stylus runs round a 20 mm circle (kCentreMm, kRadiusMm, kTurnRadPerS; the second one's
+//   centre kSecondDeviceOffsetMm away) with the matching velocity, latched at hdBeginFrame like
+//   the device's state;
+// - as in OpenHaptics, hdInitDevice and hdMakeCurrentDevice make a device current, and the
+//   parameter calls (hdGet*, hdSetDoublev, hdEnable) act on the current device;
 // - the force set in a frame is applied at hdEndFrame, and only while HD_FORCE_OUTPUT is enabled;
 // - errors form a stack that hdGetError pops, most recent first.
 // The fake_hd_* functions are test hooks, looked up by the tests with dlsym.
@@ -33,7 +38,7 @@ struct HDErrorInfo {
   HHD hHD;
 };
 
-constexpr HHD kHandle = 1;
+constexpr HHD kHandle = 1;  // the default device's; the second device's is 2
 constexpr HHD HD_INVALID_HANDLE = 0xFFFFFFFF;
 constexpr HDCallbackCode HD_CALLBACK_DONE = 0;
 constexpr HDerror HD_INVALID_ENUM = 0x0100;
@@ -58,6 +63,7 @@ constexpr HDenum HD_CALIBRATION_OK = 0x5000;
 constexpr double kCentreMm[3] = {0.0, 0.0, -20.0};
 constexpr double kRadiusMm = 20.0;
 constexpr double kTurnRadPerS = 3.14159265358979323846;  // one turn in 2 s
+constexpr double kSecondDeviceOffsetMm[3] = {-60.0, 0.0, 0.0};
 
 // What OpenHaptics reports, in its units: N, N/mm, N·s/mm, mm.
 struct Model {
@@ -75,25 +81,33 @@ struct Scheduled {
   void* data;
 };
 
-struct Fake {
-  std::mutex mutex;  // everything below up to the scheduler's own state
-  Model model;
-  HDenum calibration = HD_CALIBRATION_OK;
-  HDErrorInfo init_failure{0, 0, 0};
+// One device's state.
+struct Device {
+  std::string configuration;  // its name in Touch Setup; empty: not configured
+  bool initialised = false;
+  bool force_output = false;
   int buttons = 0;
   // The stylus's rotation in the device frame, column-major 3 × 3 (the gimbal angles).
   double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  bool initialised = false;
-  bool force_output = false;
-  int init_calls = 0;
-  std::vector<HDErrorInfo> errors;             // the stack, top at the back
-  std::vector<HDErrorInfo> at_next_frame_end;  // injected errors waiting for hdEndFrame
+  double centre_mm[3] = {kCentreMm[0], kCentreMm[1], kCentreMm[2]};
   std::chrono::steady_clock::time_point epoch = std::chrono::steady_clock::now();
   int frame_depth = 0;
   double position_mm[3] = {0, 0, 0};
   double velocity_mm_per_s[3] = {0, 0, 0};
   double pending_force_n[3] = {0, 0, 0};
   double applied_force_n[3] = {0, 0, 0};
+};
+
+struct Fake {
+  std::mutex mutex;  // everything below up to the scheduler's own state
+  Model model;
+  HDenum calibration = HD_CALIBRATION_OK;
+  HDErrorInfo init_failure{0, 0, 0};
+  Device devices[2];  // handle h is devices[h - 1]
+  HHD current = kHandle;
+  int init_calls = 0;
+  std::vector<HDErrorInfo> errors;             // the stack, top at the back
+  std::vector<HDErrorInfo> at_next_frame_end;  // injected errors waiting for hdEndFrame
 
   std::mutex callbacks_mutex;  // held while callbacks run: after hdUnschedule none is running
   std::vector<Scheduled> callbacks;
@@ -102,6 +116,10 @@ struct Fake {
   std::thread scheduler;
   std::atomic<bool> scheduler_running{false};
   std::atomic<long> ticks{0};
+
+  Fake() { devices[0].configuration = "Default Device"; }
+  Device& of(HHD handle) { return devices[handle - 1]; }
+  Device& current_device() { return of(current); }
 };
 
 Fake& fake() {
@@ -110,26 +128,26 @@ Fake& fake() {
 }
 
 void push_error(Fake& f, HDerror code, int internal = 0) {
-  f.errors.push_back({code, internal, kHandle});
+  f.errors.push_back({code, internal, f.current});
 }
 
 bool check_handle(Fake& f, HHD handle) {
-  if (handle == kHandle && f.initialised) return true;
+  if ((handle == 1 || handle == 2) && f.of(handle).initialised) return true;
   push_error(f, HD_BAD_HANDLE);
   return false;
 }
 
 // The stylus state now, on its circle.
-void latch_state(Fake& f) {
+void latch_state(Device& d) {
   const double t_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - f.epoch).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - d.epoch).count();
   const double angle = kTurnRadPerS * t_s;
-  f.position_mm[0] = kCentreMm[0] + kRadiusMm * std::cos(angle);
-  f.position_mm[1] = kCentreMm[1] + kRadiusMm * std::sin(angle);
-  f.position_mm[2] = kCentreMm[2];
-  f.velocity_mm_per_s[0] = -kRadiusMm * kTurnRadPerS * std::sin(angle);
-  f.velocity_mm_per_s[1] = kRadiusMm * kTurnRadPerS * std::cos(angle);
-  f.velocity_mm_per_s[2] = 0.0;
+  d.position_mm[0] = d.centre_mm[0] + kRadiusMm * std::cos(angle);
+  d.position_mm[1] = d.centre_mm[1] + kRadiusMm * std::sin(angle);
+  d.position_mm[2] = d.centre_mm[2];
+  d.velocity_mm_per_s[0] = -kRadiusMm * kTurnRadPerS * std::sin(angle);
+  d.velocity_mm_per_s[1] = kRadiusMm * kTurnRadPerS * std::cos(angle);
+  d.velocity_mm_per_s[2] = 0.0;
 }
 
 void run_scheduler() {
@@ -165,47 +183,57 @@ HHD hdInitDevice(const char* name) {
     f.errors.push_back(f.init_failure);
     return HD_INVALID_HANDLE;
   }
-  if (name != nullptr && std::strcmp(name, "Default Device") != 0) {
+  // HD_DEFAULT_DEVICE (null) is the device configured as "Default Device".
+  const std::string configuration = name != nullptr ? name : "Default Device";
+  HHD handle = 0;
+  for (HHD h : {1u, 2u})
+    if (!configuration.empty() && f.of(h).configuration == configuration) handle = h;
+  if (handle == 0) {
     push_error(f, HD_DEVICE_FAULT, -1);  // no such configuration
     return HD_INVALID_HANDLE;
   }
-  if (f.initialised) {
+  Device& d = f.of(handle);
+  if (d.initialised) {
     push_error(f, HD_DEVICE_ALREADY_INITIATED);
     return HD_INVALID_HANDLE;
   }
-  f.initialised = true;
-  f.force_output = false;
-  f.epoch = std::chrono::steady_clock::now();
-  return kHandle;
+  d.initialised = true;
+  d.force_output = false;
+  d.epoch = std::chrono::steady_clock::now();
+  f.current = handle;
+  return handle;
 }
 
 void hdDisableDevice(HHD handle) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
   if (!check_handle(f, handle)) return;
-  f.initialised = false;
-  f.force_output = false;
+  f.of(handle).initialised = false;
+  f.of(handle).force_output = false;
 }
 
 void hdMakeCurrentDevice(HHD handle) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  check_handle(f, handle);
+  if (check_handle(f, handle)) f.current = handle;
 }
 
 void hdBeginFrame(HHD handle) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
   if (!check_handle(f, handle)) return;
-  if (f.frame_depth++ == 0) latch_state(f);
+  if (f.of(handle).frame_depth++ == 0) latch_state(f.of(handle));
 }
 
 void hdEndFrame(HHD handle) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  if (!check_handle(f, handle) || f.frame_depth == 0) return;
-  if (--f.frame_depth > 0) return;
-  for (int i = 0; i < 3; ++i) f.applied_force_n[i] = f.force_output ? f.pending_force_n[i] : 0.0;
+  if (!check_handle(f, handle)) return;
+  Device& d = f.of(handle);
+  if (d.frame_depth == 0 || --d.frame_depth > 0) return;
+  for (int i = 0; i < 3; ++i) d.applied_force_n[i] = d.force_output ? d.pending_force_n[i] : 0.0;
+  // Injected errors are the default device's.
+  if (handle != kHandle) return;
   f.errors.insert(f.errors.end(), f.at_next_frame_end.begin(), f.at_next_frame_end.end());
   f.at_next_frame_end.clear();
 }
@@ -213,7 +241,7 @@ void hdEndFrame(HHD handle) {
 HDErrorInfo hdGetError() {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  if (f.errors.empty()) return {0, 0, kHandle};
+  if (f.errors.empty()) return {0, 0, f.current};
   const HDErrorInfo error = f.errors.back();
   f.errors.pop_back();
   return error;
@@ -223,7 +251,7 @@ void hdEnable(HDenum capability) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
   if (capability == HD_FORCE_OUTPUT)
-    f.force_output = true;
+    f.current_device().force_output = true;
   else
     push_error(f, HD_INVALID_ENUM);
 }
@@ -231,19 +259,20 @@ void hdEnable(HDenum capability) {
 void hdGetDoublev(HDenum parameter, double* values) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  if (f.frame_depth == 0) latch_state(f);
+  Device& d = f.current_device();
+  if (d.frame_depth == 0) latch_state(d);
   switch (parameter) {
     case HD_CURRENT_POSITION:
-      std::memcpy(values, f.position_mm, sizeof f.position_mm);
+      std::memcpy(values, d.position_mm, sizeof d.position_mm);
       return;
     case HD_CURRENT_VELOCITY:
-      std::memcpy(values, f.velocity_mm_per_s, sizeof f.velocity_mm_per_s);
+      std::memcpy(values, d.velocity_mm_per_s, sizeof d.velocity_mm_per_s);
       return;
     case HD_CURRENT_TRANSFORM:  // column-major: the rotation, translation in 12-14
       for (int i = 0; i < 16; ++i) values[i] = i == 15 ? 1.0 : 0.0;
       for (int column = 0; column < 3; ++column)
-        for (int row = 0; row < 3; ++row) values[4 * column + row] = f.rotation[3 * column + row];
-      std::memcpy(values + 12, f.position_mm, sizeof f.position_mm);
+        for (int row = 0; row < 3; ++row) values[4 * column + row] = d.rotation[3 * column + row];
+      std::memcpy(values + 12, d.position_mm, sizeof d.position_mm);
       return;
     case HD_NOMINAL_MAX_FORCE:
       *values = f.model.max_force_n;
@@ -269,7 +298,7 @@ void hdGetIntegerv(HDenum parameter, int* values) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
   if (parameter == HD_CURRENT_BUTTONS)
-    *values = f.buttons;
+    *values = f.current_device().buttons;
   else
     push_error(f, HD_INVALID_ENUM);
 }
@@ -286,7 +315,8 @@ void hdSetDoublev(HDenum parameter, const double* values) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
   if (parameter == HD_CURRENT_FORCE)
-    std::memcpy(f.pending_force_n, values, sizeof f.pending_force_n);
+    std::memcpy(f.current_device().pending_force_n, values,
+                sizeof f.current_device().pending_force_n);
   else
     push_error(f, HD_INVALID_ENUM);
 }
@@ -332,13 +362,41 @@ void fake_hd_reset() {
   const std::lock_guard lock(f.mutex);
   f.model = Model{};
   f.calibration = HD_CALIBRATION_OK;
-  for (int i = 0; i < 9; ++i) f.rotation[i] = i % 4 == 0 ? 1.0 : 0.0;
   f.init_failure = {0, 0, 0};
-  f.buttons = 0;
   f.errors.clear();
   f.at_next_frame_end.clear();
-  for (double& force : f.applied_force_n) force = 0.0;
-  for (double& force : f.pending_force_n) force = 0.0;
+  for (Device& d : f.devices) {
+    for (int i = 0; i < 9; ++i) d.rotation[i] = i % 4 == 0 ? 1.0 : 0.0;
+    d.buttons = 0;
+    for (double& force : d.applied_force_n) force = 0.0;
+    for (double& force : d.pending_force_n) force = 0.0;
+  }
+  // The second device is configured only by the tests that use it (a device still open keeps
+  // its configuration).
+  if (!f.devices[1].initialised) f.devices[1].configuration.clear();
+}
+
+// A second device, configured under this name in Touch Setup (a left hand's Omni), its circle
+// centred kSecondDeviceOffsetMm from the first's.
+void fake_hd_configure_second_device(const char* name) {
+  Fake& f = fake();
+  const std::lock_guard lock(f.mutex);
+  Device& d = f.devices[1];
+  d.configuration = name;
+  for (int i = 0; i < 3; ++i) d.centre_mm[i] = kCentreMm[i] + kSecondDeviceOffsetMm[i];
+}
+
+// The force applied at the last hdEndFrame of device `handle` (1: the default device), N.
+void fake_hd_last_force_of(unsigned int handle, double force_n[3]) {
+  Fake& f = fake();
+  const std::lock_guard lock(f.mutex);
+  std::memcpy(force_n, f.of(handle).applied_force_n, sizeof f.of(handle).applied_force_n);
+}
+
+int fake_hd_device_enabled_of(unsigned int handle) {
+  Fake& f = fake();
+  const std::lock_guard lock(f.mutex);
+  return f.of(handle).initialised ? 1 : 0;
 }
 
 // hdInitDevice fails with this error (code 0: it succeeds again).
@@ -370,13 +428,13 @@ void fake_hd_set_calibration(HDenum status) {
 void fake_hd_set_stylus_rotation(const double column_major[9]) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  std::memcpy(f.rotation, column_major, sizeof f.rotation);
+  std::memcpy(f.devices[0].rotation, column_major, sizeof f.devices[0].rotation);
 }
 
 void fake_hd_set_buttons(int buttons) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  f.buttons = buttons;
+  f.devices[0].buttons = buttons;
 }
 
 // The device raises this error at the end of the next frame.
@@ -390,7 +448,7 @@ void fake_hd_inject_error(HDerror code, int internal_code) {
 void fake_hd_last_force(double force_n[3]) {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  std::memcpy(force_n, f.applied_force_n, sizeof f.applied_force_n);
+  std::memcpy(force_n, f.devices[0].applied_force_n, sizeof f.devices[0].applied_force_n);
 }
 
 int fake_hd_scheduler_running() {
@@ -412,13 +470,13 @@ unsigned short fake_hd_last_priority() {
 int fake_hd_device_enabled() {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  return f.initialised ? 1 : 0;
+  return f.devices[0].initialised ? 1 : 0;
 }
 
 int fake_hd_force_output_enabled() {
   Fake& f = fake();
   const std::lock_guard lock(f.mutex);
-  return f.force_output ? 1 : 0;
+  return f.devices[0].force_output ? 1 : 0;
 }
 
 int fake_hd_init_calls() {

@@ -82,6 +82,20 @@ Eigen::Vector3d last_force_n() {
   hook<void (*)(double*)>("fake_hd_last_force")(force_n);
   return {force_n[0], force_n[1], force_n[2]};
 }
+// A second Omni configured under `name`, its circle 60 mm along −x from the first's.
+void configure_second_device(const char* name) {
+  hook<void (*)(const char*)>("fake_hd_configure_second_device")(name);
+}
+const Eigen::Vector3d kSecondCentreMm(-60.0, 0.0, -20.0);
+// Device `handle`: 1 the default device, 2 the second.
+Eigen::Vector3d last_force_n_of(unsigned handle) {
+  double force_n[3];
+  hook<void (*)(unsigned, double*)>("fake_hd_last_force_of")(handle, force_n);
+  return {force_n[0], force_n[1], force_n[2]};
+}
+bool device_enabled_of(unsigned handle) {
+  return hook<int (*)(unsigned)>("fake_hd_device_enabled_of")(handle) != 0;
+}
 bool scheduler_running() {
   return hook<int (*)()>("fake_hd_scheduler_running")() != 0;
 }
@@ -473,6 +487,49 @@ TEST_F(OpenHapticsFake, TheServoLoopRunsOnTheVendorsSchedulerAndLeavesZeroForce)
   servo.stop();
   EXPECT_EQ(fake::last_force_n(), Eigen::Vector3d::Zero()) << "force left on after stop";
   EXPECT_FALSE(fake::scheduler_running());
+}
+
+// Two Omnis (issue 43, item 1): each opened by its Touch Setup name, one schedule of the vendor's
+// drives both in each tick, and each device gets the force published for its own hand and reads
+// its own stylus; a configuration opened twice is refused by name.
+TEST_F(OpenHapticsFake, TwoOmnisByTheirConfiguredNamesAreDrivenInOneTickEachWithItsOwnForce) {
+  fake::configure_second_device("Left Device");
+  const auto right = open();
+  const auto left = open("Left Device");
+  ASSERT_NE(right, nullptr);
+  ASSERT_NE(left, nullptr);
+  EXPECT_TRUE(fake::device_enabled_of(1));
+  EXPECT_TRUE(fake::device_enabled_of(2));
+  const OpenHapticsOpening again = open_openhaptics_device(kFakeRuntime, "Left Device");
+  EXPECT_EQ(again.device, nullptr);
+  EXPECT_NE(again.problem.find("the device \"Left Device\""), std::string::npos) << again.problem;
+  EXPECT_NE(again.problem.find("HD_DEVICE_ALREADY_INITIATED"), std::string::npos) << again.problem;
+  {
+    ServoLoop servo(*right, *left, {});
+    servo.start();
+    EXPECT_EQ(fake::scheduled_callbacks(), 1) << "one schedule for both devices";
+    LocalForceModel right_push, left_push;
+    right_push.force_n = {0.0, 0.0, 1.0};
+    left_push.force_n = {-0.5, 0.25, 0.0};
+    const bool pushed = wait_until([&] {
+      servo.publish(Hand::right, right_push);
+      servo.publish(Hand::left, left_push);
+      return (fake::last_force_n_of(1) - right_push.force_n).norm() < 1e-9 &&
+             (fake::last_force_n_of(2) - left_push.force_n).norm() < 1e-9;
+    });
+    EXPECT_TRUE(pushed) << fake::last_force_n_of(1).transpose() << " / "
+                        << fake::last_force_n_of(2).transpose();
+    ServoFrame right_frame, left_frame;
+    ASSERT_TRUE(servo.newest_frame(Hand::right, right_frame));
+    ASSERT_TRUE(servo.newest_frame(Hand::left, left_frame));
+    EXPECT_NEAR((right_frame.sample.position_mm - kCentreMm).norm(), kRadiusMm, 1e-6)
+        << "the right hand's frame is not on the first device's circle";
+    EXPECT_NEAR((left_frame.sample.position_mm - fake::kSecondCentreMm).norm(), kRadiusMm, 1e-6)
+        << "the left hand's frame is not on the second device's circle";
+    servo.stop();
+    EXPECT_EQ(fake::last_force_n_of(1), Eigen::Vector3d::Zero()) << "force left on after stop";
+    EXPECT_EQ(fake::last_force_n_of(2), Eigen::Vector3d::Zero()) << "force left on after stop";
+  }
 }
 
 }  // namespace

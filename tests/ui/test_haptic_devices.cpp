@@ -594,5 +594,61 @@ TEST_F(DeviceTest, TheOmniIsOfferedWhenItOpensAndAFatalFaultHandsTheToolBackToTh
 }
 #endif
 
+// Two Omnis (issue 43, item 1): the left hand's entry opens the Omni that Touch Setup calls "Left
+// Device", beside the right hand's, both driven by one servo; before one is configured it is
+// refused, naming it, and the left hand stays empty; None closes it.
+TEST_F(DeviceTest, ASecondOmniInTheLeftHandMovesItsOwnToolBesideTheFirst) {
+  qputenv("LIVERSIM_OPENHAPTICS_LIBRARY", LIVERSIM_FAKE_HD_LIBRARY);
+  openWindow();
+  DevicePanel* panel = window_->devicePanel();
+  ASSERT_TRUE(panel->openHapticsOffered()) << panel->openHapticsToolTip().toStdString();
+  window_->toolPanel()->setTool(ToolKind::probe);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::openhaptics)) << panel->statusText().toStdString();
+  EXPECT_FALSE(window_->useLeftHandOmni()) << "no second Omni is configured yet";
+  EXPECT_TRUE(panel->statusText().contains("\"Left Device\"")) << panel->statusText().toStdString();
+  EXPECT_EQ(panel->shownLeftDevice(), DevicePanel::LeftDevice::none);
+  EXPECT_FALSE(window_->servo()->has_device(Hand::left));
+
+  auto configure = fakeHook<void (*)(const char*)>("fake_hd_configure_second_device");
+  auto enabled = fakeHook<int (*)(unsigned)>("fake_hd_device_enabled_of");
+  ASSERT_TRUE(configure && enabled);
+  configure("Left Device");
+  // Chosen as a user picks it in the combo box.
+  auto* leftDevice = panel->findChild<QComboBox*>("leftHandDevice");
+  ASSERT_NE(leftDevice, nullptr);
+  leftDevice->setCurrentIndex(2);
+  emit leftDevice->activated(2);
+  EXPECT_EQ(panel->shownLeftDevice(), DevicePanel::LeftDevice::omni)
+      << panel->statusText().toStdString();
+  EXPECT_TRUE(leftDevice->currentText().contains("Left Device"))
+      << leftDevice->currentText().toStdString();
+  EXPECT_EQ(window_->device(), DeviceChoice::openhaptics) << "the right hand's Omni went";
+  ASSERT_TRUE(window_->servo()->has_device(Hand::left));
+  EXPECT_EQ(enabled(2), 1);
+  ASSERT_TRUE(
+      QTest::qWaitFor([&] { return window_->servo()->stats(Hand::left).ticks > 200; }, kTimeoutMs));
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        const auto& left = snapshot().hand(Hand::left).tool;
+        const auto& right = snapshot().hand(Hand::right).tool;
+        return left && left->kind == ToolKind::forceps && right && right->kind == ToolKind::probe;
+      },
+      kTimeoutMs))
+      << "the two Omnis' styluses do not move a tool each";
+  // Each tool follows its own stylus: the fake's second circle is 60 mm from the first.
+  EXPECT_GT((snapshot().hand(Hand::left).tool->pose.origin_m -
+             snapshot().hand(Hand::right).tool->pose.origin_m)
+                .norm(),
+            0.01);
+
+  // None: the left hand's Omni is closed; the right hand's goes on.
+  leftDevice->setCurrentIndex(0);
+  emit leftDevice->activated(0);
+  EXPECT_EQ(panel->shownLeftDevice(), DevicePanel::LeftDevice::none);
+  EXPECT_FALSE(window_->servo()->has_device(Hand::left));
+  EXPECT_EQ(enabled(2), 0) << "the left hand's Omni was left open";
+  EXPECT_EQ(window_->device(), DeviceChoice::openhaptics);
+}
+
 }  // namespace
 }  // namespace liversim

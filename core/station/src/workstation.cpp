@@ -519,7 +519,21 @@ std::string Workstation::device_name() const {
 
 void Workstation::clear_left_device() {
   pending_left_device_.reset();
+  pending_left_device_is_omni_ = false;
   left_device_changing_ = true;
+}
+
+std::optional<DeviceRefusal> Workstation::use_left_omni(const std::string& configuration,
+                                                        const WorkspaceMapping& mapping) {
+  using Reason = DeviceRefusal::Reason;
+  if (auto problem = validate(mapping)) return DeviceRefusal{Reason::servo_failed, *problem};
+  OpenHapticsOpening omni = open_openhaptics_device(omni_library_, configuration.c_str());
+  if (!omni.device) return DeviceRefusal{Reason::omni_unavailable, omni.problem};
+  pending_left_device_ = std::move(omni.device);
+  pending_left_device_is_omni_ = true;
+  left_device_changing_ = true;
+  left_mapping_ = mapping;
+  return std::nullopt;
 }
 
 std::string Workstation::left_device_name() const {
@@ -551,6 +565,7 @@ std::optional<DeviceRefusal> Workstation::use_left_device(std::vector<Trajectory
   }
   // The servo in use holds the old one (if any): the next use_device replaces both.
   pending_left_device_ = std::move(device);
+  pending_left_device_is_omni_ = false;
   left_device_changing_ = true;
   left_mapping_ = mapping;
   return std::nullopt;
@@ -606,6 +621,7 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
   detach_device();  // the old servo, which may hold the old left device, goes
   if (left_device_changing_) {
     left_device_ = std::move(pending_left_device_);
+    left_device_is_omni_ = pending_left_device_is_omni_;
     left_device_changing_ = false;
   }
   servo_ = std::move(servo);

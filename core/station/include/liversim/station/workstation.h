@@ -235,12 +235,20 @@ class Workstation {
   // driven by the same servo as the right hand's: a scripted trajectory (its file named in
   // `script_file`), mapped by `mapping`; its tool is listener.left_device_tool's. It is taken at
   // the next use_device, which makes the servo. Refused, the left hand staying as it was, for an
-  // empty or bad script or a bad mapping. Neither the Omni nor the mouse can be the left hand's
-  // yet; the left device's frames and tool events are not recorded yet (the session's input log has
-  // its tools, so the session replays whole).
+  // empty or bad script or a bad mapping. Sessions record its frames and its tool's events beside
+  // the right hand's. The mouse cannot be the left hand's yet.
   std::optional<DeviceRefusal> use_left_device(std::vector<TrajectoryPoint> script,
                                                const std::filesystem::path& script_file,
                                                const WorkspaceMapping& mapping);
+  // The same with an Omni in the left hand: the one OpenHaptics knows by `configuration`, its
+  // name in Touch Setup ("Left Device" for a second Omni; "Default Device" when the right hand
+  // has no Omni). Its force is written in the tick of the right hand's device. Refused, naming the
+  // runtime's answer, when it cannot be opened (absent, not configured, already open: an Omni in
+  // the left hand is closed by clear_left_device and the next use_device).
+  std::optional<DeviceRefusal> use_left_omni(const std::string& configuration,
+                                             const WorkspaceMapping& mapping);
+  // Whether the left hand's device in use is an Omni.
+  bool left_device_is_omni() const { return left_device_is_omni_; }
   // The left hand's device goes at the next use_device.
   void clear_left_device();
   // The left hand's device, empty without one.
@@ -372,6 +380,7 @@ class Workstation {
   std::unique_ptr<HapticDevice> left_device_;  // the left hand's (a script), if any
   std::unique_ptr<HapticDevice> pending_left_device_;  // chosen, for the next use_device
   bool left_device_changing_ = false;  // pending_left_device_ (null: none) replaces it
+  bool left_device_is_omni_ = false, pending_left_device_is_omni_ = false;
   WorkspaceMapping left_mapping_;
   ManualDevice* mouse_ = nullptr;  // own_device_, while the mouse is the device
   std::unique_ptr<ServoLoop> servo_;
