@@ -145,7 +145,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   double bodies_m3 = 0.0;
   for (const FreeBody& body : bodies) bodies_m3 += body.rest_volume_m3;
   station.reset();
-  fs::remove(database);
+  // The database and the files SQLite and the store keep beside it (its recording lock too).
+  for (const char* suffix : {"", "-wal", "-shm", "-recording.lock"})
+    fs::remove(database.string() + suffix);
   if (!fault.empty()) return fail("the scripted device stopped: " + fault);
 
   // Per second of wall time: the windows that ended in it, and the cuts made in it.

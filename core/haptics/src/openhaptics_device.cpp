@@ -127,6 +127,8 @@ void discard_errors(const Api& api) {
 }
 
 const char* const kOtherDevices = "the mouse, scripted and replay devices are still available.";
+const char* const kOtherDevicesSentence =
+    "The mouse, scripted and replay devices are still available.";
 
 struct Runtime {
   const Api* api = nullptr;
@@ -250,7 +252,7 @@ OpenHapticsOpening open_openhaptics_device(const std::string& library, const cha
                          code + " (" + hd_error(error.errorCode).name + "), internal code " +
                          std::to_string(error.internalErrorCode) +
                          ". Is the device connected and configured (Touch Setup)? " +
-                         kOtherDevices};
+                         kOtherDevicesSentence};
   }
 
   api.hdMakeCurrentDevice(handle);
