@@ -30,6 +30,16 @@ PartAbove part_above(double a, double b, double dt_s, double threshold) {
   return {dt_s * (b - threshold) / (b - a), threshold, b};                     // rises through
 }
 
+// A frame the device reached by a jump (the mouse putting the tool down elsewhere), not a motion.
+bool is_jump(const ServoFrame& frame) {
+  return (frame.sample.buttons & kRepositioned) != 0;
+}
+
+// The scene distance the tip moved from one frame to the next: none for a jump, which is no path.
+double scene_length_mm(const ServoFrame& from, const ServoFrame& to, double scale) {
+  return is_jump(to) ? 0.0 : scale * (to.sample.position_mm - from.sample.position_mm).norm();
+}
+
 // The shortest text that reads back as the same double: two times that differ print differently.
 std::string shortest(double value) {
   char text[32];
@@ -165,12 +175,8 @@ TraceMetrics compute_trace_metrics(std::span<const ServoFrame> frames,
       if (!first_contact_s) first_contact_s = end_s - contact.duration_s;
     }
 
-    // A jump (the mouse putting the tool down elsewhere) is no path.
-    const bool jump = (frames[i + 1].sample.buttons & kRepositioned) != 0;
-    const double length_mm =
-        jump ? 0.0
-             : mapping.scale *
-                   (frames[i + 1].sample.position_mm - frames[i].sample.position_mm).norm();
+    const bool jump = is_jump(frames[i + 1]);
+    const double length_mm = scene_length_mm(frames[i], frames[i + 1], mapping.scale);
     metrics.path_length_mm += length_mm;
     advance_tool_to(start_s);
     const std::ptrdiff_t tool_at_start = tool_index;
@@ -243,11 +249,7 @@ std::vector<std::pair<double, double>> working_spans(const HandTrace& hand,
   for (std::size_t i = 0; i + 1 < frames.size(); ++i) {
     const double start_s = frames[i].time_s, end_s = frames[i + 1].time_s;
     const double dt_s = end_s - start_s;
-    const bool jump = (frames[i + 1].sample.buttons & kRepositioned) != 0;
-    const double length_mm =
-        jump ? 0.0
-             : hand.mapping.scale *
-                   (frames[i + 1].sample.position_mm - frames[i].sample.position_mm).norm();
+    const double length_mm = scene_length_mm(frames[i], frames[i + 1], hand.mapping.scale);
     if (length_mm / dt_s > settings.moving_speed_mm_per_s) {
       add(start_s, end_s);
       continue;

@@ -654,17 +654,32 @@ std::int64_t scenario(Connection& c, std::string_view title, std::string_view te
 }
 
 Params& add_mapping(Params& p, const std::optional<WorkspaceMapping>& mapping) {
-  for (int k = 0; k < 8; ++k) {
+  for (std::size_t k = 0; k < 8; ++k) {
     std::optional<double> value;
-    if (mapping) {
-      const WorkspaceMapping& m = *mapping;
-      const double values[] = {m.scale,        m.rotation.w(), m.rotation.x(), m.rotation.y(),
-                               m.rotation.z(), m.offset_m.x(), m.offset_m.y(), m.offset_m.z()};
-      value = values[k];
-    }
+    if (mapping) value = stored_rows::mapping_values(*mapping)[k];
     p.add(value);
   }
   return p;
+}
+
+// The left hand's device and mapping (nulls for a one-handed session), as their columns are named
+// in kLeftMappingColumns' order after left_device.
+Params& add_left_hand(Params& p, const std::optional<LeftHandDevice>& left) {
+  std::optional<std::string_view> device;
+  std::optional<WorkspaceMapping> mapping;
+  if (left) {
+    device = left->device;
+    mapping = left->mapping;
+  }
+  p.add(device);
+  return add_mapping(p, mapping);
+}
+
+// "$first, ..., $last": a statement's parameters.
+std::string placeholders(int first, int last) {
+  std::string list;
+  for (int k = first; k <= last; ++k) list += (k > first ? ", $" : "$") + std::to_string(k);
+  return list;
 }
 
 Params& add_servo(Params& p, const std::optional<SessionServoFigures>& servo) {
@@ -865,24 +880,17 @@ bool PostgresSessionStore::receive_session(const SessionTransfer& session) {
         .add(session.input_count);
     add_servo(row, s.servo);
     add_mapping(row, s.mapping);
-    std::optional<std::string_view> left_device;
-    std::optional<WorkspaceMapping> left_mapping;
-    if (s.left_hand) {
-      left_device = s.left_hand->device;
-      left_mapping = s.left_hand->mapping;
-    }
-    row.add(left_device).add(s.left_frame_count);
-    add_mapping(row, left_mapping);
+    add_left_hand(row, s.left_hand);
+    row.add(s.left_frame_count);
     add_servo(row, s.left_servo);
-    std::string values = "$1::text::uuid";
-    for (int k = 2; k <= 51; ++k) values += ", $" + std::to_string(k);
     const std::string insert =
         std::string(
             "INSERT INTO sessions (uuid, trainee_id, scenario_id, device, "
             "started_unix_ms, ended_unix_ms, status, frame_count, input_count, ") +
-        kServoColumns + ", " + kMappingColumns + ", left_device, left_frame_count, " +
-        stored_rows::kLeftMappingColumns + ", " + stored_rows::kLeftServoColumns + ") VALUES (" +
-        values + ") ON CONFLICT (uuid) DO NOTHING RETURNING id";
+        kServoColumns + ", " + kMappingColumns + ", left_device, " +
+        stored_rows::kLeftMappingColumns + ", left_frame_count, " + stored_rows::kLeftServoColumns +
+        ") VALUES ($1::text::uuid, " + placeholders(2, 51) +
+        ") ON CONFLICT (uuid) DO NOTHING RETURNING id";
     Result added = c.run(insert.c_str(), row, "adding the session");
     if (added.rows() == 0) {  // another upload of it committed meanwhile
       c.roll_back();
@@ -1005,22 +1013,15 @@ std::int64_t PostgresSessionStore::begin_session(const SessionStart& start) {
       .add(std::string_view(start.device))
       .add(start.started_unix_ms);
   add_mapping(row, start.mapping);
+  add_left_hand(row, start.left_hand);
   const std::string insert = std::string(
                                  "INSERT INTO sessions (uuid, trainee_id, scenario_id, "
                                  "device, started_unix_ms, status, ") +
-                             kMappingColumns +
-                             ") VALUES ($1::text::uuid, $2, $3, $4, $5, 'recording', $6, $7, "
-                             "$8, $9, $10, $11, $12, $13) RETURNING id";
+                             kMappingColumns + ", left_device, " +
+                             stored_rows::kLeftMappingColumns +
+                             ") VALUES ($1::text::uuid, $2, $3, $4, $5, 'recording', " +
+                             placeholders(6, 22) + ") RETURNING id";
   const std::int64_t id = c.run(insert.c_str(), row, "adding the session").integer(0, 0);
-  if (const auto& left = start.left_hand) {
-    Params left_row;
-    left_row.add(id).add(std::string_view(left->device));
-    add_mapping(left_row, left->mapping);
-    c.run(("UPDATE sessions SET left_device = $2, (" + stored_rows::kLeftMappingColumns +
-           ") = ($3, $4, $5, $6, $7, $8, $9, $10) WHERE id = $1")
-              .c_str(),
-          left_row, "adding the session's left hand");
-  }
   if (start.replay) store_replay(c, id, *start.replay);
   c.commit();
   return id;
@@ -1093,12 +1094,11 @@ void PostgresSessionStore::end_session(std::int64_t session, std::int64_t ended_
     Params left_row;
     left_row.add(session);
     add_servo(left_row, left_servo);
-    std::string values = "$2";
-    for (int k = 3; k <= 13; ++k) values += ", $" + std::to_string(k);
-    Result left = c.run(("UPDATE sessions SET (" + stored_rows::kLeftServoColumns + ") = (" +
-                         values + ") WHERE id = $1 AND left_device IS NOT NULL RETURNING id")
-                            .c_str(),
-                        left_row, "ending the session's left hand");
+    Result left = c.run(
+        ("UPDATE sessions SET (" + stored_rows::kLeftServoColumns + ") = (" + placeholders(2, 13) +
+         ") WHERE id = $1 AND left_device IS NOT NULL " + "RETURNING id")
+            .c_str(),
+        left_row, "ending the session's left hand");
     if (left.rows() != 1) {
       c.roll_back();
       throw c.error("session " + std::to_string(session) +
@@ -1318,17 +1318,12 @@ std::vector<SessionEvent> PostgresSessionStore::events(std::int64_t session) {
       Params().add(session), "reading events");
   std::vector<SessionEvent> result;
   for (int r = 0; r < rows.rows(); ++r) {
-    const std::string kind = rows.text(r, 1);
-    const std::optional<SessionEventKind> known = session_event_kind(kind);
-    if (!known)
-      throw connection_->error("session " + std::to_string(session) +
-                               " has an event of unknown kind \"" + kind + "\"");
-    const std::string hand = rows.text(r, 3);
-    const std::optional<Hand> of = hand_named(hand);
-    if (!of)
-      throw connection_->error("session " + std::to_string(session) +
-                               " has an event of an unknown hand \"" + hand + "\"");
-    result.push_back({rows.real(r, 0), *known, rows.text(r, 2), *of});
+    try {
+      result.push_back(stored_rows::session_event(rows.real(r, 0), rows.text(r, 1), rows.text(r, 2),
+                                                  rows.text(r, 3)));
+    } catch (const StorageError& e) {
+      throw connection_->error("session " + std::to_string(session) + " " + e.what());
+    }
   }
   return result;
 }

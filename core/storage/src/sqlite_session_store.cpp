@@ -609,38 +609,37 @@ std::int64_t SqliteSessionStore::begin_session(const SessionStart& start) {
       prepared(kFindScenario, "SELECT id FROM scenarios WHERE sha256 = ?1")
           .bind(1, std::string_view(hash))
           .single_integer("looking up the scenario");
-  Statement& add = prepared(
-      kAddSession,
-      "INSERT INTO sessions (trainee_id, scenario_id, device, started_unix_ms, status, "
-      "mapping_scale, mapping_rotation_w, mapping_rotation_x, mapping_rotation_y, "
-      "mapping_rotation_z, mapping_offset_x_m, mapping_offset_y_m, mapping_offset_z_m, "
-      "uuid) VALUES (?1, ?2, ?3, ?4, 'recording', ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)");
-  add.bind(13, std::string_view(new_uuid()));
+  static const std::string insert =
+      "INSERT INTO sessions (trainee_id, scenario_id, device, started_unix_ms, status, " +
+      std::string(stored_rows::kMappingColumns) + ", uuid, left_device, " +
+      stored_rows::kLeftMappingColumns +
+      ") VALUES (?1, ?2, ?3, ?4, 'recording', ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, "
+      "?16, ?17, ?18, ?19, ?20, ?21, ?22)";
+  Statement& add = prepared(kAddSession, insert.c_str());
   add.bind(1, trainee)
       .bind(2, scenario)
       .bind(3, std::string_view(start.device))
-      .bind(4, start.started_unix_ms);
-  if (const auto& m = start.mapping) {
-    const double values[] = {m->scale,        m->rotation.w(), m->rotation.x(), m->rotation.y(),
-                             m->rotation.z(), m->offset_m.x(), m->offset_m.y(), m->offset_m.z()};
-    for (int k = 0; k < 8; ++k) add.bind(5 + k, values[k]);
+      .bind(4, start.started_unix_ms)
+      .bind(13, std::string_view(new_uuid()));
+  // A mapping's eight columns from parameter `first` on, null without one.
+  const auto bind_mapping = [&](int first, const std::optional<WorkspaceMapping>& mapping) {
+    for (int k = 0; k < 8; ++k)
+      if (mapping)
+        add.bind(first + k, stored_rows::mapping_values(*mapping)[static_cast<std::size_t>(k)]);
+      else
+        add.bind_null(first + k);
+  };
+  bind_mapping(5, start.mapping);
+  std::optional<WorkspaceMapping> left_mapping;
+  if (const auto& left = start.left_hand) {
+    add.bind(14, std::string_view(left->device));
+    left_mapping = left->mapping;
   } else {
-    for (int k = 0; k < 8; ++k) add.bind_null(5 + k);
+    add.bind_null(14);
   }
+  bind_mapping(15, left_mapping);
   add.run("adding the session");
   const std::int64_t session = sqlite3_last_insert_rowid(db_);
-  if (const auto& left = start.left_hand) {
-    const WorkspaceMapping& m = left->mapping;
-    Statement add_left(
-        *this, ("UPDATE sessions SET left_device = ?2, (" + stored_rows::kLeftMappingColumns +
-                ") = (?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10) WHERE id = ?1")
-                   .c_str());
-    add_left.bind(1, session).bind(2, std::string_view(left->device));
-    const double values[] = {m.scale,        m.rotation.w(), m.rotation.x(), m.rotation.y(),
-                             m.rotation.z(), m.offset_m.x(), m.offset_m.y(), m.offset_m.z()};
-    for (int k = 0; k < 8; ++k) add_left.bind(3 + k, values[k]);
-    add_left.run("adding the session's left hand");
-  }
   if (const auto& replay = start.replay) {
     Statement& add_replay =
         prepared(kAddReplay,
@@ -675,18 +674,19 @@ void SqliteSessionStore::append_frames(std::int64_t session, Hand hand,
   begin_if_needed();
   const bool left = hand == Hand::left;
   const std::string looking = "looking up session " + std::to_string(session);
-  if (left && prepared(kHasLeftHand, "SELECT left_device IS NOT NULL FROM sessions WHERE id = ?1")
-                      .bind(1, session)
-                      .single_integer(looking.c_str()) == 0)
-    throw error("session " + std::to_string(session) +
-                " was begun without a left-hand device: it takes no left-hand frames");
+  // The left hand's count, or -1 for a session begun without a left-hand device.
   const std::int64_t first =
-      left ? prepared(kLeftFrameCount, "SELECT left_frame_count FROM sessions WHERE id = ?1")
+      left ? prepared(kLeftFrameCount,
+                      "SELECT CASE WHEN left_device IS NULL THEN -1 ELSE left_frame_count END "
+                      "FROM sessions WHERE id = ?1")
                  .bind(1, session)
                  .single_integer(looking.c_str())
            : prepared(kFrameCount, "SELECT frame_count FROM sessions WHERE id = ?1")
                  .bind(1, session)
                  .single_integer(looking.c_str());
+  if (first < 0)
+    throw error("session " + std::to_string(session) +
+                " was begun without a left-hand device: it takes no left-hand frames");
   const std::vector<std::uint8_t> bytes = encode_frame_chunk(frames);
   (left ? prepared(kAddLeftChunk,
                    "INSERT INTO left_hand_frame_chunks (session_id, first_frame, frame_count, "
@@ -1048,21 +1048,13 @@ std::vector<SessionEvent> SqliteSessionStore::events(std::int64_t session) {
   rows.bind(1, session);
   std::vector<SessionEvent> result;
   while (rows.step("reading events")) {
-    const std::string kind = rows.text(1);
-    const std::optional<SessionEventKind> known = session_event_kind(kind);
-    if (!known) {
+    try {
+      result.push_back(
+          stored_rows::session_event(rows.real(0), rows.text(1), rows.text(2), rows.text(3)));
+    } catch (const StorageError& e) {
       rows.reset();
-      throw error("session " + std::to_string(session) + " has an event of unknown kind \"" + kind +
-                  "\"");
+      throw error("session " + std::to_string(session) + " " + e.what());
     }
-    const std::string hand = rows.text(3);
-    const std::optional<Hand> of = hand_named(hand);
-    if (!of) {
-      rows.reset();
-      throw error("session " + std::to_string(session) + " has an event of an unknown hand \"" +
-                  hand + "\"");
-    }
-    result.push_back({rows.real(0), *known, rows.text(2), *of});
   }
   rows.reset();
   return result;

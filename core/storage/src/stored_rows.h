@@ -5,12 +5,15 @@
 
 #include "liversim/sessions/session_store.h"
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <iterator>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace liversim::stored_rows {
@@ -59,6 +62,23 @@ inline const std::string kSessionSummarySelect =
     prefixed_columns(kLeftMappingColumns, "s.") + ", " + prefixed_columns(kLeftServoColumns, "s.") +
     " FROM sessions s JOIN people p ON p.id = s.trainee_id "
     "JOIN scenarios c ON c.id = s.scenario_id ";
+
+// A mapping's values in kMappingColumns' order.
+inline std::array<double, 8> mapping_values(const WorkspaceMapping& m) {
+  return {m.scale,        m.rotation.w(), m.rotation.x(), m.rotation.y(),
+          m.rotation.z(), m.offset_m.x(), m.offset_m.y(), m.offset_m.z()};
+}
+
+// An event from its stored columns (kind and hand by name); throws StorageError naming a kind or
+// hand this version does not know (the caller adds which session).
+inline SessionEvent session_event(double time_s, const std::string& kind, std::string detail,
+                                  const std::string& hand) {
+  const std::optional<SessionEventKind> known = session_event_kind(kind);
+  if (!known) throw StorageError("has an event of unknown kind \"" + kind + "\"");
+  const std::optional<Hand> of = hand_named(hand);
+  if (!of) throw StorageError("has an event of an unknown hand \"" + hand + "\"");
+  return {time_s, *known, std::move(detail), *of};
+}
 
 // Servo figures from the 12 columns from `first` on (kServoColumns' order).
 template <typename Row>
