@@ -892,6 +892,35 @@ TEST(SessionStore, RefusesFilesItCannotUseWithTheFileAndTheReasonNamed) {
   }
 }
 
+// A file another program wrote into (past the schema's check on hands): an event of a kind or a
+// hand this version does not know is named with its session, not read as something else.
+TEST(SessionStore, AnEventOfAnUnknownKindOrHandIsNamedWithItsSession) {
+  const fs::path file = fresh_database("unknown-event");
+  {
+    SqliteSessionStore store(file);
+    const std::int64_t session = store.begin_session(start_of("Trainee A", "{}"));
+    const SessionEvent grasp{0.5, SessionEventKind::grasp, "", Hand::left};
+    store.append_events(session, std::span(&grasp, 1));
+    store.commit();
+  }
+  const auto message = [&] {
+    try {
+      SqliteSessionStore(file, SqliteSessionStore::Access::read_only).events(1);
+    } catch (const StorageError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  run_sql(file, "PRAGMA ignore_check_constraints = ON; UPDATE events SET hand = 'third'");
+  EXPECT_NE(message().find("session 1 has an event of an unknown hand \"third\""),
+            std::string::npos)
+      << message();
+  run_sql(file, "UPDATE events SET hand = 'left', kind = 'teleport'");
+  EXPECT_NE(message().find("session 1 has an event of unknown kind \"teleport\""),
+            std::string::npos)
+      << message();
+}
+
 TEST(SessionStore, ADamagedFileGivesAClearMessageAndNoCrash) {
   const fs::path file = fresh_database("damaged");
   {
