@@ -48,6 +48,19 @@ BladeStroke sweep_of(const Eigen::Vector3d& heel, const Eigen::Vector3d& tip,
   return stroke;
 }
 
+// The same, with the edge at instants 1 mm apart, as the real-time loop takes a stroke (every
+// 0.5 mm): what the edge runs beside is seen at each instant.
+BladeStroke sweep_in_steps(const Eigen::Vector3d& heel, const Eigen::Vector3d& tip,
+                           const Eigen::Vector3d& motion) {
+  BladeStroke stroke;
+  const int steps = static_cast<int>(std::ceil(motion.norm() / 0.001));
+  for (int i = 0; i <= steps; ++i) {
+    const Eigen::Vector3d moved = (double(i) / steps) * motion;
+    stroke.add({heel + moved, tip + moved});
+  }
+  return stroke;
+}
+
 // Vertical sweep in the plane x = `x`, reaching from above the block down to `bottom_z`, across
 // the whole width.
 BladeStroke vertical_cut(double x, double bottom_z) {
@@ -680,14 +693,15 @@ TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
   settings = {};
   settings.snap_min_shape_fraction = std::nan("");
   EXPECT_TRUE(validate(settings).has_value());
-  // The refinement, the height floor and the mass budget, each by its name.
+  // The refinement, the height floor, the mass budget and the groove guide, each by its name.
   const std::pair<double CuttingSettings::*, std::vector<double>> bad[] = {
       {&CuttingSettings::refine_edge_m, {-0.001, std::nan(""), INFINITY}},
       {&CuttingSettings::min_part_height_m, {0.0, -0.002, std::nan(""), INFINITY}},
       {&CuttingSettings::max_added_mass_fraction, {-0.001, 0.5, std::nan("")}},
-      {&CuttingSettings::min_free_body_volume_m3, {-1e-6, -INFINITY, std::nan("")}}};
+      {&CuttingSettings::min_free_body_volume_m3, {-1e-6, -INFINITY, std::nan("")}},
+      {&CuttingSettings::groove_guide_m, {-0.001, std::nan(""), INFINITY}}};
   const char* names[] = {"refinement edge", "smallest part height", "added mass fraction",
-                         "smallest free body"};
+                         "smallest free body", "groove guide"};
   for (std::size_t k = 0; k < std::size(bad); ++k)
     for (double value : bad[k].second) {
       settings = {};
@@ -887,6 +901,51 @@ TEST(Cutting, TwoStrokesInOnePlaneThatMeetCutWhatOneStrokeAcrossCuts) {
   ASSERT_TRUE(once.cut());
   ASSERT_EQ(free_bodies(*once.model).size(), 1u);
   EXPECT_NEAR(free_bodies(*once.model)[0].rest_volume_m3, top_m3, 1e-9 * top_m3);
+}
+
+// A stroke drawn beside an earlier cut follows it (issue 42, item 6: passes that deepened a groove
+// in tissue that had moved between them cut sheets up to ~3 mm apart in the material, and the
+// slivers between kept the lobe joined). The first stroke cuts the block at z = 2.4 cm from
+// x = −1 cm to 4.5 cm; the second, 3 mm higher, from x = 2.5 cm across the rest, its edge seen
+// every millimetre as the loop sees it: over the first cut it runs along it, beyond that cut's
+// front it climbs to its own plane, and the top comes free whole. Without the guide the sheets
+// overlap 2 cm, 3 mm apart, and the slab between them keeps the top joined; a stroke 6 mm off,
+// farther than the guide reaches, cuts a sheet of its own.
+TEST(Cutting, AStrokeBesideAnEarlierCutFollowsItAndFreesWhatTheyEncloseTogether) {
+  const SimModel model = block_model();
+  const double z = 0.024, offset = 0.003;
+  const CutResult first =
+      cut_tissue(model, make_rest_state(model),
+                 sweep_of({-0.01, -0.01, z}, {0.045, -0.01, z}, {0.0, 0.07, 0.0}), cut_anything());
+  ASSERT_TRUE(first.cut());
+  ASSERT_TRUE(free_bodies(*first.model).empty()) << "half a cut freed the top";
+  auto second_stroke = [&](double above_m) {
+    return sweep_in_steps({0.025, -0.01, z + above_m}, {0.07, -0.01, z + above_m},
+                          {0.0, 0.07, 0.0});
+  };
+  ASSERT_EQ(cut_anything().groove_guide_m, 0.004);
+  const CutResult guided =
+      cut_tissue(*first.model, first.state, second_stroke(offset), cut_anything());
+  ASSERT_TRUE(guided.cut());
+  const std::vector<FreeBody> freed = free_bodies(*guided.model);
+  ASSERT_EQ(freed.size(), 1u) << "the stroke beside the first cut did not free the top";
+  // All that lies above the higher plane, and less than all above the lower.
+  EXPECT_GT(freed[0].rest_volume_m3, 0.06 * 0.05 * (0.04 - z - offset));
+  EXPECT_LT(freed[0].rest_volume_m3, 0.06 * 0.05 * (0.04 - z));
+  EXPECT_TRUE(boundary_is_manifold(*guided.model));
+  EXPECT_TRUE(elements_are_sound(*guided.model, guided.state));
+
+  CuttingSettings unguided = cut_anything();
+  unguided.groove_guide_m = 0.0;
+  const CutResult beside = cut_tissue(*first.model, first.state, second_stroke(offset), unguided);
+  ASSERT_TRUE(beside.cut());
+  EXPECT_TRUE(free_bodies(*beside.model).empty())
+      << "two sheets 3 mm apart freed the top without the guide: the test shows nothing";
+
+  const CutResult apart =
+      cut_tissue(*first.model, first.state, second_stroke(0.006), cut_anything());
+  ASSERT_TRUE(apart.cut());
+  EXPECT_TRUE(free_bodies(*apart.model).empty()) << "a stroke 6 mm off followed the first cut";
 }
 
 // A blade under the surface cuts (issue 42, item 3): a sweep wholly inside the block, 4 cm across

@@ -12,9 +12,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <utility>
 
@@ -49,6 +51,8 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
   if (!(settings.min_free_body_volume_m3 >= 0.0))  // infinity: every piece taken out
     return out_of_range("smallest free body (m³)", settings.min_free_body_volume_m3,
                         "a value >= 0 (infinity: take every freed piece out)");
+  if (!(settings.groove_guide_m >= 0.0) || !std::isfinite(settings.groove_guide_m))
+    return out_of_range("groove guide (m)", settings.groove_guide_m, "a finite value >= 0");
   return std::nullopt;
 }
 
@@ -239,24 +243,88 @@ struct SweepSurface {
   }
 };
 
+// The blade's edge at one instant, heel to tip: its two ends, or more points where it follows a
+// groove (bend_onto_grooves).
+using EdgePoints = std::vector<Eigen::Vector3d>;
+
 // The stroke's triangles, oriented alike (a stroke that turns back keeps one side one side);
-// degenerate ones (the blade still, or moving along itself) are left out.
-SweepSurface sweep_surface(const BladeStroke& stroke) {
+// degenerate ones (the blade still, or moving along itself) are left out. Between two instants
+// given by their ends, the triangles (heel_i, tip_i, tip_i+1) and (heel_i, tip_i+1, heel_i+1);
+// between instants bent onto a groove (as many points each), those of each stretch, on the side
+// of the straight ones (a stretch that climbs from a groove to the blade's own plane stands across
+// it, and its own normal says nothing of the stroke's sides).
+SweepSurface sweep_surface(const std::vector<EdgePoints>& edges,
+                           std::span<const std::array<Eigen::Vector3d, 2>> straight) {
   SweepSurface surface;
   double extent = 0.0;
-  for (std::size_t i = 0; i + 1 < stroke.edges_m.size(); ++i) {
-    const auto& [heel0, tip0] = stroke.edges_m[i];
-    const auto& [heel1, tip1] = stroke.edges_m[i + 1];
-    for (const Triangle& tri : {Triangle{heel0, tip0, tip1}, Triangle{heel0, tip1, heel1}}) {
-      const Eigen::Vector3d normal = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
-      const double longest =
-          std::max({(tri[1] - tri[0]).norm(), (tri[2] - tri[1]).norm(), (tri[0] - tri[2]).norm()});
-      if (!(longest > 0.0) || !(normal.norm() > 1e-12 * longest * longest)) continue;
-      extent = std::max(extent, longest);
-      Eigen::Vector3d unit = normal.normalized();
-      if (!surface.unit_normal.empty() && unit.dot(surface.unit_normal.front()) < 0.0) unit = -unit;
-      surface.triangle.push_back(tri);
-      surface.unit_normal.push_back(unit);
+  auto normal_of = [](const Triangle& tri, double& longest) -> std::optional<Eigen::Vector3d> {
+    const Eigen::Vector3d normal = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+    longest =
+        std::max({(tri[1] - tri[0]).norm(), (tri[2] - tri[1]).norm(), (tri[0] - tri[2]).norm()});
+    if (!(longest > 0.0) || !(normal.norm() > 1e-12 * longest * longest)) return std::nullopt;
+    return normal.normalized();
+  };
+  auto add = [&](const Triangle& tri, const Eigen::Vector3d* side) {
+    double longest = 0.0;
+    auto unit = normal_of(tri, longest);
+    if (!unit) return;
+    extent = std::max(extent, longest);
+    if (side) {
+      if (unit->dot(*side) < 0.0) *unit = -*unit;
+    } else if (!surface.unit_normal.empty() && unit->dot(surface.unit_normal.front()) < 0.0) {
+      *unit = -*unit;
+    }
+    surface.triangle.push_back(tri);
+    surface.unit_normal.push_back(*unit);
+  };
+  // A bent edge's points by their parameter along the straight edge (0 at the heel, 1 at the tip:
+  // a point is bent across the edge, so its parameter stays), and where it is at `t`.
+  auto parameters = [](const EdgePoints& edge, const std::array<Eigen::Vector3d, 2>& straight) {
+    const Eigen::Vector3d along = straight[1] - straight[0];
+    std::vector<double> t(edge.size());
+    for (std::size_t k = 0; k < edge.size(); ++k)
+      t[k] = k == 0 ? 0.0
+             : k + 1 == edge.size()
+                 ? 1.0
+                 : std::clamp((edge[k] - straight[0]).dot(along) / along.squaredNorm(), 0.0, 1.0);
+    return t;
+  };
+  auto point_at = [](const EdgePoints& edge, const std::vector<double>& t, double at) {
+    const auto k = static_cast<std::size_t>(
+        std::clamp<std::ptrdiff_t>(std::upper_bound(t.begin(), t.end(), at) - t.begin(), 1,
+                                   static_cast<std::ptrdiff_t>(t.size()) - 1));
+    const double span = t[k] - t[k - 1];
+    const double w = span > 0.0 ? (at - t[k - 1]) / span : 0.0;
+    return Eigen::Vector3d(edge[k - 1] + w * (edge[k] - edge[k - 1]));
+  };
+  std::vector<double> ta, tb, at;
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
+    if (edges[i].size() == 2 && edges[i + 1].size() == 2) {
+      const Eigen::Vector3d &heel0 = edges[i][0], &tip0 = edges[i][1];
+      const Eigen::Vector3d &heel1 = edges[i + 1][0], &tip1 = edges[i + 1][1];
+      add({heel0, tip0, tip1}, nullptr);
+      add({heel0, tip1, heel1}, nullptr);
+      continue;
+    }
+    // Both edges at the parameters of either's points.
+    ta = parameters(edges[i], straight[i]);
+    tb = parameters(edges[i + 1], straight[i + 1]);
+    at.assign(ta.begin(), ta.end());
+    at.insert(at.end(), tb.begin(), tb.end());
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end()), at.end());
+    const EdgePoints &a0 = edges[i], &b0 = edges[i + 1];
+    double longest = 0.0;
+    auto side = normal_of({a0.front(), a0.back(), b0.back()}, longest);
+    if (!side) side = normal_of({a0.front(), b0.back(), b0.front()}, longest);
+    if (!side) continue;
+    if (!surface.unit_normal.empty() && side->dot(surface.unit_normal.front()) < 0.0)
+      *side = -*side;
+    for (std::size_t k = 0; k + 1 < at.size(); ++k) {
+      const Eigen::Vector3d a = point_at(a0, ta, at[k]), a1 = point_at(a0, ta, at[k + 1]);
+      const Eigen::Vector3d b = point_at(b0, tb, at[k]), b1 = point_at(b0, tb, at[k + 1]);
+      add({a, a1, b1}, &*side);
+      add({a, b1, b}, &*side);
     }
   }
   surface.tolerance_m = 1e-9 * extent;
@@ -269,6 +337,124 @@ SweepSurface sweep_surface(const BladeStroke& stroke) {
   }
   surface.build_runs();
   return surface;
+}
+
+// The stroke's edges, each bent onto a cut already made where it runs beside one: a point of the
+// edge within `guide_m` of a cut face's plane (along the sweep's normal there), the face within
+// 10° of parallel to the sweep, is moved along that normal onto the plane, fully over the face and
+// less the farther beyond its border (to nothing at `guide_m`), so that the stroke continues the
+// cut from its front rather than cutting a sheet beside it. Points every kGuideSpacingM along the
+// edge; an edge near no cut face keeps its two ends. Instants `first` on, appended to `edges`.
+void bend_onto_grooves(const SimModel& model, const NodeArray& position_m,
+                       const BladeStroke& stroke, std::size_t first, double guide_m,
+                       std::vector<EdgePoints>& edges) {
+  for (std::size_t i = first; i < stroke.edges_m.size(); ++i)
+    edges.push_back({stroke.edges_m[i][0], stroke.edges_m[i][1]});
+  if (!(guide_m > 0.0) || model.cut_face_mask.empty() || stroke.edges_m.size() < 2 ||
+      first >= stroke.edges_m.size())
+    return;
+  Aabb stroke_box;
+  for (std::size_t i = first; i < stroke.edges_m.size(); ++i)
+    stroke_box.grow(Aabb::around(stroke.edges_m[i][0], stroke.edges_m[i][1], guide_m));
+  struct CutFace {
+    Triangle corner;
+    Eigen::Vector3d unit_normal;  // outward from its element
+    Aabb near;                    // its box grown by guide_m
+  };
+  std::vector<CutFace> faces;
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const std::uint8_t mask = model.cut_face_mask[e];
+    if (mask == 0) continue;
+    for (int f = 0; f < 4; ++f) {
+      if (!((mask >> f) & 1)) continue;
+      CutFace face;
+      for (int k = 0; k < 3; ++k) face.corner[k] = position_m.at(model.corner[kTetFace[f][k]][e]);
+      face.near = Aabb::around(face.corner[0], face.corner[1], guide_m);
+      face.near.grow(Aabb::around(face.corner[2], face.corner[2], guide_m));
+      if (!face.near.overlaps(stroke_box)) continue;
+      const Eigen::Vector3d normal =
+          (face.corner[1] - face.corner[0]).cross(face.corner[2] - face.corner[0]);
+      if (!(normal.norm() > 0.0)) continue;
+      // Outward from its element: away from the corner across from it.
+      const Eigen::Vector3d across = position_m.at(model.corner[f][e]) - face.corner[0];
+      face.unit_normal = (across.dot(normal) > 0.0 ? -normal : normal).normalized();
+      faces.push_back(face);
+    }
+  }
+  if (faces.empty()) return;
+  constexpr double kGuideSpacingM = 0.002;
+  const double kCosGuideAngle = std::cos(std::numbers::pi / 18.0);  // 10°
+  double longest_edge_m = 0.0;
+  for (std::size_t i = first; i < stroke.edges_m.size(); ++i)
+    longest_edge_m = std::max(longest_edge_m, (stroke.edges_m[i][1] - stroke.edges_m[i][0]).norm());
+  const auto stretches =
+      static_cast<std::size_t>(std::clamp(std::ceil(longest_edge_m / kGuideSpacingM), 1.0, 256.0));
+  std::vector<const CutFace*> near;
+  const std::size_t count = stroke.edges_m.size();
+  for (std::size_t i = first; i < count; ++i) {
+    const auto& [heel, tip] = stroke.edges_m[i];
+    // The sweep's normal at this instant: the edge across its direction of travel.
+    const auto& before = stroke.edges_m[i == 0 ? 0 : i - 1];
+    const auto& after = stroke.edges_m[std::min(i + 1, count - 1)];
+    const Eigen::Vector3d travel = (after[0] + after[1]) - (before[0] + before[1]);
+    const Eigen::Vector3d across = (tip - heel).cross(travel);
+    if (!(across.norm() > 1e-12 * (tip - heel).norm() * travel.norm())) continue;
+    const Eigen::Vector3d normal = across.normalized();
+    const Aabb edge_box = Aabb::around(heel, tip, 0.0);
+    near.clear();
+    for (const CutFace& face : faces)
+      if (face.near.overlaps(edge_box) && std::abs(face.unit_normal.dot(normal)) >= kCosGuideAngle)
+        near.push_back(&face);
+    if (near.empty()) continue;
+    EdgePoints points(stretches + 1);
+    bool moved = false;
+    for (std::size_t k = 0; k <= stretches; ++k) {
+      const Eigen::Vector3d q = heel + (double(k) / double(stretches)) * (tip - heel);
+      double best_score = std::numeric_limits<double>::infinity(), offset_m = 0.0;
+      for (const CutFace* face : near) {
+        // In front of the face (in the gap the blade holds open, or out of the tissue), the
+        // edge is in the groove already; behind it, in the tissue beside the cut.
+        const double behind_m = (q - face->corner[0]).dot(face->unit_normal);
+        if (behind_m > 0.0) continue;
+        const double d = behind_m / face->unit_normal.dot(normal);
+        if (std::abs(d) > guide_m) continue;
+        const Eigen::Vector3d on_plane = q - d * normal;
+        std::array<double, 3> weight;
+        const double beyond_m =
+            (closest_point_on_triangle(on_plane, face->corner[0], face->corner[1], face->corner[2],
+                                       weight) -
+             on_plane)
+                .norm();
+        if (beyond_m >= guide_m) continue;
+        const double score = beyond_m + std::abs(d);
+        if (score < best_score) {
+          best_score = score;
+          offset_m = (1.0 - beyond_m / guide_m) * d;
+        }
+      }
+      points[k] = q - offset_m * normal;
+      moved |= offset_m != 0.0;
+    }
+    if (!moved) continue;
+    // Points in line with their neighbours say nothing: the sweep keeps its triangles few.
+    EdgePoints kept{points.front()};
+    for (std::size_t k = 1; k + 1 < points.size(); ++k) {
+      const Eigen::Vector3d chord = points[k + 1] - kept.back();
+      const Eigen::Vector3d off = points[k] - kept.back();
+      if ((off - off.dot(chord) / chord.squaredNorm() * chord).norm() > 1e-7)
+        kept.push_back(points[k]);
+    }
+    kept.push_back(points.back());
+    edges[edges.size() - (count - i)] = std::move(kept);
+  }
+}
+
+// The stroke's edges as they cut: those it keeps bent, the rest bent now.
+std::vector<EdgePoints> cutting_edges(const SimModel& model, const NodeArray& position_m,
+                                      const BladeStroke& stroke, double guide_m) {
+  std::vector<EdgePoints> edges(stroke.cutting_edges_m.begin(), stroke.cutting_edges_m.end());
+  bend_onto_grooves(model, position_m, stroke, edges.size(), guide_m, edges);
+  return edges;
 }
 
 // Whether the tetrahedron p touches the sweep: an edge of one meets a face of the other, or the
@@ -1284,7 +1470,8 @@ double frequency_ceiling(const SimModel& model) {
 CutResult cut_along(const SimModel& model, const SimState& state, const SweepSurface& surface,
                     const CuttingSettings& settings, const AfterSplitting* after,
                     const SweepSurface* front = nullptr,
-                    const std::vector<std::uint8_t>* half_floor = nullptr) {
+                    const std::vector<std::uint8_t>* half_floor = nullptr,
+                    const SweepSurface* recent = nullptr) {
   CutResult result;
   CutReport& report = result.report;
   FaceNeighbours neighbours(model);
@@ -1300,8 +1487,12 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
       reference_m, std::max(settings.min_part_height_m, kLeastPartOfReference * reference_m));
 
   // 1. The elements the sweep touches, and those of them stressed past the threshold.
+  // (Elements the stroke touched since the last update but a few instants, when the stroke says
+  // which those are: those it passed before were cut then, and looking at them again cost an
+  // update of a long, deep stroke tens of milliseconds.)
+  const SweepSurface& zone_sweep = recent ? *recent : surface;
   Aabb sweep_box;
-  for (const Aabb& box : surface.box) sweep_box.grow(box);
+  for (const Aabb& box : zone_sweep.box) sweep_box.grow(box);
   const std::size_t tets = model.tet_count;
   std::vector<std::uint8_t> swept(tets, 0), over_threshold(tets, 0);
   std::vector<std::size_t> zone;
@@ -1314,7 +1505,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
     const auto p = corners_at(model, state.position_m, e);
     Aabb box;
     for (const auto& q : p) box.grow(q);
-    if (!box.overlaps(sweep_box) || !tet_touches_sweep(p, box, surface)) continue;
+    if (!box.overlaps(sweep_box) || !tet_touches_sweep(p, box, zone_sweep)) continue;
     swept[e] = 1;
     zone.push_back(e);
     over_threshold[e] = is_over_threshold(e);
@@ -1375,7 +1566,8 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
       AfterSplitting refinement;
       refinement.reshaped_around = refined.reshaped_around;
       refinement.may_make_nodes = true;
-      CutResult cut = cut_along(*refined.model, refined.state, surface, settings, &refinement);
+      CutResult cut = cut_along(*refined.model, refined.state, surface, settings, &refinement,
+                                nullptr, nullptr, recent);
       if (!cut.cut()) {
         // Nothing parted: the refined model stands, its small parts given mass here.
         SimModel& m = *refined.model;
@@ -1822,7 +2014,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
         for (int c = 0; c < 4; ++c)
           for_each_element_of(model, model.corner[c][e], [&](std::size_t o) { thinner[o] = 1; });
       }
-    if (any) return cut_along(model, state, surface, settings, after, front, &thinner);
+    if (any) return cut_along(model, state, surface, settings, after, front, &thinner, recent);
   }
 
   // A free body the merges left one element is a flap of its own: a crumb (a lone element's
@@ -1981,6 +2173,19 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
 
 }  // namespace
 
+// The instants before the settled ones a cut looks at again (2 mm of a stroke in the loop): a
+// bridge an update had to leave joined (a pinched node, a part too thin to make) may part once the
+// next update has changed the mesh around it.
+constexpr std::size_t kInstantsLookedAtAgain = 20;
+
+void follow_grooves(BladeStroke& stroke, const SimModel& model, const NodeArray& position_m,
+                    double guide_m) {
+  if (stroke.cutting_edges_m.size() > stroke.edges_m.size())
+    throw std::invalid_argument("the blade's stroke has more cutting edges than instants");
+  bend_onto_grooves(model, position_m, stroke, stroke.cutting_edges_m.size(), guide_m,
+                    stroke.cutting_edges_m);
+}
+
 CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
                      const CuttingSettings& settings) {
   if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
@@ -1988,15 +2193,34 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
     if (!edge[0].allFinite() || !edge[1].allFinite())
       throw std::invalid_argument("the blade's stroke is not finite");
   // A blade that did not move sweeps nothing.
-  const SweepSurface surface = sweep_surface(stroke);
+  if (stroke.cutting_edges_m.size() > stroke.edges_m.size())
+    throw std::invalid_argument("the blade's stroke has more cutting edges than instants");
+  for (const auto& edge : stroke.cutting_edges_m)
+    for (const auto& point : edge)
+      if (!point.allFinite()) throw std::invalid_argument("the blade's stroke is not finite");
+  const std::vector<EdgePoints> edges =
+      cutting_edges(model, state.position_m, stroke, settings.groove_guide_m);
+  const SweepSurface surface = sweep_surface(edges, stroke.edges_m);
   if (surface.size() == 0) return {};
-  if (settings.refine_edge_m > 0.0 && stroke.edges_m.size() >= 2) {
-    BladeStroke last;
-    last.edges_m.assign(stroke.edges_m.end() - 2, stroke.edges_m.end());
-    const SweepSurface front = sweep_surface(last);
-    if (front.size() > 0) return cut_along(model, state, surface, settings, nullptr, &front);
+  std::optional<SweepSurface> recent;
+  if (stroke.settled_instants > 0) {
+    const std::size_t from =
+        stroke.settled_instants > kInstantsLookedAtAgain + 1
+            ? std::min(stroke.settled_instants - kInstantsLookedAtAgain - 1, edges.size() - 1)
+            : 0;
+    if (from > 0)
+      recent = sweep_surface(std::vector<EdgePoints>(edges.begin() + from, edges.end()),
+                             std::span(stroke.edges_m).subspan(from));
   }
-  return cut_along(model, state, surface, settings, nullptr);
+  if (settings.refine_edge_m > 0.0 && edges.size() >= 2) {
+    const SweepSurface front = sweep_surface(std::vector<EdgePoints>(edges.end() - 2, edges.end()),
+                                             std::span(stroke.edges_m).last(2));
+    if (front.size() > 0)
+      return cut_along(model, state, surface, settings, nullptr, &front, nullptr,
+                       recent ? &*recent : nullptr);
+  }
+  return cut_along(model, state, surface, settings, nullptr, nullptr, nullptr,
+                   recent ? &*recent : nullptr);
 }
 
 std::vector<std::uint8_t> organ_elements(const SimModel& model) {

@@ -166,7 +166,7 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
             pressed.fracture_toughness_j_per_m2 * blade_edge_in_contact_m(blade, scalpel.geometry))
       return;
     hand.blade_in_tissue = true;
-    hand.stroke.edges_m.assign(1, cutting_edge_m(scalpel));
+    hand.stroke.restart(cutting_edge_m(scalpel));
     return;
   }
   resist_cutting(hand, edge, in);
@@ -179,12 +179,14 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   if (!in.within_reach) return hand.end_stroke();
   // Disarmed, the blade passes on without cutting; armed again, the stroke goes on from here.
   if (!scalpel.blade_armed) {
-    hand.stroke.edges_m.assign(1, edge);
+    hand.stroke.restart(edge);
     return;
   }
   hand.stroke.add(edge);
-  if (hand.stroke.edges_m.size() < 2) return;
   const auto update_start = std::chrono::steady_clock::now();
+  // Each instant follows the groove it is in as the tissue is now (CuttingSettings).
+  follow_grooves(hand.stroke, *model_, state_.position_m, cutting_->groove_guide_m);
+  if (hand.stroke.edges_m.size() < 2) return;
   // Once in, the edge cuts whatever it is drawn through: the stress at a sharp edge in the tissue
   // (a crack front) is unbounded, which no element's average resolves, so the threshold decides
   // only where the blade breaks in. Otherwise the tissue, relaxed around a still blade, would let
@@ -195,6 +197,7 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   // the shipped meshes (elements 10–14 mm across).
   propagating.refine_edge_m = kBladeRefineEdgeM;
   CutResult cut = cut_tissue(*model_, state_, hand.stroke, propagating);
+  hand.stroke.settled_instants = hand.stroke.edges_m.size();
   const auto trace_cut = [&](bool parted) {
     if (!trace_) return;
     LoopRecord record;

@@ -77,6 +77,13 @@ struct CuttingSettings {
   // A piece that comes free stays as a body of its own when its rest volume is at least this (a
   // specimen); smaller pieces (crumbs) are taken out at once (infinity: every piece is taken out).
   double min_free_body_volume_m3 = 1e-6;
+  // A stroke drawn beside a cut already made, within this distance of its surface and within 10°
+  // of parallel to it, follows that cut (0: never): a blade drawn into an incision is guided by
+  // its lips instead of cutting a second sheet beside it. Deepening a groove stroke after stroke
+  // in tissue that moved between the strokes otherwise cut sheets up to ~3 mm apart in the
+  // material, whose slivers kept a lobe joined to the organ (issue 42). It is also the closest a
+  // stroke can slice parallel to an earlier cut.
+  double groove_guide_m = 0.004;
 };
 
 // The problem with the settings, if any (a message naming the setting, its value and what is
@@ -86,12 +93,40 @@ std::optional<std::string> validate(const CuttingSettings& settings);
 // The surface a blade edge sweeps over a stroke: the edge (heel, tip) at successive instants
 // (scene, m); between instants i and i + 1 it covers the triangles (heel_i, tip_i, tip_i+1) and
 // (heel_i, tip_i+1, heel_i+1). An element is cut once the stroke has passed all the way through
-// it, however many instants that took, so a stroke keeps all its edges until it ends.
+// it, however many instants that took, so a stroke keeps all its edges until it ends. Where the
+// edge runs beside an earlier cut (CuttingSettings::groove_guide_m) it is bent onto that cut's
+// surface, as it is now in the tissue, before the sweep is taken.
 struct BladeStroke {
   std::vector<std::array<Eigen::Vector3d, 2>> edges_m;
+  // The first instants' edges as they cut, heel to tip: bent onto the cut each ran beside when it
+  // was taken (follow_grooves), so that the tissue's later motion does not move them. Instants
+  // past these are bent when the stroke is cut.
+  std::vector<std::vector<Eigen::Vector3d>> cutting_edges_m;
+  // The instants an earlier cut of this stroke took in (the real-time loop sets it after each
+  // update): what the stroke passed through before them was cut then, so a cut looks only at the
+  // elements the stroke touched since (and a few instants before). 0: every element it touched.
+  std::size_t settled_instants = 0;
 
   void add(const std::array<Eigen::Vector3d, 2>& edge_m) { edges_m.push_back(edge_m); }
+  // A stroke of the one instant `edge_m`.
+  void restart(const std::array<Eigen::Vector3d, 2>& edge_m) {
+    edges_m.assign(1, edge_m);
+    cutting_edges_m.clear();
+    settled_instants = 0;
+  }
+  void clear() {
+    edges_m.clear();
+    cutting_edges_m.clear();
+    settled_instants = 0;
+  }
 };
+
+// Bends the stroke's instants not yet bent onto the cuts they run beside in the tissue as it is
+// now (CuttingSettings::groove_guide_m; each instant's sweep normal from the instants on either
+// side of it, or the one before, taken as they come): the real-time loop calls it as it adds each
+// instant, so that an instant follows the groove it was in.
+void follow_grooves(BladeStroke& stroke, const SimModel& model, const NodeArray& position_m,
+                    double guide_m);
 
 // The scalpel's edge (heel, tip) in the scene.
 std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel);
