@@ -80,7 +80,7 @@ int run(const CutBenchOptions& o) {
                   Eigen::Vector3d(x, centre.y(), box.min().z() - 0.01)});
       UpdateTimes times;
       const auto t0 = clock::now();
-      CutResult cut = cut_tissue(*model, state, stroke, settings);
+      CutResult cut = cut_stroke_so_far(*model, state, stroke, settings);
       const auto t1 = clock::now();
       times.cut_ms = times.whole_ms = ms(t0, t1);
       if ((times.cut = cut.cut())) {
@@ -134,8 +134,10 @@ int run(const CutBenchOptions& o) {
       << "drawn " << o.stroke_mm << " mm along the built-in liver (" << start_tets
       << " tetrahedra) through its whole depth in steps of " << o.step_mm
       << " mm; after each step the cut is\n"
-      << "updated with the stroke so far (`cut_tissue`), and when it changed the mesh the surface "
-         "is\n"
+      << "updated with the stroke so far as the real-time loop updates it (`cut_stroke_so_far`: "
+         "the new\n"
+      << "instant bent onto a groove it runs beside, then `cut_tissue`), and when it changed the "
+         "mesh the surface is\n"
       << "read again (`boundary_surface`) and the contact hierarchy rebuilt. The cutting threshold "
          "is 0 (the blade "
          "cuts\n"
@@ -155,7 +157,7 @@ int run(const CutBenchOptions& o) {
   };
   row("every update (cut, and surface and hierarchy when it cut)", all_ms);
   row("updates that cut, whole", cutting_ms);
-  row("`cut_tissue` alone, every update", cut_ms);
+  row("`cut_stroke_so_far` alone, every update", cut_ms);
   row("surface (`boundary_surface`), updates that cut", surface_ms);
   row("hierarchy build, updates that cut", bvh_ms);
   const double slowest_ms = all_ms.empty() ? 0.0 : *std::max_element(all_ms.begin(), all_ms.end());

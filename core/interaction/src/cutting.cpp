@@ -2223,6 +2223,14 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
                    recent ? &*recent : nullptr);
 }
 
+CutResult cut_stroke_so_far(const SimModel& model, const SimState& state, BladeStroke& stroke,
+                            const CuttingSettings& settings) {
+  follow_grooves(stroke, model, state.position_m, settings.groove_guide_m);
+  CutResult cut = cut_tissue(model, state, stroke, settings);
+  stroke.settled_instants = stroke.edges_m.size();
+  return cut;
+}
+
 std::vector<std::uint8_t> organ_elements(const SimModel& model) {
   Pieces pieces(model);
   std::vector<std::uint8_t> organ(model.tet_count, 0);

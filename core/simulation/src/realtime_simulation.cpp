@@ -183,10 +183,8 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
     return;
   }
   hand.stroke.add(edge);
-  const auto update_start = std::chrono::steady_clock::now();
-  // Each instant follows the groove it is in as the tissue is now (CuttingSettings).
-  follow_grooves(hand.stroke, *model_, state_.position_m, cutting_->groove_guide_m);
   if (hand.stroke.edges_m.size() < 2) return;
+  const auto update_start = std::chrono::steady_clock::now();
   // Once in, the edge cuts whatever it is drawn through: the stress at a sharp edge in the tissue
   // (a crack front) is unbounded, which no element's average resolves, so the threshold decides
   // only where the blade breaks in. Otherwise the tissue, relaxed around a still blade, would let
@@ -196,8 +194,8 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   // And the mesh is refined around the blade as it goes, so that a short stroke parts tissue on
   // the shipped meshes (elements 10–14 mm across).
   propagating.refine_edge_m = kBladeRefineEdgeM;
-  CutResult cut = cut_tissue(*model_, state_, hand.stroke, propagating);
-  hand.stroke.settled_instants = hand.stroke.edges_m.size();
+  // Each instant follows the groove it is in as the tissue is now (CuttingSettings).
+  CutResult cut = cut_stroke_so_far(*model_, state_, hand.stroke, propagating);
   const auto trace_cut = [&](bool parted) {
     if (!trace_) return;
     LoopRecord record;

@@ -202,6 +202,12 @@ struct CutResult {
 CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
                      const CuttingSettings& settings);
 
+// An update of a stroke as the blade goes on: its instants not yet bent follow their grooves
+// (follow_grooves), the stroke so far is cut, and its instants are settled for the next update.
+// The real-time loop and bench-cut both update a stroke this way.
+CutResult cut_stroke_so_far(const SimModel& model, const SimState& state, BladeStroke& stroke,
+                            const CuttingSettings& settings);
+
 // Von Mises equivalent of the Cauchy stress of element e in `state` (Pa): of the elastic part
 // F·Fp⁻¹ in viscous regions (the instantaneous response, before the Maxwell arm relaxes).
 double element_cutting_stress_pa(const SimModel& model, const SimState& state, std::size_t e);
