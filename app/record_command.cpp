@@ -331,7 +331,7 @@ std::function<std::optional<int>()> add_record_command(CLI::App& app) {
       "--left-trajectory", options->left_trajectory,
       "A second scripted device, in the left hand (forceps holding while the right "
       "hand cuts): its trajectory, as --trajectory's, in the same device frame; the "
-      "session's input log has its tools, its frames are not recorded yet");
+      "session records its frames, events and metrics as the right hand's, tagged left");
   auto* left_tool =
       command
           ->add_option("--left-tool", options->left_tool,
