@@ -1,6 +1,7 @@
 // The embedded session store on real SQLite files: sessions written and read back exactly, a
 // writer killed mid-session, and files that are damaged, foreign, newer, read-only or full.
 #include "liversim/engine/forces.h"
+#include "liversim/engine/health.h"
 #include "liversim/sessions/session_recorder.h"
 #include "liversim/sessions/session_replay.h"
 #include "liversim/storage/sqlite_session_store.h"
@@ -577,8 +578,9 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
-// A session recorded once the blade follows the groove it is in (issue 42), by the same command as
-// above (tests/data/storage/session-v7-scalpel-cuts-guided.sqlite): replayed by today's engine, its
+// A session recorded once the blade follows the groove it is in and a cut's mass scaling looks one
+// element beyond the cut (issue 42), by the same command as above
+// (tests/data/storage/session-v7-scalpel-cuts-guided.sqlite): replayed by today's engine, its
 // final positions and velocities are those its replay gave when it was recorded, to the last bit.
 // Bit for bit holds for one build of the engine, the one the digest was taken with: GCC's
 // optimised build with the AVX2+FMA element kernels. Other builds skip. A deliberate change of the
@@ -591,10 +593,36 @@ TEST(SessionReplay, ARecordedSessionReplaysToTheSameStateBitForBit) {
       "recorded-following-the-groove");
   // Each refinement around the blade is a topology change of its own.
   EXPECT_EQ(end.cuts, 33u);
-  EXPECT_EQ(end.nodes, 478u);
-  EXPECT_EQ(end.steps, 3060u);
+  EXPECT_EQ(end.nodes, 477u);
+  EXPECT_EQ(end.steps, 3049u);
   EXPECT_EQ(end.time_s, 2.5995903787974228);
-  EXPECT_EQ(end.digest, 0x9c0cce4e357ad1adull);
+  EXPECT_EQ(end.digest, 0xbfe8f51a4c861615ull);
+}
+
+// A free-practice session whose live loop the health guard halted (recorded at 3ec318a by
+// `liversim-cli record --tets 5406 --tool scalpel --trajectory
+// tests/data/trajectories/free-practice-three-strokes.txt`; about 1 run in 5 halted so): at 5.7 s
+// a cut left a mode of 3059 rad/s over the whole mesh, past the loop's 0.675 ms step (its limit
+// 0.654 ms), which the block around the cut its mass scaling looked at had not seen, and the
+// replay of that engine halts there too (its log holds no steps after: the replay ends at 4.6 s
+// simulated). The scaling now looks one element further; today's engine replays the same hand
+// without a rollback.
+TEST(SessionReplay, AStrokeWhoseCutOnceHaltedTheLoopReplaysToItsEnd) {
+  const fs::path file = fresh_database("halted-at-3ec318a");
+  fs::copy_file(fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" /
+                    "session-v7-free-practice-halted-at-3ec318a.sqlite",
+                file);
+  SqliteSessionStore store(file, SqliteSessionStore::Access::read_only);
+  const std::optional<ReplaySetup> setup = store.replay_setup(1);
+  ASSERT_TRUE(setup);
+  SessionReplay replay(replay_scene(*setup, store.scenario_text(1)), store.inputs(1),
+                       setup->loop_step_s);
+  EXPECT_TRUE(replay.advance_to(std::numeric_limits<double>::infinity()));
+  const RealtimeStats stats = replay.simulation().stats();
+  EXPECT_FALSE(stats.halted) << health_problem_text(stats.last_problem);
+  replay.simulation().update_snapshot();
+  EXPECT_GT(replay.simulation().snapshot().topology_version, 0u) << "its scalpel cut nothing";
+  EXPECT_EQ(stats.rollbacks, 0) << "the guard had to roll a step back";
 }
 
 // A session whose stored loop step is no step (a damaged or hand-edited file: negative, zero, or
