@@ -676,6 +676,21 @@ TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
   BladeStroke stroke = vertical_cut(0.032, 0.005);
   stroke.edges_m[1][0].x() = std::nan("");
   EXPECT_THROW(cut_tissue(model, state, stroke, cut_anything()), std::invalid_argument);
+  // Its kept cutting edges: one not finite, or more of them than instants, each named.
+  auto refusal = [&](const BladeStroke& bad) -> std::string {
+    try {
+      cut_tissue(model, state, bad, cut_anything());
+    } catch (const std::invalid_argument& error) {
+      return error.what();
+    }
+    return "taken";
+  };
+  BladeStroke kept = vertical_cut(0.032, 0.005);
+  kept.cutting_edges_m.push_back({kept.edges_m[0][0], Eigen::Vector3d::Constant(INFINITY)});
+  EXPECT_NE(refusal(kept).find("not finite"), std::string::npos) << refusal(kept);
+  kept.cutting_edges_m.assign(3, {kept.edges_m[0][0], kept.edges_m[0][1]});
+  EXPECT_NE(refusal(kept).find("more cutting edges than instants"), std::string::npos)
+      << refusal(kept);
   CuttingSettings settings;
   settings.cutting_stress_pa = -1.0;
   try {

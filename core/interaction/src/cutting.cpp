@@ -2197,6 +2197,9 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
 // next update has changed the mesh around it.
 constexpr std::size_t kInstantsLookedAtAgain = 20;
 
+namespace {
+
+// Bends the stroke's instants not yet bent, with the tissue as it is now, and keeps them so.
 void follow_grooves(BladeStroke& stroke, const SimModel& model, const NodeArray& position_m,
                     double guide_m) {
   if (stroke.cutting_edges_m.size() > stroke.edges_m.size())
@@ -2204,6 +2207,8 @@ void follow_grooves(BladeStroke& stroke, const SimModel& model, const NodeArray&
   bend_onto_grooves(model, position_m, stroke, stroke.cutting_edges_m.size(), guide_m,
                     stroke.cutting_edges_m);
 }
+
+}  // namespace
 
 CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
                      const CuttingSettings& settings) {

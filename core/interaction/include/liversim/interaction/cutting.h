@@ -99,10 +99,10 @@ std::optional<std::string> validate(const CuttingSettings& settings);
 struct BladeStroke {
   std::vector<std::array<Eigen::Vector3d, 2>> edges_m;
   // The first instants' edges as they cut, heel to tip: bent onto the cut each ran beside when it
-  // was taken (follow_grooves), so that the tissue's later motion does not move them. Instants
+  // was taken (cut_stroke_so_far), so that the tissue's later motion does not move them. Instants
   // past these are bent when the stroke is cut.
   std::vector<std::vector<Eigen::Vector3d>> cutting_edges_m;
-  // The instants an earlier cut of this stroke took in (the real-time loop sets it after each
+  // The instants an earlier cut of this stroke took in (cut_stroke_so_far sets it after each
   // update): what the stroke passed through before them was cut then, so a cut looks only at the
   // elements the stroke touched since (and a few instants before). 0: every element it touched.
   std::size_t settled_instants = 0;
@@ -120,13 +120,6 @@ struct BladeStroke {
     settled_instants = 0;
   }
 };
-
-// Bends the stroke's instants not yet bent onto the cuts they run beside in the tissue as it is
-// now (CuttingSettings::groove_guide_m; each instant's sweep normal from the instants on either
-// side of it, or the one before, taken as they come): the real-time loop calls it as it adds each
-// instant, so that an instant follows the groove it was in.
-void follow_grooves(BladeStroke& stroke, const SimModel& model, const NodeArray& position_m,
-                    double guide_m);
 
 // The scalpel's edge (heel, tip) in the scene.
 std::array<Eigen::Vector3d, 2> blade_edge_m(const Tool& scalpel);
@@ -202,8 +195,9 @@ struct CutResult {
 CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
                      const CuttingSettings& settings);
 
-// An update of a stroke as the blade goes on: its instants not yet bent follow their grooves
-// (follow_grooves), the stroke so far is cut, and its instants are settled for the next update.
+// An update of a stroke as the blade goes on: its instants not yet bent are bent onto the cuts
+// they run beside in the tissue as it is now (CuttingSettings::groove_guide_m), the stroke so far
+// is cut, and its instants are settled for the next update.
 // The real-time loop and bench-cut both update a stroke this way.
 CutResult cut_stroke_so_far(const SimModel& model, const SimState& state, BladeStroke& stroke,
                             const CuttingSettings& settings);
