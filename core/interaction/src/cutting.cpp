@@ -42,6 +42,9 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
     return out_of_range("split fraction", settings.split_min_fraction, "a value in (0, 0.5]");
   if (!(settings.refine_edge_m >= 0.0) || !std::isfinite(settings.refine_edge_m))
     return out_of_range("refinement edge (m)", settings.refine_edge_m, "a finite value >= 0");
+  if (!(settings.refine_over_stroke_m >= 0.0))  // infinity: all along
+    return out_of_range("refinement stretch (m)", settings.refine_over_stroke_m,
+                        "a value >= 0 (infinity: all along the stroke)");
   if (!(settings.min_part_height_m > 0.0) || !std::isfinite(settings.min_part_height_m))
     return out_of_range("smallest part height (m)", settings.min_part_height_m,
                         "a finite value > 0");
@@ -2210,6 +2213,26 @@ void follow_grooves(BladeStroke& stroke, const SimModel& model, const NodeArray&
 
 }  // namespace
 
+namespace {
+
+// Whether the stroke refines the mesh around its front now (CuttingSettings::refine_over_stroke_m):
+// on its first stretch, and while the cuts' added mass leaves their own thin parts half the budget.
+bool refines_at(const SimModel& model, std::span<const std::array<Eigen::Vector3d, 2>> edges_m,
+                const CuttingSettings& settings) {
+  if (model.added_mass_kg >=
+      kRefinementBudgetShare * settings.max_added_mass_fraction * tissue_mass_kg(model))
+    return false;
+  double travel_m = 0.0;
+  for (std::size_t i = 1; i < edges_m.size(); ++i) {
+    travel_m +=
+        0.5 * ((edges_m[i][0] + edges_m[i][1]) - (edges_m[i - 1][0] + edges_m[i - 1][1])).norm();
+    if (travel_m > settings.refine_over_stroke_m) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
                      const CuttingSettings& settings) {
   if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
@@ -2236,7 +2259,8 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
       recent = sweep_surface(std::vector<EdgePoints>(edges.begin() + from, edges.end()),
                              std::span(stroke.edges_m).subspan(from));
   }
-  if (settings.refine_edge_m > 0.0 && edges.size() >= 2) {
+  if (settings.refine_edge_m > 0.0 && edges.size() >= 2 &&
+      refines_at(model, stroke.edges_m, settings)) {
     const SweepSurface front = sweep_surface(std::vector<EdgePoints>(edges.end() - 2, edges.end()),
                                              std::span(stroke.edges_m).last(2));
     if (front.size() > 0)

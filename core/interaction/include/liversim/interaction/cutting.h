@@ -67,6 +67,13 @@ struct CuttingSettings {
   // only at a node whose elements the cut parts all round, and a 2 cm stroke over elements 14 mm
   // across has none (issue 42).
   double refine_edge_m = 0.0;
+  // ... but only over a stroke's first stretch: while its edge's middle has travelled at most this
+  // far from where the stroke began (infinity: all along), and while the cuts have added less than
+  // half the mass they may (max_added_mass_fraction; the rest is for the thin parts a cut itself
+  // leaves). Past two elements of the coarsest shipped mesh a stroke opens its crack without
+  // refinement, and refining all along spent the whole budget: the shipped wedge resection's four
+  // passes exhausted it in their third, and the loop's step halved (issue 42).
+  double refine_over_stroke_m = 0.03;
   // No element a snap moves or a split or refinement makes may be thinner than this at rest,
   // unless the mesh already had one as thin: the explicit step goes with the smallest height. (Each
   // guarding only relative to its own element, a refined mesh's cuts brought the step to 0.02 ms.)
@@ -85,6 +92,9 @@ struct CuttingSettings {
   // stroke can slice parallel to an earlier cut.
   double groove_guide_m = 0.004;
 };
+
+// The share of CuttingSettings::max_added_mass_fraction past which a stroke no longer refines.
+inline constexpr double kRefinementBudgetShare = 0.5;
 
 // The problem with the settings, if any (a message naming the setting, its value and what is
 // expected).
