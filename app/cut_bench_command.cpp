@@ -218,10 +218,26 @@ std::function<std::optional<int>()> add_cut_bench_command(CLI::App& app) {
       "until the tool column says otherwise)");
   command->add_option("--scenario", live->scenario,
                       "--live: the scenario to cut (default: free practice at --tets)");
-  return [command, options, live, live_asked, trajectory]() -> std::optional<int> {
+  auto* left_trajectory = command->add_option(
+      "--left-trajectory", live->left_trajectory,
+      "--live: a second scripted device, in the left hand (forceps holding the lobe while the "
+      "scalpel cuts), in the same device frame as --trajectory");
+  auto* left_tool = command
+                        ->add_option("--left-tool", live->left_tool,
+                                     "--live: what the left hand holds (hand, probe, forceps or "
+                                     "scalpel) until its trajectory's tool column says otherwise")
+                        ->capture_default_str();
+  return [command, options, live, live_asked, trajectory, left_trajectory,
+          left_tool]() -> std::optional<int> {
     if (!command->parsed()) return std::nullopt;
+    const bool live_only =
+        trajectory->count() > 0 || left_trajectory->count() > 0 || left_tool->count() > 0;
+    if (!*live_asked && live_only)
+      return fail("--trajectory, --left-trajectory and --left-tool go with --live");
     if (!*live_asked) return run(*options);
     if (trajectory->count() == 0) return fail("bench-cut --live needs --trajectory");
+    if (left_tool->count() > 0 && left_trajectory->count() == 0)
+      return fail("--left-tool needs --left-trajectory: the left hand's device plays it");
     live->tets = options->tets;
     live->output_dir = options->output_dir;
     return run_live_cut_bench(*live);

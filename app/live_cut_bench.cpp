@@ -58,20 +58,29 @@ std::string ms_text(double seconds) {
 }  // namespace
 
 int run_live_cut_bench(const LiveCutBenchOptions& o) {
-  std::vector<TrajectoryPoint> script;
+  std::vector<TrajectoryPoint> script, left_script;
   std::optional<OpenedScenario> scenario;
-  std::optional<ScriptedTools> tools;  // the scalpel, unless the trajectory's tool column says
+  std::optional<ScriptedTools> tools;       // the scalpel, unless the trajectory's tool column says
+  std::optional<ScriptedTools> left_tools;  // --left-tool, then the left trajectory's
   try {
     TrajectoryFile file = read_trajectory_file(o.trajectory);
     script = std::move(file.points);
+    std::optional<TrajectoryFile> left_file;
+    if (o.left_trajectory) left_file = read_trajectory_file(*o.left_trajectory);
     scenario = open_scenario_to_run(o.scenario);
     std::optional<AllowedTools> allowed;
     if (scenario) allowed = AllowedTools{scenario->scenario.tools, o.scenario->string()};
     tools.emplace(ToolKind::scalpel, file.tool_changes, allowed);
+    if (left_file) {
+      left_script = std::move(left_file->points);
+      left_tools.emplace(tool_for_the_hand(o.left_tool, allowed, "--left-tool"),
+                         left_file->tool_changes, allowed, Hand::left);
+    }
   } catch (const std::exception& e) {
     return fail(e.what());
   }
-  const double duration_s = script.empty() ? 0.0 : script.back().time_s;
+  double duration_s = script.empty() ? 0.0 : script.back().time_s;
+  if (!left_script.empty()) duration_s = std::max(duration_s, left_script.back().time_s);
   if (!(duration_s > 0.0))
     return fail("the trajectory " + o.trajectory.string() + " lasts 0 s: nothing to cut");
 
@@ -89,13 +98,8 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
 
   const Eigen::Quaterniond view_axes = opening_view_device_axes();
   StationListener listener;
-  listener.device_tool = [&]() -> std::optional<DeviceToolSettings> {
-    if (!tools->held()) return std::nullopt;
-    DeviceToolSettings held;
-    held.kind = *tools->held();
-    held.orientation = tool_orientation_from_view(view_axes);
-    return held;
-  };
+  listener.device_tool = [&] { return scripted_tool_held(tools, view_axes); };
+  listener.left_device_tool = [&] { return scripted_tool_held(left_tools, view_axes); };
   std::string fault;
   listener.device_stopped = [&](DeviceChoice, const std::string&, const std::string& why) {
     fault = why;
@@ -118,6 +122,11 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   station->use_sessions(std::move(store), database);
   const WorkspaceMapping mapping =
       first_use_mapping(station->setup().mesh.rest_position_m, view_axes);
+  if (!left_script.empty())
+    if (const std::optional<DeviceRefusal> refusal =
+            station->use_left_device(std::move(left_script), *o.left_trajectory, mapping))
+      return fail("cannot play the left hand's trajectory " + o.left_trajectory->string() + ": " +
+                  refusal->detail);
   if (const std::optional<DeviceRefusal> refusal =
           station->use_device(DeviceChoice::scripted, mapping, std::move(script), o.trajectory))
     return fail("cannot play the trajectory " + o.trajectory.string() + ": " + refusal->detail);
@@ -128,6 +137,7 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
   while (servo.now_s() - begin_s < duration_s && fault.empty()) {
     std::this_thread::sleep_for(std::chrono::duration<double>(kFramePeriodS));
     tools->advance(servo.now_s() - begin_s, servo.now_s(), *station);
+    if (left_tools) left_tools->advance(servo.now_s() - begin_s, servo.now_s(), *station);
     station->frame();
     for (LoopRecord record; trace.pop(record);) records.push_back(record);
   }
@@ -182,6 +192,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
 
   std::ostringstream command;
   command << "liversim-cli bench-cut --live --trajectory " << o.trajectory.string();
+  if (o.left_trajectory)
+    command << " --left-trajectory " << o.left_trajectory->string() << " --left-tool "
+            << o.left_tool;
   if (o.scenario)
     command << " --scenario " << o.scenario->string();
   else
@@ -191,8 +204,12 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << written_by(command.str()) << "\n\n"
       << "One run of the workstation's own loop (`core/station`, headless): " << scene_name << " ("
       << start_tets << " tetrahedra), a scalpel moved by the scripted device along `"
-      << o.trajectory.filename().string() << "` through the 1 kHz servo, the session recorded "
-      << "to a database thrown away after. Each second of wall time: the simulated time it "
+      << o.trajectory.filename().string() << "` through the 1 kHz servo"
+      << (o.left_trajectory ? std::string(" (and in the left hand ") + o.left_tool + " along `" +
+                                  o.left_trajectory->filename().string() + "`)"
+                            : std::string())
+      << ", the session recorded to a database thrown away after. Each second of wall time: the "
+         "simulated time it "
       << "advanced (the real-time factor), the smallest step taken and what limited it (the mesh "
       << "with its stiffening, the springs of the tool, or the node-travel limit), and the cut "
       << "updates made in it. The loop is paced by the clock, so a second that keeps up shows a "

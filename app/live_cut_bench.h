@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
 namespace liversim::cli {
 
@@ -12,6 +13,10 @@ struct LiveCutBenchOptions {
   std::optional<std::filesystem::path> scenario;  // none: free practice on the built-in liver
   int tets = 5406;
   std::filesystem::path trajectory;  // the scripted device's, in device millimetres
+  // A second scripted device in the left hand (forceps holding the lobe while the scalpel cuts),
+  // in the same device frame, and what it holds until its tool column says otherwise.
+  std::optional<std::filesystem::path> left_trajectory;
+  std::string left_tool = "hand";
   std::filesystem::path output_dir = "docs";
 };
 

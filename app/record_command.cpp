@@ -152,17 +152,8 @@ int record(const RecordOptions& options) {
   std::string device_fault;
   std::optional<SessionMetricsOutcome> metrics;
   StationListener listener;
-  // Each hand's tool held as the workstation holds the device's, in its opening view.
-  const auto held_tool = [&](const std::optional<ScriptedTools>& hand_tools) {
-    std::optional<DeviceToolSettings> held;
-    if (!hand_tools || !hand_tools->held()) return held;
-    held.emplace();
-    held->kind = *hand_tools->held();
-    held->orientation = tool_orientation_from_view(view_axes);
-    return held;
-  };
-  listener.device_tool = [&] { return held_tool(tools); };
-  listener.left_device_tool = [&] { return held_tool(left_tools); };
+  listener.device_tool = [&] { return scripted_tool_held(tools, view_axes); };
+  listener.left_device_tool = [&] { return scripted_tool_held(left_tools, view_axes); };
   listener.trainee = [&] { return options.trainee.value_or(default_trainee_name()); };
   listener.recording_refused = [&](const StorageError& e) { failure = e; };
   listener.recording_stopped = [&](const StorageError& e) { failure = e; };
@@ -271,6 +262,16 @@ int record(const RecordOptions& options) {
 }
 
 }  // namespace
+
+std::optional<DeviceToolSettings> scripted_tool_held(const std::optional<ScriptedTools>& hand,
+                                                     const Eigen::Quaterniond& view_axes) {
+  std::optional<DeviceToolSettings> held;
+  if (!hand || !hand->held()) return held;
+  held.emplace();
+  held->kind = *hand->held();
+  held->orientation = tool_orientation_from_view(view_axes);
+  return held;
+}
 
 std::optional<OpenedScenario> open_scenario_to_run(const std::optional<fs::path>& file) {
   if (!file) return std::nullopt;

@@ -5,7 +5,10 @@
 // and, at the end, the servo's figures and the metrics go to a sessions database. For unattended
 // soaks (memory, rate), demonstrations and the crash-safety tests.
 
+#include "liversim/station/scripted_tools.h"
 #include "liversim/station/workstation.h"
+
+#include <Eigen/Geometry>
 
 #include <filesystem>
 #include <functional>
@@ -26,5 +29,10 @@ std::function<std::optional<int>()> add_record_command(CLI::App& app);
 // Throws std::runtime_error naming the file and each of its errors.
 std::optional<OpenedScenario> open_scenario_to_run(
     const std::optional<std::filesystem::path>& file);
+
+// What a scripted hand holds now (none: nothing), held as the workstation holds a device's tool in
+// its opening view (`view_axes`: opening_view_device_axes).
+std::optional<DeviceToolSettings> scripted_tool_held(const std::optional<ScriptedTools>& hand,
+                                                     const Eigen::Quaterniond& view_axes);
 
 }  // namespace liversim::cli
