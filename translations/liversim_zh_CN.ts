@@ -610,6 +610,10 @@
         <source>The Omni cannot be the left hand&apos;s: %1</source>
         <translation>Omni 不能用作左手设备：%1</translation>
     </message>
+    <message>
+        <source>The left hand&apos;s Omni keeps the name “%1”: a Touch Setup name is 1 to %2 printable characters</source>
+        <translation>左手的 Phantom Omni 保留名称“%1”：Touch Setup 中的名称为 1 到 %2 个可打印字符</translation>
+    </message>
 </context>
 <context>
     <name>liversim::DevicePanel</name>
@@ -714,12 +718,20 @@
         <translation>手术刀</translation>
     </message>
     <message>
-        <source>Phantom Omni (“Left Device”)</source>
-        <translation>Phantom Omni（“Left Device”）</translation>
+        <source>The name Touch Setup gives the Omni in the left hand: “Left Device” for a second Omni beside the right hand&apos;s, “Default Device” for a single Omni beside the mouse</source>
+        <translation>Touch Setup 中左手 Phantom Omni 的名称：与右手设备并用的第二台 Phantom Omni 为“Left Device”，与鼠标并用的单台 Phantom Omni 为“Default Device”</translation>
     </message>
     <message>
-        <source>%1 (“Left Device”)</source>
-        <translation>%1（“Left Device”）</translation>
+        <source>Name in Touch Setup:</source>
+        <translation>Touch Setup 中的名称：</translation>
+    </message>
+    <message>
+        <source>%1 (“%2”)</source>
+        <translation>%1（“%2”）</translation>
+    </message>
+    <message>
+        <source>Phantom Omni</source>
+        <translation>Phantom Omni</translation>
     </message>
 </context>
 <context>

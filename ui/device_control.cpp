@@ -60,6 +60,23 @@ DeviceControl::DeviceControl(Workstation& station, MouseToolControl& mouse, Cont
               useLeftDevice(file);
           });
   connect(context_.panel, &DevicePanel::leftToolChanged, this, [this] { leftToolChanged(); });
+  context_.panel->setLeftOmniName(haptics_.left_omni_configuration);
+  connect(context_.panel, &DevicePanel::leftOmniNameChanged, this, [this](const QString& name) {
+    if (name == haptics_.left_omni_configuration) return;
+    if (!valid_omni_configuration(name)) {
+      context_.panel->setLeftOmniName(haptics_.left_omni_configuration);
+      context_.panel->showStatus(
+          tr("The left hand's Omni keeps the name “%1”: a Touch Setup name is 1 to %2 printable "
+             "characters")
+              .arg(haptics_.left_omni_configuration)
+              .arg(kMaxOmniConfigurationLength),
+          true);
+      return;
+    }
+    haptics_.left_omni_configuration = name;
+    context_.panel->setLeftOmniName(name);
+    save();
+  });
 }
 
 DeviceToolSettings DeviceControl::heldAlongTheView(ToolKind kind) const {
@@ -135,7 +152,7 @@ bool DeviceControl::useLeftOmni() {
     save();
   }
   if (const std::optional<DeviceRefusal> refusal =
-          station_.use_left_omni(kLeftOmniConfiguration, haptics_.mapping))
+          station_.use_left_omni(haptics_.left_omni_configuration.toStdString(), haptics_.mapping))
     return refuse(tr("The Omni cannot be the left hand's: %1").arg(qstring(refusal->detail)));
   if (!useDevice(station_.device())) {
     station_.clear_left_device();

@@ -22,9 +22,6 @@ namespace liversim {
 class CalibrationDialog;
 class DevicePanel;
 
-// The Touch Setup name of the Omni the left hand's entry opens: a second Omni is configured under
-// it (the first is "Default Device").
-inline constexpr const char* kLeftOmniConfiguration = "Left Device";
 class ToolPanel;
 
 class DeviceControl : public QObject {
@@ -65,7 +62,9 @@ class DeviceControl : public QObject {
   // none. The servo is made again with it, which restarts the device in use (and its session).
   // False, saying why in the panel, when it cannot be played; the left hand then stays as it was.
   bool useLeftDevice(const QString& trajectoryFile);
-  // The same with the Omni Touch Setup names kLeftOmniConfiguration (a second Omni).
+  // The same with the Omni Touch Setup knows by the name the panel sets (HapticPreferences::
+  // left_omni_configuration: "Left Device" for a second Omni, "Default Device" for a single one
+  // beside the mouse).
   bool useLeftOmni();
   void clearLeftDevice();
   // What the left hand's device holds: the panel's tool, its shaft along the view.

@@ -4,6 +4,7 @@
 #include <QFormLayout>
 #include <QGroupBox>
 #include <QLabel>
+#include <QLineEdit>
 #include <QPushButton>
 #include <QVBoxLayout>
 
@@ -48,9 +49,17 @@ DevicePanel::DevicePanel(QWidget* parent) : QWidget(parent) {
   leftDevice_->setObjectName("leftHandDevice");
   leftDevice_->addItem(tr("None"));
   leftDevice_->addItem(tr("Scripted trajectory…"));
-  // A second Omni, as Touch Setup names it (OpenHaptics opens devices by their configured name).
-  leftDevice_->addItem(tr("Phantom Omni (“Left Device”)"));
+  // An Omni, as Touch Setup names it (OpenHaptics opens devices by their configured name).
+  leftDevice_->addItem(QString());
   form->addRow(tr("Device:"), leftDevice_);
+  leftOmniName_ = new QLineEdit(left);
+  leftOmniName_->setObjectName("leftOmniName");
+  leftOmniName_->setMaxLength(kMaxOmniConfigurationLength);
+  leftOmniName_->setToolTip(
+      tr("The name Touch Setup gives the Omni in the left hand: “Left Device” for a second Omni "
+         "beside the right hand's, “Default Device” for a single Omni beside the mouse"));
+  form->addRow(tr("Name in Touch Setup:"), leftOmniName_);
+  setLeftOmniName(QStringLiteral("Left Device"));
   leftTool_ = new QComboBox(left);
   leftTool_->setObjectName("leftHandTool");
   form->addRow(tr("Holds:"), leftTool_);
@@ -60,6 +69,8 @@ DevicePanel::DevicePanel(QWidget* parent) : QWidget(parent) {
   connect(leftDevice_, &QComboBox::activated, this,
           [this](int index) { emit leftDeviceChosen(static_cast<LeftDevice>(index)); });
   connect(leftTool_, &QComboBox::activated, this, [this] { emit leftToolChanged(); });
+  connect(leftOmniName_, &QLineEdit::editingFinished, this,
+          [this] { emit leftOmniNameChanged(leftOmniName_->text().trimmed()); });
   layout->addStretch(1);
   showServoStats(nullptr);
   setCalibrationAvailable(false);
@@ -146,9 +157,20 @@ void DevicePanel::showLeftDevice(const QString& name, bool omni) {
                            : omni         ? LeftDevice::omni
                                           : LeftDevice::scripted;
   leftDevice_->setItemText(1, shown == LeftDevice::scripted ? name : tr("Scripted trajectory…"));
-  leftDevice_->setItemText(2, shown == LeftDevice::omni ? tr("%1 (“Left Device”)").arg(name)
-                                                        : tr("Phantom Omni (“Left Device”)"));
+  leftDevice_->setItemText(
+      2, tr("%1 (“%2”)")
+             .arg(shown == LeftDevice::omni ? name : tr("Phantom Omni"), leftOmniName_->text()));
   leftDevice_->setCurrentIndex(static_cast<int>(shown));
+}
+
+void DevicePanel::setLeftOmniName(const QString& name) {
+  leftOmniName_->setText(name);
+  if (shownLeftDevice() != LeftDevice::omni)
+    leftDevice_->setItemText(2, tr("%1 (“%2”)").arg(tr("Phantom Omni"), name));
+}
+
+QString DevicePanel::leftOmniName() const {
+  return leftOmniName_->text();
 }
 
 bool DevicePanel::leftDeviceShown() const {

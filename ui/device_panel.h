@@ -15,6 +15,7 @@
 
 class QComboBox;
 class QLabel;
+class QLineEdit;
 class QPushButton;
 
 namespace liversim {
@@ -52,6 +53,9 @@ class DevicePanel : public QWidget {
   void setLeftTool(std::optional<ToolKind> tool);
   // The tools a scenario allows (the hand always is); a held tool no longer offered is put down.
   void setLeftHandTools(const std::vector<ToolKind>& tools);
+  // The Touch Setup name of the Omni the left hand's entry opens.
+  void setLeftOmniName(const QString& name);
+  QString leftOmniName() const;
 
  signals:
   void deviceChosen(liversim::DeviceChoice device);
@@ -59,6 +63,8 @@ class DevicePanel : public QWidget {
   // The left hand's device asked for.
   void leftDeviceChosen(liversim::DevicePanel::LeftDevice device);
   void leftToolChanged();
+  // The left hand's Omni name edited (trimmed; valid_omni_configuration may still refuse it).
+  void leftOmniNameChanged(const QString& name);
 
  private:
   QComboBox* devices_ = nullptr;
@@ -67,6 +73,7 @@ class DevicePanel : public QWidget {
   QLabel* servo_ = nullptr;
   QComboBox* leftDevice_ = nullptr;
   QComboBox* leftTool_ = nullptr;
+  QLineEdit* leftOmniName_ = nullptr;
   QString omniProblem_;
 };
 

@@ -18,6 +18,14 @@ std::optional<double> number(QSettings& settings, const QString& key) {
 
 }  // namespace
 
+bool valid_omni_configuration(const QString& name) {
+  if (name.isEmpty() || name.size() > kMaxOmniConfigurationLength || name != name.trimmed())
+    return false;
+  for (const QChar c : name)
+    if (!c.isPrint()) return false;
+  return true;
+}
+
 HapticPreferences load_haptic_preferences(QSettings& settings) {
   HapticPreferences preferences;
   settings.beginGroup("haptics");
@@ -28,6 +36,9 @@ HapticPreferences load_haptic_preferences(QSettings& settings) {
   bool ok = false;
   const uint buttons = settings.value("actionButtons").toUInt(&ok);
   if (ok && buttons >= 1 && buttons <= 3) preferences.action_buttons = buttons;
+  if (const QString name = settings.value("leftOmniConfiguration").toString().trimmed();
+      valid_omni_configuration(name))
+    preferences.left_omni_configuration = name;
 
   WorkspaceMapping mapping;
   const auto scale = number(settings, "mapping/scale");
@@ -57,6 +68,7 @@ void save_haptic_preferences(QSettings& settings, const HapticPreferences& prefe
   settings.setValue("device", device);
   settings.setValue("trajectoryFile", preferences.trajectory_file);
   settings.setValue("actionButtons", preferences.action_buttons);
+  settings.setValue("leftOmniConfiguration", preferences.left_omni_configuration);
   if (preferences.mapping_set) {
     const WorkspaceMapping& m = preferences.mapping;
     settings.setValue("mapping/scale", m.scale);

@@ -21,7 +21,17 @@ struct HapticPreferences {
   bool mapping_set = false;
   WorkspaceMapping mapping;
   std::uint32_t action_buttons = 1;  // device buttons that grasp or cut (bit mask)
+  // The Touch Setup name of the Omni the left hand opens: "Left Device" for a second Omni beside
+  // the right hand's, "Default Device" for a single Omni in the left hand beside the mouse.
+  QString left_omni_configuration = QStringLiteral("Left Device");
 };
+
+// The longest left-hand Omni name kept (Touch Setup's names are short; a longer stored value is a
+// damaged file).
+inline constexpr int kMaxOmniConfigurationLength = 64;
+// A name OpenHaptics could know a device by: not empty, at most kMaxOmniConfigurationLength
+// printable characters, no leading or trailing spaces.
+bool valid_omni_configuration(const QString& name);
 
 // What is stored; a value that is missing, unreadable or out of range gives the default, so a
 // damaged settings file never stops the workstation.

@@ -8,6 +8,7 @@
 #include <QAction>
 #include <QComboBox>
 #include <QDir>
+#include <QLineEdit>
 #include <QSettings>
 #include <QSignalSpy>
 #include <QTemporaryDir>
@@ -53,6 +54,7 @@ TEST(HapticPreferences, SurviveARestartAndADamagedValueGivesTheDefault) {
   saved.device = DeviceChoice::openhaptics;
   saved.trajectory_file = "/somewhere/stroke.txt";
   saved.action_buttons = 2;
+  saved.left_omni_configuration = "Default Device";
   saved.mapping_set = true;
   saved.mapping.scale = 1.7;
   saved.mapping.rotation =
@@ -67,6 +69,7 @@ TEST(HapticPreferences, SurviveARestartAndADamagedValueGivesTheDefault) {
   EXPECT_EQ(loaded.device, DeviceChoice::openhaptics);
   EXPECT_EQ(loaded.trajectory_file, saved.trajectory_file);
   EXPECT_EQ(loaded.action_buttons, 2u);
+  EXPECT_EQ(loaded.left_omni_configuration, "Default Device");
   ASSERT_TRUE(loaded.mapping_set);
   EXPECT_DOUBLE_EQ(loaded.mapping.scale, 1.7);
   EXPECT_LT(loaded.mapping.rotation.angularDistance(saved.mapping.rotation), 1e-12);
@@ -84,6 +87,12 @@ TEST(HapticPreferences, SurviveARestartAndADamagedValueGivesTheDefault) {
   }
   settings.setValue("haptics/actionButtons", 9);
   EXPECT_EQ(load_haptic_preferences(settings).action_buttons, 1u);
+  // A left-hand Omni name no device can have: the default.
+  for (const QString& bad : {QString(), QString(65, 'x'), QStringLiteral("Left\nDevice")}) {
+    settings.setValue("haptics/leftOmniConfiguration", bad);
+    EXPECT_EQ(load_haptic_preferences(settings).left_omni_configuration, "Left Device")
+        << bad.toStdString();
+  }
 }
 
 class DeviceTest : public ::testing::Test {
@@ -648,6 +657,73 @@ TEST_F(DeviceTest, ASecondOmniInTheLeftHandMovesItsOwnToolBesideTheFirst) {
   EXPECT_FALSE(window_->servo()->has_device(Hand::left));
   EXPECT_EQ(enabled(2), 0) << "the left hand's Omni was left open";
   EXPECT_EQ(window_->device(), DeviceChoice::openhaptics);
+}
+
+// A single Omni in the left hand beside the mouse (issue 43, item 1): the left hand's Omni is the
+// one Touch Setup knows by the name the panel sets, here "Default Device" (the only one
+// configured); it moves the left hand's forceps while the mouse stays the right hand's device,
+// and goes back to the right hand's choice once the left hand puts it down. The name is kept in the
+// settings for the next start; a name no device can have is refused and the last one kept.
+TEST_F(DeviceTest, ASingleOmniInTheLeftHandMovesItsToolBesideTheMouse) {
+  qputenv("LIVERSIM_OPENHAPTICS_LIBRARY", LIVERSIM_FAKE_HD_LIBRARY);
+  openWindow();
+  DevicePanel* panel = window_->devicePanel();
+  ASSERT_TRUE(panel->openHapticsOffered()) << panel->openHapticsToolTip().toStdString();
+  ASSERT_EQ(window_->device(), DeviceChoice::mouse);
+  // No second device configured (an earlier test of this program may have configured one).
+  auto reset = fakeHook<void (*)()>("fake_hd_reset");
+  ASSERT_TRUE(reset);
+  reset();
+  auto* name = panel->findChild<QLineEdit*>("leftOmniName");
+  ASSERT_NE(name, nullptr);
+  EXPECT_EQ(name->text(), "Left Device");
+  EXPECT_FALSE(window_->useLeftHandOmni()) << "no Omni is configured as Left Device";
+  EXPECT_TRUE(panel->statusText().contains("\"Left Device\"")) << panel->statusText().toStdString();
+
+  // Typed as a user types it.
+  name->clear();
+  QTest::keyClicks(name, "Default Device");
+  emit name->editingFinished();
+  auto* leftDevice = panel->findChild<QComboBox*>("leftHandDevice");
+  ASSERT_NE(leftDevice, nullptr);
+  EXPECT_TRUE(leftDevice->itemText(2).contains("Default Device"))
+      << leftDevice->itemText(2).toStdString();
+  leftDevice->setCurrentIndex(2);
+  emit leftDevice->activated(2);
+  EXPECT_EQ(panel->shownLeftDevice(), DevicePanel::LeftDevice::omni)
+      << panel->statusText().toStdString();
+  EXPECT_EQ(window_->device(), DeviceChoice::mouse) << "the mouse went from the right hand";
+  ASSERT_TRUE(window_->servo() && window_->servo()->has_device(Hand::left));
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        const auto& left = snapshot().hand(Hand::left).tool;
+        return left && left->kind == ToolKind::forceps;
+      },
+      kTimeoutMs))
+      << "the Omni does not move the left hand's forceps";
+  // While the left hand holds it, the right hand cannot have it; put down there, it can.
+  EXPECT_FALSE(window_->useDevice(DeviceChoice::openhaptics));
+  EXPECT_TRUE(panel->statusText().contains("in the left hand"))
+      << panel->statusText().toStdString();
+  EXPECT_EQ(window_->device(), DeviceChoice::mouse);
+  leftDevice->setCurrentIndex(0);
+  emit leftDevice->activated(0);
+  EXPECT_EQ(panel->shownLeftDevice(), DevicePanel::LeftDevice::none);
+  ASSERT_TRUE(window_->useDevice(DeviceChoice::openhaptics)) << panel->statusText().toStdString();
+  EXPECT_FALSE(window_->servo()->has_device(Hand::left));
+
+  // A name no device can have (empty) is refused, naming the one kept.
+  name->clear();
+  emit name->editingFinished();
+  EXPECT_EQ(name->text(), "Default Device");
+  EXPECT_TRUE(panel->statusText().contains("Default Device")) << panel->statusText().toStdString();
+
+  // Kept for the next start.
+  window_.reset();
+  openWindow();
+  name = window_->devicePanel()->findChild<QLineEdit*>("leftOmniName");
+  ASSERT_NE(name, nullptr);
+  EXPECT_EQ(name->text(), "Default Device");
 }
 
 }  // namespace

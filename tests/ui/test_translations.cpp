@@ -106,9 +106,10 @@ std::vector<ShownText> shownTexts(const MainWindow& window) {
 // and shortcuts "（Ctrl+O）", mnemonics "(&F)", file names in docs/, numbers.
 QString withoutNamesAndUnits(QString text) {
   static const QRegularExpression allowed(QStringLiteral(
-      // “Left Device”: the name a second Omni has in Touch Setup, which the user types there.
-      R"(\(&[A-Z]\)|LiverSim|Phantom Omni|Geomagic Touch|OpenHaptics|libHD\.so|SQLite|JSON|)"
-      R"(“Left Device”|)"
+      // “Left Device”, “Default Device”: the names Omnis have in Touch Setup (Geomagic's
+      // configuration tool), which the user types there.
+      R"(\(&[A-Z]\)|LiverSim|Phantom Omni|Geomagic Touch|OpenHaptics|Touch Setup|libHD\.so|)"
+      R"(SQLite|JSON|“Left Device”|“Default Device”|)"
       R"(CSV|PDF|RK4|BDF2|Dormand|Prince|Gmsh|English|Shift|Ctrl|p99|)"
       R"(（((Ctrl|Shift|Alt)\+)*[A-Z]）|docs/[\w.-]+\.md|kg/m³|m/s²|J/m²|)"
       R"([-+]?\d+(\.\d+)?(e[-+]?\d+)?|)"

@@ -518,18 +518,34 @@ std::string Workstation::device_name() const {
 }
 
 void Workstation::clear_left_device() {
+  take_back_pending_omni();
   pending_left_device_.reset();
   pending_left_device_is_omni_ = false;
   left_device_changing_ = true;
+}
+
+void Workstation::take_back_pending_omni() {
+  if (pending_left_device_is_station_omni_) omni_ = std::move(pending_left_device_);
+  pending_left_device_is_station_omni_ = false;
 }
 
 std::optional<DeviceRefusal> Workstation::use_left_omni(const std::string& configuration,
                                                         const WorkspaceMapping& mapping) {
   using Reason = DeviceRefusal::Reason;
   if (auto problem = validate(mapping)) return DeviceRefusal{Reason::servo_failed, *problem};
-  OpenHapticsOpening omni = open_openhaptics_device(omni_library_, configuration.c_str());
-  if (!omni.device) return DeviceRefusal{Reason::omni_unavailable, omni.problem};
-  pending_left_device_ = std::move(omni.device);
+  take_back_pending_omni();
+  // A single Omni beside the mouse: the one the station holds open, while the right hand does
+  // not use it, goes to the left hand (opened again, the runtime says it is open already).
+  const bool lend =
+      configuration == kDefaultOmniConfiguration && omni_ && device_ != DeviceChoice::openhaptics;
+  if (lend) {
+    pending_left_device_ = std::move(omni_);
+  } else {
+    OpenHapticsOpening omni = open_openhaptics_device(omni_library_, configuration.c_str());
+    if (!omni.device) return DeviceRefusal{Reason::omni_unavailable, omni.problem};
+    pending_left_device_ = std::move(omni.device);
+  }
+  pending_left_device_is_station_omni_ = lend;
   pending_left_device_is_omni_ = true;
   left_device_changing_ = true;
   left_mapping_ = mapping;
@@ -564,6 +580,7 @@ std::optional<DeviceRefusal> Workstation::use_left_device(std::vector<Trajectory
     return DeviceRefusal{Reason::no_trajectory, e.what()};
   }
   // The servo in use holds the old one (if any): the next use_device replaces both.
+  take_back_pending_omni();
   pending_left_device_ = std::move(device);
   pending_left_device_is_omni_ = false;
   left_device_changing_ = true;
@@ -584,6 +601,10 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
       device = owned.get();
       break;
     case DeviceChoice::openhaptics:
+      if (left_device_is_station_omni_ || pending_left_device_is_station_omni_)
+        return DeviceRefusal{Reason::omni_unavailable,
+                             "the Omni is in the left hand: put the left hand's device down "
+                             "first"};
       if (!omni_) open_omni(omni_library_);
       if (!omni_) return DeviceRefusal{Reason::omni_unavailable, omni_problem_};
       device = omni_.get();
@@ -620,8 +641,11 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
   simulation_->stop();
   detach_device();  // the old servo, which may hold the old left device, goes
   if (left_device_changing_) {
+    if (left_device_is_station_omni_) omni_ = std::move(left_device_);  // lent back
     left_device_ = std::move(pending_left_device_);
     left_device_is_omni_ = pending_left_device_is_omni_;
+    left_device_is_station_omni_ = pending_left_device_is_station_omni_;
+    pending_left_device_is_station_omni_ = false;
     left_device_changing_ = false;
   }
   servo_ = std::move(servo);

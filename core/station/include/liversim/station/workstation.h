@@ -136,6 +136,9 @@ struct StationFrame {
   bool cut = false;           // and its model is a cut newer than the last frame's
 };
 
+// The Touch Setup name of the Omni OpenHaptics opens by default (HD_DEFAULT_DEVICE).
+inline constexpr const char* kDefaultOmniConfiguration = "Default Device";
+
 class Workstation {
  public:
   // Runs `setup` (built into its model here; throws std::invalid_argument for a model that cannot
@@ -241,10 +244,12 @@ class Workstation {
                                                const std::filesystem::path& script_file,
                                                const WorkspaceMapping& mapping);
   // The same with an Omni in the left hand: the one OpenHaptics knows by `configuration`, its
-  // name in Touch Setup ("Left Device" for a second Omni; "Default Device" when the right hand
-  // has no Omni). Its force is written in the tick of the right hand's device. Refused, naming the
-  // runtime's answer, when it cannot be opened (absent, not configured, already open: an Omni in
-  // the left hand is closed by clear_left_device and the next use_device).
+  // name in Touch Setup ("Left Device" for a second Omni; kDefaultOmniConfiguration for a single
+  // Omni beside the mouse: the Omni the station opened at open_omni goes to the left hand, and
+  // comes back when the left hand's device next changes). Its force is written in the tick of the
+  // right hand's device. Refused, naming the runtime's answer, when it cannot be opened (absent,
+  // not configured, already open: an Omni in the left hand is closed by clear_left_device and the
+  // next use_device).
   std::optional<DeviceRefusal> use_left_omni(const std::string& configuration,
                                              const WorkspaceMapping& mapping);
   // Whether the left hand's device in use is an Omni.
@@ -330,6 +335,8 @@ class Workstation {
   void detach_device();
   std::optional<DeviceToolSettings> device_tool(Hand hand = Hand::right) const;
   // A servo for `device` in the right hand, and `left` (if any) in the left.
+  // The station's Omni, lent to the left hand by a choice not yet taken, back to omni_.
+  void take_back_pending_omni();
   std::unique_ptr<ServoLoop> make_servo(HapticDevice& device, const WorkspaceMapping& mapping,
                                         HapticDevice* left);
   void start_model_change(ModelChange change, std::function<ModelChangeBuilt()> build);
@@ -381,6 +388,8 @@ class Workstation {
   std::unique_ptr<HapticDevice> pending_left_device_;  // chosen, for the next use_device
   bool left_device_changing_ = false;  // pending_left_device_ (null: none) replaces it
   bool left_device_is_omni_ = false, pending_left_device_is_omni_ = false;
+  // The left hand's device (or the one chosen for it) is omni_, lent to it (a single Omni).
+  bool left_device_is_station_omni_ = false, pending_left_device_is_station_omni_ = false;
   WorkspaceMapping left_mapping_;
   ManualDevice* mouse_ = nullptr;  // own_device_, while the mouse is the device
   std::unique_ptr<ServoLoop> servo_;
