@@ -996,7 +996,8 @@ TEST(SessionStore, ADamagedFileGivesAClearMessageAndNoCrash) {
 }
 
 // A file that cannot grow (SQLite's page cap stands in for a full disk): the recorder stops with a
-// message naming the file and the cause, and every frame it committed before stays readable.
+// message naming the file and the cause, and every frame it committed before stays readable. The
+// frames are given 500 at a time, each batch once the last is committed.
 TEST(SessionRecorder, AFullDiskStopsTheRecordingAndKeepsWhatWasCommitted) {
   const fs::path file = fresh_database("full-disk");
   SqliteSessionStore store(file);
@@ -1011,7 +1012,12 @@ TEST(SessionRecorder, AFullDiskStopsTheRecordingAndKeepsWhatWasCommitted) {
   while (recorder.error().empty() && std::chrono::steady_clock::now() < deadline &&
          source.released.load() < frames.size()) {
     source.release(500);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    // The next 500 once these are committed (or the file is full): a commit then holds at most
+    // 500, however late a loaded machine runs the recorder (a first commit of thousands overflowed
+    // the cap at once and kept nothing).
+    while (recorder.error().empty() && std::chrono::steady_clock::now() < deadline &&
+           recorder.frames_written() < static_cast<std::int64_t>(source.released.load()))
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   const std::string error = recorder.error();
   ASSERT_FALSE(error.empty()) << "the file never filled";
