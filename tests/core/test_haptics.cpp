@@ -8,7 +8,9 @@
 #include "liversim/haptics/triple_buffer.h"
 
 #include <gtest/gtest.h>
+
 #include <Eigen/Eigenvalues>
+#include <atomic>
 
 #include <array>
 #include <cmath>
@@ -634,6 +636,29 @@ TEST(TrajectoryDevice, PlaysTheTrajectoryOnTheServoClock) {
   EXPECT_TRUE(sample.position_mm.isApprox(Eigen::Vector3d(10, 20, 0)));
   EXPECT_EQ(sample.velocity_mm_per_s.norm(), 0.0);
   EXPECT_THROW(TrajectoryDevice("bad", {}), std::invalid_argument);
+}
+
+// Paced by another clock (a simulation's time), a script plays from that clock's value at its
+// first read, whatever time the servo passes: it waits while that clock stands still.
+TEST(TrajectoryDevice, PlaysOnTheClockItIsGivenFromItsFirstRead) {
+  TrajectoryDevice device("scripted", {{0.0, {0, 0, 0}, 0}, {1.0, {10, 0, 0}, 1}});
+  std::atomic<double> simulated_s{5.0};
+  device.play_on(&simulated_s);
+  DeviceSample sample;
+  device.read(0.7, sample);  // the servo's time is not the script's
+  EXPECT_TRUE(sample.position_mm.isApprox(Eigen::Vector3d(0, 0, 0)));
+  device.read(3.0, sample);  // the servo goes on; the simulation does not
+  EXPECT_TRUE(sample.position_mm.isApprox(Eigen::Vector3d(0, 0, 0)));
+  simulated_s = 5.25;
+  device.read(3.001, sample);
+  EXPECT_TRUE(sample.position_mm.isApprox(Eigen::Vector3d(2.5, 0, 0)));
+  simulated_s = 6.5;
+  device.read(3.002, sample);
+  EXPECT_TRUE(sample.position_mm.isApprox(Eigen::Vector3d(10, 0, 0)));
+  EXPECT_EQ(sample.buttons, 1u);
+  device.play_on(nullptr);  // the servo's clock again
+  device.read(0.5, sample);
+  EXPECT_TRUE(sample.position_mm.isApprox(Eigen::Vector3d(5, 0, 0)));
 }
 
 TEST(ServoLoop, RunsNearOneKilohertzOnItsOwnThreadAndEndsWithZeroForce) {

@@ -600,6 +600,11 @@ TEST_F(RealtimeSteppingFixture, TwoScriptedDevicesMoveAToolEachAndEachFeelsItsOw
   TrajectoryDevice right(
       "right script",
       {{0.0, {0.0, 0.0, 10.0}, 0}, {1.0, {0.0, 0.0, -8.0}, 0}, {30.0, {0.0, 0.0, -8.0}, 0}});
+  // Both play on the simulation's time: a loaded machine (a sanitizer build beside other work)
+  // slows the simulation, and a script on the wall clock then closed and lifted the forceps at
+  // other moments of the simulated motion (the node came up 1.6 mm, not 5).
+  left.play_on(&simulation.simulated_time_s());
+  right.play_on(&simulation.simulated_time_s());
   ServoLoop servo(right, left, options);
   simulation.set_haptic_servo(&servo);
   simulation.set_device_tool(Hand::left, forceps);

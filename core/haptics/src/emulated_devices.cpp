@@ -168,6 +168,11 @@ TrajectoryDevice::TrajectoryDevice(std::string name, std::vector<TrajectoryPoint
 }
 
 DeviceStatus TrajectoryDevice::read(double time_s, DeviceSample& sample) {
+  if (clock_s_) {
+    const double now_s = clock_s_->load(std::memory_order_relaxed);
+    if (clock_origin_s_ < 0.0) clock_origin_s_ = now_s;
+    time_s = now_s - clock_origin_s_;
+  }
   if (time_s < points_[cursor_].time_s) cursor_ = 0;  // the clock went back (a restart)
   while (cursor_ + 1 < points_.size() && points_[cursor_ + 1].time_s <= time_s) ++cursor_;
   const TrajectoryPoint& from = points_[cursor_];

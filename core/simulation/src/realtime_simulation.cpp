@@ -89,6 +89,7 @@ RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
                                : steps_per_cycle(options.cycle_s, step_s_)),
       snapshots_(snapshot_of(state_, model_)),
       integrator_kind_(model_->integrator.kind) {
+  simulated_time_s_.store(state_.time_s, std::memory_order_relaxed);
   if (!(step_s_ > 0.0) || !std::isfinite(step_s_))
     throw std::invalid_argument("the model has no usable time step (" + std::to_string(step_s_) +
                                 " s)");
@@ -631,6 +632,7 @@ void RealtimeSimulation::publish_cycle() {
   out.position_m.z = state_.position_m.z;
   out.time_s = state_.time_s;
   out.step_count = state_.step_count;
+  simulated_time_s_.store(state_.time_s, std::memory_order_relaxed);
   for (Hand which : kHands) {
     const HandInLoop& held = hand(which);
     HandSnapshot& seen = out.hands[hand_index(which)];

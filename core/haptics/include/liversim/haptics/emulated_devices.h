@@ -8,6 +8,7 @@
 #include "liversim/haptics/triple_buffer.h"
 
 #include <array>
+#include <atomic>
 #include <filesystem>
 #include <span>
 #include <string>
@@ -109,11 +110,24 @@ class TrajectoryDevice final : public HapticDevice {
   double duration_s() const { return points_.back().time_s; }
   const std::vector<TrajectoryPoint>& points() const { return points_; }
 
+  // Plays on `clock_s` instead of the servo's clock, from its value at the first read: a
+  // simulation's time (RealtimeSimulation::simulated_time_s), so that the script waits for a
+  // simulation that falls behind instead of running ahead of it. What a scripted run that must not
+  // depend on the machine's load plays on (tests wait on simulated time). Set before the servo
+  // starts; null: the servo's clock again. The clock is only read (atomically): the servo path
+  // stays lock-free.
+  void play_on(const std::atomic<double>* clock_s) {
+    clock_s_ = clock_s;
+    clock_origin_s_ = -1.0;
+  }
+
  private:
   std::string name_;
   std::vector<TrajectoryPoint> points_;
   DeviceLimits limits_;
-  std::size_t cursor_ = 0;  // the segment of the last read: reads move forward, so no search
+  const std::atomic<double>* clock_s_ = nullptr;
+  double clock_origin_s_ = -1.0;  // < 0: not read yet
+  std::size_t cursor_ = 0;        // the segment of the last read: reads move forward, so no search
 };
 
 }  // namespace liversim

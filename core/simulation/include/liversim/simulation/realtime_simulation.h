@@ -304,6 +304,9 @@ class RealtimeSimulation {
   const SimState& state() const { return state_; }
 
   RealtimeStats stats() const;
+  // The simulated time of the last published cycle, readable from any thread without a lock: the
+  // clock a scripted device paced by this simulation plays on (TrajectoryDevice::play_on).
+  const std::atomic<double>& simulated_time_s() const { return simulated_time_s_; }
   const SimModel& model() const { return *model_; }
   std::shared_ptr<const SimModel> shared_model() const { return model_; }
   double step_s() const { return step_s_; }
@@ -407,7 +410,8 @@ class RealtimeSimulation {
   std::atomic<double> wall_s_per_simulated_s_{0.0}, force_evaluations_per_simulated_s_{0.0},
       dropped_s_{0.0};
   std::atomic<bool> behind_{false}, stability_limited_{false};
-  StateCheckpoint checkpoint_;  // simulation thread only
+  std::atomic<double> simulated_time_s_{0.0};  // state_.time_s as of the last published cycle
+  StateCheckpoint checkpoint_;                 // simulation thread only
   std::atomic<int> rollbacks_{0}, rejected_inputs_{0};
   std::atomic<HealthProblem> last_problem_{HealthProblem::none};
   std::atomic<bool> halted_{false};
