@@ -157,16 +157,18 @@ void DevicePanel::showLeftDevice(const QString& name, bool omni) {
                            : omni         ? LeftDevice::omni
                                           : LeftDevice::scripted;
   leftDevice_->setItemText(1, shown == LeftDevice::scripted ? name : tr("Scripted trajectory…"));
-  leftDevice_->setItemText(
-      2, tr("%1 (“%2”)")
-             .arg(shown == LeftDevice::omni ? name : tr("Phantom Omni"), leftOmniName_->text()));
+  leftDevice_->setItemText(2, omniEntry(shown == LeftDevice::omni ? name : tr("Phantom Omni")));
   leftDevice_->setCurrentIndex(static_cast<int>(shown));
 }
 
 void DevicePanel::setLeftOmniName(const QString& name) {
   leftOmniName_->setText(name);
   if (shownLeftDevice() != LeftDevice::omni)
-    leftDevice_->setItemText(2, tr("%1 (“%2”)").arg(tr("Phantom Omni"), name));
+    leftDevice_->setItemText(2, omniEntry(tr("Phantom Omni")));
+}
+
+QString DevicePanel::omniEntry(const QString& device) const {
+  return tr("%1 (“%2”)").arg(device, leftOmniName_->text());
 }
 
 QString DevicePanel::leftOmniName() const {

@@ -74,6 +74,8 @@ class DevicePanel : public QWidget {
   QComboBox* leftDevice_ = nullptr;
   QComboBox* leftTool_ = nullptr;
   QLineEdit* leftOmniName_ = nullptr;
+  // The left hand's Omni entry: `device` and the Touch Setup name it is opened by.
+  QString omniEntry(const QString& device) const;
   QString omniProblem_;
 };
 

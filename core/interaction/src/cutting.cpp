@@ -2211,10 +2211,6 @@ void follow_grooves(BladeStroke& stroke, const SimModel& model, const NodeArray&
                     stroke.cutting_edges_m);
 }
 
-}  // namespace
-
-namespace {
-
 // Whether the stroke refines the mesh around its front now (CuttingSettings::refine_over_stroke_m):
 // on its first stretch, and while the cuts' added mass leaves their own thin parts half the budget.
 bool refines_at(const SimModel& model, std::span<const std::array<Eigen::Vector3d, 2>> edges_m,
