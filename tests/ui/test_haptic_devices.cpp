@@ -176,7 +176,10 @@ TEST_F(DeviceTest, AScriptedDeviceHoldsTheProbeOnTheLiverThroughTheServo) {
       << window_->devicePanel()->statusText().toStdString();
   ASSERT_NE(window_->servo(), nullptr);
   EXPECT_TRUE(window_->devicePanel()->statusText().contains("trajectory.txt"));
-  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().hand(Hand::right).force_n.norm() > 0.05; },
+  // Hertz's 4/3 E/(1 − ν²) √R d^1.5 for this ball and depth is 0.055 N; the coarse mesh held
+  // 0.034 N once the tissue had relaxed, and only the press's moment passed 0.05 N (a loaded
+  // machine's snapshots miss it). A fifth of Hertz's figure tells pressing from touching nothing.
+  ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().hand(Hand::right).force_n.norm() > 0.011; },
                               kTimeoutMs))
       << "the scripted probe pressed nothing: " << snapshot().hand(Hand::right).force_n.transpose();
   ASSERT_TRUE(snapshot().hand(Hand::right).tool && snapshot().hand(Hand::right).device_sample);
