@@ -46,6 +46,8 @@ struct RecordOptions {
   // the tool it holds until its tool column says otherwise.
   std::optional<fs::path> left_trajectory;
   std::string left_tool = "hand";
+  // The scripts play on the simulation's time, not the wall clock (--paced).
+  bool paced = false;
 };
 
 // The workstation's display frame: how often the recorder takes the simulation's input log and
@@ -177,6 +179,7 @@ int record(const RecordOptions& options) {
                 e.what());
   }
   station->use_sessions(std::move(store), options.database);
+  station->play_scripts_on_simulated_time(options.paced);
   // A device not calibrated: the workstation's first-use mapping in its opening view.
   const WorkspaceMapping mapping =
       first_use_mapping(station->setup().mesh.rest_position_m, view_axes);
@@ -203,21 +206,35 @@ int record(const RecordOptions& options) {
                     ? std::string(", left hand's tool ") +
                           std::string(left_tools->held() ? tool_name(*left_tools->held()) : "hand")
                     : std::string())
-            << ", " << number(duration_s) << " s" << std::endl;
+            << ", " << number(duration_s) << (options.paced ? " s of simulated time" : " s")
+            << std::endl;
   ServoLoop& servo = *station->servo();
   const double begin_s = servo.now_s();
+  // Paced, the scripts' time (their tool columns' too) is the simulation's since this moment.
+  const std::atomic<double>& simulated_s = station->simulated_clock_s();
+  const double simulated_begin_s = simulated_s.load(std::memory_order_relaxed);
+  const auto script_time_s = [&] {
+    return options.paced ? simulated_s.load(std::memory_order_relaxed) - simulated_begin_s
+                         : servo.now_s() - begin_s;
+  };
   double next_progress_s = begin_s + options.progress_s.value_or(INFINITY);
   int stop_signal = 0;
+  bool halted = false;
   while (true) {
-    const double now_s = servo.now_s();
-    if (now_s - begin_s >= duration_s) break;
+    const double played_s = script_time_s();
+    if (played_s >= duration_s) break;
     stop_signal =
-        wait_for_stop_signal(stop_signals, std::min(kFramePeriodS, duration_s - (now_s - begin_s)));
+        wait_for_stop_signal(stop_signals, std::min(kFramePeriodS, duration_s - played_s));
     if (stop_signal != 0) break;
-    tools->advance(servo.now_s() - begin_s, servo.now_s(), *station);  // the script's tools
-    if (left_tools) left_tools->advance(servo.now_s() - begin_s, servo.now_s(), *station);
+    tools->advance(script_time_s(), servo.now_s(), *station);  // the script's tools
+    if (left_tools) left_tools->advance(script_time_s(), servo.now_s(), *station);
     station->frame();
     if (failure) break;
+    // Paced, a halted simulation's time stands still: the session ends with what it recorded.
+    if (options.paced && station->simulation().stats().halted) {
+      halted = true;
+      break;
+    }
     if (!device_fault.empty()) {
       // As the workstation: the session ended with what it recorded; the mouse took over.
       std::cerr << "liversim-cli: the device stopped: " << device_fault << '\n';
@@ -226,13 +243,19 @@ int record(const RecordOptions& options) {
     if (servo.now_s() >= next_progress_s) {
       const ResidentMemory memory = resident_memory();
       std::cout << std::fixed << std::setprecision(2) << "elapsed " << servo.now_s() - begin_s
-                << " s: " << station->recorded_frames() << " frames committed, VmRSS "
+                << " s" << (options.paced ? " (" + number(script_time_s()) + " s simulated)" : "")
+                << ": " << station->recorded_frames() << " frames committed, VmRSS "
                 << std::setprecision(1) << memory.now_mib << " MiB, VmHWM " << memory.peak_mib
                 << " MiB" << std::endl;
       std::cout.unsetf(std::ios::floatfield);
       next_progress_s += *options.progress_s;
     }
   }
+  if (halted)
+    std::cerr << "liversim-cli: the simulation halted at " << number(script_time_s())
+              << " s of the script: "
+              << health_problem_text(station->simulation().stats().last_problem)
+              << "; the session ends with what it recorded\n";
   // The servo's last command is a zero force, and its last frames are kept.
   station->stop();
   if (failure) return storage_failure(failure->what());
@@ -314,8 +337,15 @@ std::function<std::optional<int>()> add_record_command(CLI::App& app) {
   command->add_option("--trainee", options->trainee, "Trainee the session is of (default: $USER)");
   command
       ->add_option("--duration", options->duration_s,
-                   "Wall time to record, in seconds (default: the trajectory's length)")
+                   "Time to record, in seconds: wall time, or simulated time with --paced "
+                   "(default: the trajectory's length)")
       ->check(CLI::PositiveNumber);
+  command->add_flag(
+      "--paced", options->paced,
+      "Play the trajectories on the simulation's time instead of the wall clock: they "
+      "wait for a simulation that falls behind, so what they do to the tissue does not "
+      "turn on the machine's load (the session then takes as long as the simulation "
+      "needs)");
   command
       ->add_option("--progress", options->progress_s,
                    "Print a line every this many seconds: elapsed time, frames committed, VmRSS "

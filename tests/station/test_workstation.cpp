@@ -488,6 +488,61 @@ TEST_F(StationTest, LiveModelChangesCarryTheLiverOnAndAreSessionEvents) {
 // A scenario opened while a device session is recorded: the session of the old scene ends whole,
 // and one begins on the new scene, storing the scenario's exact text; a cancelled build changes
 // nothing.
+// Paced scripts play on the simulation's time (record --paced): while the simulation stands
+// still the script waits, so the device is where the script puts it at the simulation's time, not
+// the wall clock's, also after a model change has replaced the simulation.
+TEST_F(StationTest, APacedScriptWaitsForTheSimulationAlsoAfterAModelChange) {
+  open(ToolKind::probe);
+  station_->play_scripts_on_simulated_time(true);
+  // Held 20 mm above the liver for 1 s, then moving sideways at 10 mm/s (touching nothing).
+  const Eigen::Vector3d start = topOfTheMiddle_mm() + Eigen::Vector3d(-40, 0, 20);
+  constexpr double kSpeedMmPerS = 10.0;
+  const double begin_s = station_->simulated_clock_s().load();
+  play({{0.0, start, 0}, {1.0, start, 0}, {61.0, start + Eigen::Vector3d(600, 0, 0), 0}});
+  // Where the script puts the device at a simulated time (its clock's origin is the simulated
+  // time of the servo's first read: a few milliseconds after begin_s, kOriginS leaves room for a
+  // loaded machine).
+  constexpr double kOriginS = 0.25;
+  auto expected_x_mm = [&](double simulated_s) {
+    return start.x() + kSpeedMmPerS * std::max(0.0, simulated_s - begin_s - 1.0);
+  };
+  // The device's reading a snapshot shows is the servo's last before the cycle: it lags the
+  // snapshot's time by at most a cycle (1/60 s of simulated time), so it lies between where the
+  // script puts it kOriginS + 20 ms before and at the snapshot's time.
+  auto on_the_script = [&] {
+    const SimulationSnapshot& seen = snapshot();
+    if (!seen.hand(Hand::right).device_sample) return ::testing::AssertionFailure() << "no sample";
+    const double x = seen.hand(Hand::right).device_sample->position_mm.x();
+    const double lo = expected_x_mm(seen.time_s - kOriginS - 0.02), hi = expected_x_mm(seen.time_s);
+    if (x >= lo - 1e-9 && x <= hi + 1e-9) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure()
+           << "the device at x = " << x << " mm, the script between " << lo << " and " << hi
+           << " mm at " << seen.time_s << " s simulated";
+  };
+  const double moving_s = begin_s + 1.5;
+  ASSERT_TRUE(frameUntil([&] { return snapshot().time_s > moving_s; }));
+  EXPECT_TRUE(on_the_script());
+  // The simulation stopped for a second of wall time: a script on the wall clock would be 10 mm
+  // ahead when it goes on.
+  station_->simulation().stop();
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const double stopped_at_s = station_->simulation().snapshot().time_s;
+  station_->simulation().start();
+  ASSERT_TRUE(frameUntil([&] { return snapshot().time_s > stopped_at_s + 0.05; }));
+  EXPECT_TRUE(on_the_script());
+  // A model change replaces the simulation: the new one's time is the script's clock.
+  IntegratorSettings settings = station_->integrator();
+  settings.kind = IntegratorKind::rk4;
+  ASSERT_TRUE(station_->change_integrator(settings));
+  ASSERT_TRUE(frameUntil([&] { return !changes_.empty(); }));
+  ASSERT_TRUE(changes_[0].applied) << changes_[0].error;
+  const double changed_at_s = snapshot().time_s;
+  ASSERT_TRUE(frameUntil([&] { return snapshot().time_s > changed_at_s + 0.2; }));
+  EXPECT_TRUE(on_the_script());
+  EXPECT_NEAR(station_->simulated_clock_s().load(),
+              station_->simulation().simulated_time_s().load(), 0.05);
+}
+
 TEST_F(StationTest, OpeningAScenarioEndsTheSessionAndBeginsOneOnTheNewScene) {
   open();
   const fs::path database = folder_ / "sessions.sqlite";

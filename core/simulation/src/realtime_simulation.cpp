@@ -624,6 +624,11 @@ void RealtimeSimulation::replay(std::span<const SimulationInput> inputs,
     }
 }
 
+void RealtimeSimulation::publish_time_to(std::atomic<double>* clock_s) {
+  published_clock_s_ = clock_s;
+  if (published_clock_s_) published_clock_s_->store(state_.time_s, std::memory_order_relaxed);
+}
+
 void RealtimeSimulation::publish_cycle() {
   SimulationSnapshot& out = snapshots_.back();
   // Same size: copies without allocating (a cut's new size allocates once).
@@ -633,6 +638,7 @@ void RealtimeSimulation::publish_cycle() {
   out.time_s = state_.time_s;
   out.step_count = state_.step_count;
   simulated_time_s_.store(state_.time_s, std::memory_order_relaxed);
+  if (published_clock_s_) published_clock_s_->store(state_.time_s, std::memory_order_relaxed);
   for (Hand which : kHands) {
     const HandInLoop& held = hand(which);
     HandSnapshot& seen = out.hands[hand_index(which)];

@@ -110,6 +110,7 @@ void Workstation::install_scene(SceneSetup setup, std::shared_ptr<const SimModel
     simulation_->stop();
   }
   simulation_ = std::move(simulation);
+  simulation_->publish_time_to(&simulated_clock_s_);
   setup_ = std::move(setup);
   scene_model_ = std::move(model);
   shown_topology_ = 0;
@@ -122,6 +123,7 @@ void Workstation::restart_from_rest() {
   if (scene_model_->integrator != setup_.model_options.integrator)
     scene_model_ = std::make_shared<const SimModel>(build_model(setup_.mesh, setup_.model_options));
   simulation_ = make_scene_simulation(scene_model_, setup_.visual.surface);
+  simulation_->publish_time_to(&simulated_clock_s_);
   if (!hand_springs_.empty()) simulation_->set_springs(hand_springs_);
   attach_device();
   shown_topology_ = 0;
@@ -367,6 +369,7 @@ void Workstation::finish_model_change(const ModelChange& change, const ModelChan
     auto replacement =
         std::make_unique<RealtimeSimulation>(model, carry_state(old, *model, shared_worker_pool()));
     simulation_ = std::move(replacement);
+    simulation_->publish_time_to(&simulated_clock_s_);
     if (tracking) simulation_->track_outcome(std::move(*tracking));
   } catch (const std::exception& e) {
     if (recorder_) simulation_->log_inputs(true);  // the old one's log goes on
@@ -574,8 +577,10 @@ std::optional<DeviceRefusal> Workstation::use_left_device(std::vector<Trajectory
   if (auto problem = validate(mapping)) return DeviceRefusal{Reason::servo_failed, *problem};
   std::unique_ptr<HapticDevice> device;
   try {
-    device = std::make_unique<TrajectoryDevice>("Scripted: " + script_file.filename().string(),
-                                                std::move(script));
+    auto scripted = std::make_unique<TrajectoryDevice>(
+        "Scripted: " + script_file.filename().string(), std::move(script));
+    if (scripts_paced_) scripted->play_on(&simulated_clock_s_);
+    device = std::move(scripted);
   } catch (const std::exception& e) {
     return DeviceRefusal{Reason::no_trajectory, e.what()};
   }
@@ -617,8 +622,10 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
     case DeviceChoice::scripted:
       if (script.empty()) return DeviceRefusal{Reason::no_trajectory, {}};
       try {
-        owned = std::make_unique<TrajectoryDevice>("Scripted: " + script_file.filename().string(),
-                                                   std::move(script));
+        auto scripted = std::make_unique<TrajectoryDevice>(
+            "Scripted: " + script_file.filename().string(), std::move(script));
+        if (scripts_paced_) scripted->play_on(&simulated_clock_s_);
+        owned = std::move(scripted);
       } catch (const std::exception& e) {
         return DeviceRefusal{Reason::no_trajectory, e.what()};
       }

@@ -307,6 +307,10 @@ class RealtimeSimulation {
   // The simulated time of the last published cycle, readable from any thread without a lock: the
   // clock a scripted device paced by this simulation plays on (TrajectoryDevice::play_on).
   const std::atomic<double>& simulated_time_s() const { return simulated_time_s_; }
+  // Before start(): each published cycle's time is stored in `clock_s` too, a clock that outlives
+  // this simulation (the station's: the simulation that replaces this one after a model change
+  // goes on storing to it, so a paced script is not left holding a dangling clock). Null: none.
+  void publish_time_to(std::atomic<double>* clock_s);
   const SimModel& model() const { return *model_; }
   std::shared_ptr<const SimModel> shared_model() const { return model_; }
   double step_s() const { return step_s_; }
@@ -411,7 +415,8 @@ class RealtimeSimulation {
       dropped_s_{0.0};
   std::atomic<bool> behind_{false}, stability_limited_{false};
   std::atomic<double> simulated_time_s_{0.0};  // state_.time_s as of the last published cycle
-  StateCheckpoint checkpoint_;                 // simulation thread only
+  std::atomic<double>* published_clock_s_ = nullptr;  // publish_time_to's
+  StateCheckpoint checkpoint_;                        // simulation thread only
   std::atomic<int> rollbacks_{0}, rejected_inputs_{0};
   std::atomic<HealthProblem> last_problem_{HealthProblem::none};
   std::atomic<bool> halted_{false};

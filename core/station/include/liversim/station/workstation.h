@@ -234,6 +234,16 @@ class Workstation {
                                           std::vector<TrajectoryPoint> script = {},
                                           const std::filesystem::path& script_file = {});
   DeviceChoice device() const { return device_; }
+  // Scripted devices chosen from now on (either hand's) play on the simulation's time instead of
+  // the servo's wall clock (TrajectoryDevice::play_on): a script then waits for a simulation that
+  // falls behind, so what it does to the tissue does not turn on the machine's load (`record
+  // --paced`). Their frames are still recorded at the servo's rate; replays keep the servo's clock.
+  // A restart from rest sets the simulation's time back to 0: a paced script then holds its point
+  // until the time is back where the script began (record never restarts).
+  void play_scripts_on_simulated_time(bool paced) { scripts_paced_ = paced; }
+  // The clock paced scripts play on: every simulation the station runs stores its time there at
+  // each published cycle, so it outlives a model change's new simulation.
+  const std::atomic<double>& simulated_clock_s() const { return simulated_clock_s_; }
   // A device in the left hand too (issue 43: forceps in one hand hold while the other cuts),
   // driven by the same servo as the right hand's: a scripted trajectory (its file named in
   // `script_file`), mapped by `mapping`; its tool is listener.left_device_tool's. It is taken at
@@ -360,6 +370,8 @@ class Workstation {
 
   SceneSetup setup_;
   std::shared_ptr<const SimModel> scene_model_;  // setup_'s model, uncut, with the integrator
+  // Declared before the simulations and devices that use it, so destroyed after them.
+  std::atomic<double> simulated_clock_s_{0.0};
   std::unique_ptr<RealtimeSimulation> simulation_;
   std::optional<OpenedScenario> scenario_;
   std::uint64_t shown_topology_ = 0;  // the cut of the last frame's snapshot
@@ -392,6 +404,7 @@ class Workstation {
   bool left_device_is_station_omni_ = false, pending_left_device_is_station_omni_ = false;
   WorkspaceMapping left_mapping_;
   ManualDevice* mouse_ = nullptr;  // own_device_, while the mouse is the device
+  bool scripts_paced_ = false;     // play_scripts_on_simulated_time's
   std::unique_ptr<ServoLoop> servo_;
   std::vector<TrajectoryPoint> replay_points_;
   WorkspaceMapping replay_mapping_;
