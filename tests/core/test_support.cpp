@@ -145,6 +145,40 @@ TEST(Support, NoNodeOfTheLiverAtRestTouchesItsSupport) {
 // The real-time loop steps through the guard, which bounds each node's kinetic energy by the
 // energy supplied: what gravity releases as the organ comes down counts, so a box let go above its
 // support falls onto it and settles without a single step undone, its books closing.
+// The moulded bed rises to the liver's rim within a cell or two; the penalty pushes along the
+// support's gradient, so such a wall pushed a rim node sideways many times harder than up, and the
+// sagging liver's rim chattered against it at metres per second (the wedge resection with gravity
+// ran at a tenth of real time). The support is deepened so that it nowhere rises more steeply than
+// kSupportMaxSlope; the bilinear slope inside a cell is a mean of its sides' and obeys it too.
+TEST(Support, NowhereRisesMoreSteeplyThanItsSlopeLimit) {
+  const SceneSetup scene = default_scene(3841);
+  const BoundarySurface surface = extract_surface(scene.mesh);
+  for (const Eigen::Vector3d& down :
+       {Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1)}) {
+    auto steepest = [&](const SupportSurface& support) {
+      double worst = 0.0;
+      for (int j = 0; j < support.cells_v; ++j)
+        for (int i = 0; i < support.cells_u; ++i)
+          for (const double a : {0.01, 0.5, 0.99}) {
+            const Eigen::Vector3d point =
+                (support.origin_u_m + (i + a) * support.cell_m) * support.axis_u +
+                (support.origin_v_m + (j + 1.0 - a) * support.cell_m) * support.axis_v;
+            const SupportSurface::Depth under = support.depth_under(point);
+            worst = std::max({worst, std::abs(under.slope_u), std::abs(under.slope_v)});
+          }
+      return worst;
+    };
+    const SupportSurface moulded =
+        support_under(scene.mesh.rest_position_m, surface, down, 0.002, 0.05, kClearance, INFINITY);
+    EXPECT_GT(steepest(moulded), 5.0) << "down " << down.transpose() << ": the rim's wall";
+    const SupportSurface limited = support_under(scene.mesh, down);
+    EXPECT_LE(steepest(limited), kSupportMaxSlope + 1e-9) << "down " << down.transpose();
+    // Only deepened: nowhere shallower than the moulded bed.
+    for (std::size_t k = 0; k < limited.depth_m.size(); ++k)
+      ASSERT_GE(limited.depth_m[k], moulded.depth_m[k]) << k;
+  }
+}
+
 TEST(Support, TheGuardLetsGravityBringTheBodyDownOntoIt) {
   const TetMesh mesh = box();
   const SimModel model = resting_model(mesh, 200.0);

@@ -29,13 +29,48 @@ SupportSurface::Depth SupportSurface::depth_under(const Eigen::Vector3d& point_m
   return out;
 }
 
+void limit_support_slope(SupportSurface& support, double max_slope) {
+  // Max-plus relaxation over the 8 neighbours, sweeping forward then backward until nothing
+  // moves: depth(p) >= depth(q) - max_slope * |p - q|. Only deepens, so nothing the support
+  // cleared at rest touches it.
+  const int nu = support.cells_u + 1, nv = support.cells_v + 1;
+  const double straight = max_slope * support.cell_m, diagonal = straight * std::sqrt(2.0);
+  auto at = [&](int i, int j) -> double& {
+    return support.depth_m[static_cast<std::size_t>(j) * static_cast<std::size_t>(nu) +
+                           static_cast<std::size_t>(i)];
+  };
+  auto relax = [&](int i, int j) {
+    bool moved = false;
+    double& here = at(i, j);
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        if ((di == 0 && dj == 0) || i + di < 0 || j + dj < 0 || i + di >= nu || j + dj >= nv)
+          continue;
+        const double bound = at(i + di, j + dj) - (di != 0 && dj != 0 ? diagonal : straight);
+        if (bound > here) {
+          here = bound;
+          moved = true;
+        }
+      }
+    return moved;
+  };
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (int j = 0; j < nv; ++j)
+      for (int i = 0; i < nu; ++i) moved |= relax(i, j);
+    for (int j = nv - 1; j >= 0; --j)
+      for (int i = nu - 1; i >= 0; --i) moved |= relax(i, j);
+  }
+}
+
 SupportSurface support_under(const NodeArray& rest_position_m, const BoundarySurface& surface,
                              const Eigen::Vector3d& down, double cell_m, double margin_m,
-                             double clearance_m) {
+                             double clearance_m, double max_slope) {
   if (!down.allFinite() || down.norm() == 0.0)
     throw std::invalid_argument("the support needs a direction of gravity, not zero");
-  if (!(cell_m > 0.0) || !(margin_m >= 0.0) || !(clearance_m >= 0.0))
-    throw std::invalid_argument("the support's cell must be > 0 and its margin and clearance >= 0");
+  if (!(cell_m > 0.0) || !(margin_m >= 0.0) || !(clearance_m >= 0.0) || !(max_slope > 0.0))
+    throw std::invalid_argument(
+        "the support's cell and its steepest slope must be > 0 and its margin and clearance >= 0");
   if (surface.triangles.empty())
     throw std::invalid_argument("the support needs the organ's surface, which has no triangles");
   SupportSurface support;
@@ -135,6 +170,7 @@ SupportSurface support_under(const NodeArray& rest_position_m, const BoundarySur
       if (!std::isnan(deepest_around))
         support.depth_m[static_cast<std::size_t>(j) * row + i] = deepest_around + clearance_m;
     }
+  if (std::isfinite(max_slope)) limit_support_slope(support, max_slope);
   return support;
 }
 

@@ -39,15 +39,28 @@ struct SupportSurface {
   Depth depth_under(const Eigen::Vector3d& point_m) const;
 };
 
+// The steepest the support may rise, as rise over run (1: 45°). The organ's underside rises to its
+// rim within a cell or two; a penalty pushes along the support's gradient, so such a wall pushed a
+// node at the rim sideways dozens of times harder than up, and the sagging liver's rim chattered
+// against it at metres per second, setting the explicit step (issue 42).
+inline constexpr double kSupportMaxSlope = 1.0;
+
+// Deepens the support wherever it rises more steeply than `max_slope` toward a deeper neighbour:
+// afterwards depth(p) >= depth(q) - max_slope·|p - q| for all neighbouring grid points p, q.
+void limit_support_slope(SupportSurface& support, double max_slope);
+
 // The support under an organ at rest: the organ's underside over its footprint (each grid point
 // the deepest point of the boundary over the cells around it, so that no node lies below the
 // bilinear surface between grid points: under a slope the bed is up to a cell's rise deeper),
 // the tray (its deepest node) elsewhere, both `clearance_m` deeper so that the organ at rest
 // touches nothing; the grid reaches `margin_m`
 // beyond the footprint on every side. `down` need not be of unit length (not zero).
+// The support is then deepened where it would rise more steeply than `max_slope`
+// (limit_support_slope; infinity: as moulded).
 SupportSurface support_under(const NodeArray& rest_position_m, const BoundarySurface& surface,
                              const Eigen::Vector3d& down, double cell_m = 0.002,
-                             double margin_m = 0.05, double clearance_m = 1e-4);
+                             double margin_m = 0.05, double clearance_m = 1e-4,
+                             double max_slope = kSupportMaxSlope);
 // The same under a mesh at rest (its boundary extracted), with the defaults: what a scene with
 // gravity gets.
 SupportSurface support_under(const TetMesh& mesh, const Eigen::Vector3d& down);
