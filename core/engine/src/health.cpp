@@ -112,7 +112,8 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
   const bool saved_already = checkpoint.valid && checkpoint.step_count == state.step_count &&
                              checkpoint.time_s == state.time_s;
   if (on_entry == HealthProblem::none || !checkpoint.valid) {
-    if (!saved_already) save_checkpoint(state, checkpoint);
+    if (!saved_already && (options.checkpoint_on_entry || !checkpoint.valid))
+      save_checkpoint(state, checkpoint);
   } else {
     report.problem = on_entry;
     ++report.rollbacks;
@@ -132,7 +133,7 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
     const HealthProblem problem = steps.unconverged_steps > 0 ? HealthProblem::solver_failed
                                                               : check_health(model, state, options);
     if (problem == HealthProblem::none) {
-      save_checkpoint(state, checkpoint);  // the newest good state
+      if (options.checkpoint_after_advance) save_checkpoint(state, checkpoint);  // newest good
       report.steps = steps;
       report.step_scale = scale;
       checkpoint.step_scale = std::min(1.0, 2.0 * scale);

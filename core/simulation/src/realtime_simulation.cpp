@@ -531,6 +531,9 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
     for (int s = 0; s < steps; ++s) {
       GuardOptions step_guard = guard;
       step_guard.check_energy = guard.check_energy && s == 0;
+      // One checkpoint per cycle: saved before its first step and after its last.
+      step_guard.checkpoint_on_entry = s == 0;
+      step_guard.checkpoint_after_advance = s == steps - 1;
       const GuardedReport one =
           guarded_advance(model, state_, tool_inputs(), step_s_, checkpoint_, step_guard);
       merge_guarded(guarded, one);
