@@ -136,6 +136,45 @@ TEST_P(GuardFixture, ANodeWithMoreKineticEnergyThanSuppliedIsARunaway) {
 
 // An implicit step whose Newton iteration stops short is not a solution: it is rolled back and
 // retried with shorter steps, and when none converges the state stays the last good one.
+// The real-time loop steps one cycle a step at a time while a tool acts, and keeps one checkpoint
+// for the cycle (saved before its first step and after its last): a state gone bad in between
+// goes back to the cycle's start, not to the step before.
+TEST_P(GuardFixture, TheStepsOfOneCycleShareOneCheckpoint) {
+  SimState state = make_rest_state(model);
+  StateCheckpoint checkpoint = make_checkpoint(model);
+  const StepInputs inputs{pull, {}};
+  ASSERT_EQ(guarded_advance(model, state, inputs, 0.01, checkpoint).problem, HealthProblem::none);
+  const double cycle_start_s = state.time_s;
+  const NodeArray cycle_start = state.position_m;
+  GuardOptions first, middle, last;
+  first.checkpoint_after_advance = false;
+  middle.checkpoint_on_entry = middle.checkpoint_after_advance = false;
+  last.checkpoint_on_entry = false;
+  ASSERT_FALSE(guarded_advance(model, state, inputs, 0.002, checkpoint, first).rollbacks);
+  ASSERT_FALSE(guarded_advance(model, state, inputs, 0.002, checkpoint, middle).rollbacks);
+  EXPECT_EQ(checkpoint.time_s, cycle_start_s) << "not saved within the cycle";
+  EXPECT_NEAR(state.time_s, cycle_start_s + 0.004, 1e-12);
+  state.position_m.y[3] = std::numeric_limits<double>::quiet_NaN();
+  const GuardedReport report = guarded_advance(model, state, inputs, 0.002, checkpoint, last);
+  EXPECT_GE(report.rollbacks, 1);
+  EXPECT_FALSE(report.gave_up);
+  // Back at the cycle's start and one step on from it; that state is the new checkpoint.
+  EXPECT_NEAR(state.time_s, cycle_start_s + 0.002, 1e-12);
+  EXPECT_EQ(checkpoint.time_s, state.time_s);
+  EXPECT_EQ(check_health(model, state), HealthProblem::none);
+  double moved = 0.0;
+  for (std::size_t n = 0; n < cycle_start.size(); ++n)
+    moved = std::max(moved, (state.position_m.at(n) - cycle_start.at(n)).norm());
+  EXPECT_LT(moved, 1e-3) << "one 2 ms step from the cycle's start";
+  // With the defaults each good step is saved: the same corruption goes back one step only.
+  SimState saved_each = make_rest_state(model);
+  StateCheckpoint each = make_checkpoint(model);
+  for (int i = 0; i < 3; ++i) guarded_advance(model, saved_each, inputs, 0.002, each);
+  saved_each.position_m.y[3] = std::numeric_limits<double>::quiet_NaN();
+  guarded_advance(model, saved_each, inputs, 0.002, each);
+  EXPECT_NEAR(saved_each.time_s, 0.008, 1e-12);
+}
+
 TEST(Guard, UnconvergedImplicitStepsAreRolledBack) {
   const TetMesh mesh = testing::block_mesh(4, 1, 1, {0.04, 0.01, 0.01});
   ModelOptions options;

@@ -701,6 +701,7 @@ void RealtimeSimulation::run() {
   std::uint64_t window_start_steps = state_.step_count;
   StepReport window_report = empty_window();
   double window_integrating_s = 0.0;
+  int window_retries = 0;  // the guard's rollbacks in the window (each retries at half the step)
   bool window_capped = false;
   bool close_books = false;  // close the energy books with the next advance
   double dropped_s = 0.0;
@@ -727,6 +728,7 @@ void RealtimeSimulation::run() {
              haptic_servo_ ? haptic_servo_->now_s() : std::numeric_limits<double>::quiet_NaN()});
       const GuardedReport guarded = advance_cycle(due.steps, check_energy);
       window_integrating_s += Seconds(Clock::now() - cycle_start).count();
+      window_retries += guarded.rollbacks;
       accumulate(window_report, guarded.steps);
       publish_cycle();
     } else {
@@ -772,6 +774,7 @@ void RealtimeSimulation::run() {
         record.smallest_mesh_limit_s = window_report.smallest_mesh_limit_s;
         record.smallest_travel_limit_s = window_report.smallest_travel_limit_s;
         record.smallest_spring_limit_s = window_report.smallest_spring_limit_s;
+        record.guard_retries = window_retries;
         trace_->push(record);
       }
       window_start = now;
@@ -779,6 +782,7 @@ void RealtimeSimulation::run() {
       window_start_steps = state_.step_count;
       window_report = empty_window();
       window_integrating_s = 0.0;
+      window_retries = 0;
       window_capped = false;
     }
   }

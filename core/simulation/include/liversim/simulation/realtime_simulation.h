@@ -136,6 +136,9 @@ struct LoopRecord {
   double smallest_mesh_limit_s = std::numeric_limits<double>::infinity();
   double smallest_travel_limit_s = std::numeric_limits<double>::infinity();
   double smallest_spring_limit_s = std::numeric_limits<double>::infinity();
+  // Steps the guard undid and retried at half the step (health.h): a step halved by a retry is
+  // told apart from one a limit split.
+  int guard_retries = 0;
   // A cut: the wall time of the whole update (the cut, the new model's surface and the tools on
   // it), whether it parted anything, and the model after it: its elements, its stable explicit
   // step and its smallest element height.
