@@ -559,6 +559,14 @@ std::string Workstation::left_device_name() const {
   return left_device_ ? left_device_->name() : std::string();
 }
 
+std::unique_ptr<TrajectoryDevice> Workstation::make_scripted_device(
+    std::vector<TrajectoryPoint> script, const std::filesystem::path& script_file) {
+  auto device = std::make_unique<TrajectoryDevice>("Scripted: " + script_file.filename().string(),
+                                                   std::move(script));
+  if (scripts_paced_) device->play_on(&simulated_clock_s_);
+  return device;
+}
+
 std::unique_ptr<ServoLoop> Workstation::make_servo(HapticDevice& device,
                                                    const WorkspaceMapping& mapping,
                                                    HapticDevice* left) {
@@ -577,10 +585,7 @@ std::optional<DeviceRefusal> Workstation::use_left_device(std::vector<Trajectory
   if (auto problem = validate(mapping)) return DeviceRefusal{Reason::servo_failed, *problem};
   std::unique_ptr<HapticDevice> device;
   try {
-    auto scripted = std::make_unique<TrajectoryDevice>(
-        "Scripted: " + script_file.filename().string(), std::move(script));
-    if (scripts_paced_) scripted->play_on(&simulated_clock_s_);
-    device = std::move(scripted);
+    device = make_scripted_device(std::move(script), script_file);
   } catch (const std::exception& e) {
     return DeviceRefusal{Reason::no_trajectory, e.what()};
   }
@@ -622,10 +627,7 @@ std::optional<DeviceRefusal> Workstation::use_device(DeviceChoice choice,
     case DeviceChoice::scripted:
       if (script.empty()) return DeviceRefusal{Reason::no_trajectory, {}};
       try {
-        auto scripted = std::make_unique<TrajectoryDevice>(
-            "Scripted: " + script_file.filename().string(), std::move(script));
-        if (scripts_paced_) scripted->play_on(&simulated_clock_s_);
-        owned = std::move(scripted);
+        owned = make_scripted_device(std::move(script), script_file);
       } catch (const std::exception& e) {
         return DeviceRefusal{Reason::no_trajectory, e.what()};
       }

@@ -344,9 +344,13 @@ class Workstation {
   void attach_device();
   void detach_device();
   std::optional<DeviceToolSettings> device_tool(Hand hand = Hand::right) const;
-  // A servo for `device` in the right hand, and `left` (if any) in the left.
   // The station's Omni, lent to the left hand by a choice not yet taken, back to omni_.
   void take_back_pending_omni();
+  // A scripted device playing `script` (throws for a bad one, as TrajectoryDevice does), paced when
+  // play_scripts_on_simulated_time says so.
+  std::unique_ptr<TrajectoryDevice> make_scripted_device(std::vector<TrajectoryPoint> script,
+                                                         const std::filesystem::path& script_file);
+  // A servo for `device` in the right hand, and `left` (if any) in the left.
   std::unique_ptr<ServoLoop> make_servo(HapticDevice& device, const WorkspaceMapping& mapping,
                                         HapticDevice* left);
   void start_model_change(ModelChange change, std::function<ModelChangeBuilt()> build);
