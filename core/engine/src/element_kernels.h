@@ -58,6 +58,8 @@ struct ViscousKernelData {
   const double* arm_energy_scale;
   const double* arm_energy_volumetric;
   const double* step_over_relaxation_time;
+  // Per element: what its yield limit is raised by (SimModel::in_vivo_stress_pa; zeros: nothing).
+  const double* yield_raise_pa;
   // Per block: 0 where every element of it has Fp = I (ViscousHistory::plastic_blocks).
   const std::uint8_t* plastic_block;
   // Out: 1 where the element yields or has collapsed (J < J0): its history is left untouched and

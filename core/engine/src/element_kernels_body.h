@@ -364,7 +364,7 @@ void viscous_law(const ViscousKernelData& data, std::size_t block, std::size_t c
     const double deviator_sq = (t00 - mean) * (t00 - mean) + (t11 - mean) * (t11 - mean) +
                                (t22 - mean) * (t22 - mean) +
                                2.0 * (t12 * t12 + t02 * t02 + t01 * t01);
-    const double yield = constant(v.yield_limit_pa, i);
+    const double yield = constant(v.yield_limit_pa, i) + v.yield_raise_pa[block + i];
     const double J = fe.m[0][0] * (fe.m[1][1] * fe.m[2][2] - fe.m[2][1] * fe.m[1][2]) +
                      fe.m[1][0] * (fe.m[2][1] * fe.m[0][2] - fe.m[0][1] * fe.m[2][2]) +
                      fe.m[2][0] * (fe.m[0][1] * fe.m[1][2] - fe.m[1][1] * fe.m[0][2]);

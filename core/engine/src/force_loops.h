@@ -102,6 +102,10 @@ struct ViscousContext {
   double* dissipated_j = nullptr;         // committing: the dashpots' work of the step is added
 };
 
+double yield_raise_pa(const SimModel& model, std::size_t e) {
+  return model.in_vivo_stress_pa.empty() ? 0.0 : model.in_vivo_stress_pa[e];
+}
+
 bool in_viscous_region(const SimModel& model, std::size_t e) {
   return built(model).viscous &&
          model.viscous_parameters[static_cast<std::size_t>(model.region[e])].has_value();
@@ -126,7 +130,7 @@ Eigen::Matrix3d stress_of(const SimModel& model, std::size_t e, const Eigen::Mat
       const ViscousTissueStep& s = **step;
       ViscousTissueState history = viscous.history->load(e);
       const double before = maxwell_arm_energy_density(history.maxwell_stress_pa, s);
-      P = viscous_tissue_update(F, s, history);
+      P = viscous_tissue_update(F, s, history, yield_raise_pa(model, e));
       viscous.history->store(e, history);
       *viscous.dissipated_j += model.rest_volume_m3[e] * s.dt_s / s.relaxation_time_s *
                                (before + maxwell_arm_energy_density(history.maxwell_stress_pa, s));
@@ -384,6 +388,8 @@ ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& positio
                                &data.step_over_relaxation_time};
   for (int k = 0; k < 10; ++k) *fields[k] = constants + k * regions;
   data.needs_general = scratch.needs_general.data();
+  data.yield_raise_pa = model.in_vivo_stress_pa.empty() ? scratch.no_yield_raise_pa.data()
+                                                        : model.in_vivo_stress_pa.data();
   const detail::ViscousKernel kernel =
       detail::elastic_kernels().viscous[kFibres ? fibre_families(elastic) : 0];
   for_each_chunk(scratch, model.tet_count, kElementsPerChunk,

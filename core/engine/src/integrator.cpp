@@ -426,7 +426,9 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
     }
     // Plastic flow after the step, the arm's Q held (g = h = 1): first order in the flow, exact
     // under a held stress as the seed's Eq. 4.
-    if (step.viscoplastic) viscous_tissue_update(F, step, committed);
+    if (step.viscoplastic)
+      viscous_tissue_update(F, step, committed,
+                            model.in_vivo_stress_pa.empty() ? 0.0 : model.in_vivo_stress_pa[e]);
     dissipated_j += model.rest_volume_m3[e] / step.relaxation_time_s *
                     (arm_before + maxwell_arm_energy_density(committed.maxwell_stress_pa, step));
     state.viscous_history.store(e, committed);

@@ -1,4 +1,6 @@
 #include "liversim/engine/model_building.h"
+
+#include "liversim/engine/in_vivo_stress.h"
 #include "liversim/engine/validation_message.h"
 
 #include "liversim/engine/integrator.h"
@@ -271,6 +273,9 @@ void set_gravity(SimModel& model, const Eigen::Vector3d& gravity_m_per_s2,
   const double support_omega = model.support_frequency_fraction * model.max_frequency_rad_per_s;
   model.support_stiffness_per_kg = model.support ? support_omega * support_omega : 0.0;
   model.stable_time_step_s = stable_time_step_s(model, StepInputs{});
+  // The yield is measured above the stress the organ bears under its weight (in_vivo_stress.h).
+  model.in_vivo_stress_pa.clear();
+  model.in_vivo_stress_pa = in_vivo_stress_pa(model);
 }
 
 }  // namespace liversim

@@ -16,6 +16,7 @@ ForceScratch make_force_scratch(const SimModel& model) {
   if (model.effects.viscous) {
     scratch.region_constants.resize(10 * model.viscous_parameters.size());
     scratch.needs_general.resize(model.tet_count);
+    scratch.no_yield_raise_pa.assign(model.tet_count, 0.0);
   }
   if (model.effects.average_nodal_pressure) {
     scratch.element_volume_ratio.resize(model.tet_count);

@@ -176,7 +176,7 @@ Eigen::Matrix<double, 9, 9> viscoelastic_stress_tangent_rate_form(
 
 Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
                                       const ViscousTissueState& committed,
-                                      ViscousTissueState& trial) {
+                                      ViscousTissueState& trial, double yield_raise_pa) {
   const Eigen::Matrix3d arm_before = from_voigt(committed.maxwell_stress_pa);
   const Eigen::Matrix3d elastic_before = from_voigt(committed.elastic_stress_pa);
   Eigen::Matrix3d fp_inverse = committed.inverse_plastic_deformation;
@@ -210,7 +210,8 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
     const Eigen::Matrix3d deviator =
         kirchhoff - kirchhoff.trace() / 3.0 * Eigen::Matrix3d::Identity();
     const double equivalent_pa = std::sqrt(1.5 * deviator.squaredNorm());
-    if (equivalent_pa > vp.yield_limit_pa) {
+    const double yield_limit_pa = vp.yield_limit_pa + yield_raise_pa;
+    if (equivalent_pa > yield_limit_pa) {
       // Time hardening with increments of tⁿ (exact under a held stress, never the singular
       // rate n·tⁿ⁻¹), solved implicitly in closed form: the end-of-step equivalent stress is
       // σ_trial − 3·G·Δε, so Δε·η2 = (σ_end − σs)·Δ(tⁿ) gives the expression below. However
@@ -219,7 +220,7 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
       const double clock_increment = clock_power_increment(clock_s, step.dt_s, vp.creep_index_n);
       clock_s += step.dt_s;
       const double increment =
-          (equivalent_pa - vp.yield_limit_pa) * clock_increment /
+          (equivalent_pa - yield_limit_pa) * clock_increment /
           (vp.eta2_pa_s_pow_n + 3.0 * step.step_shear_modulus_pa * clock_increment);
       if (increment > 0.0) {
         // Fe ← exp(−Δε·N)·Fe with N = (3/2)·dev τ/σ_eq: flow along the Kirchhoff deviator,
@@ -248,8 +249,8 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
 }
 
 Eigen::Matrix3d viscous_tissue_update(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
-                                      ViscousTissueState& state) {
-  return viscous_tissue_stress(F, step, state, state);
+                                      ViscousTissueState& state, double yield_raise_pa) {
+  return viscous_tissue_stress(F, step, state, state, yield_raise_pa);
 }
 
 // ---------------------------------------------------------------- history of a mesh

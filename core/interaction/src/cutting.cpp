@@ -1074,6 +1074,7 @@ void take_element_data(SimModel& m, const std::vector<TetIndex>& origin) {
   take(m.region);
   take(m.fibre_parameters);
   for (auto& family : m.fibre_direction) take(family);
+  take(m.in_vivo_stress_pa);
 }
 
 // Dm⁻¹ and rest volume of element i from its corners' rest positions.

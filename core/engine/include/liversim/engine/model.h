@@ -116,6 +116,11 @@ struct SimModel {
   std::array<std::vector<Eigen::Vector3d>, 2> fibre_direction;
   // Per region, the viscous law of regions that have one (allocated only when effects.viscous).
   std::vector<std::optional<ViscousTissueParameters>> viscous_parameters;
+  // Per element, the von Mises stress (Pa) it bears in vivo: the largest as the organ settles
+  // under its own weight on its support (in_vivo_stress.h). Its yield limit is measured above it:
+  // tissue that has borne its weight yields under what an instrument adds, not under its weight.
+  // Empty: none (no gravity, or no region that yields).
+  std::vector<double> in_vivo_stress_pa;
   NodeArray rest_position_m;
   std::vector<double> lumped_mass_kg;
   std::vector<double> inverse_mass_per_kg;  // 0 on fixed nodes, so they never move

@@ -37,6 +37,8 @@ double tissue_mass_kg(const SimModel& model);
 // Switches gravity on with this acceleration (m/s², the mesh's axes; zero: off) and the support
 // the organ rests on (null: none), as build_model would make them, also on a cut model: the
 // support's stiffness follows the model's largest frequency, and the stable step follows both.
+// With gravity and a region that yields, the in-vivo stress is measured (in_vivo_stress.h: the
+// organ settles for 2 s of simulated time on the calling thread).
 // Throws std::invalid_argument for an acceleration that is not finite.
 void set_gravity(SimModel& model, const Eigen::Vector3d& gravity_m_per_s2,
                  std::shared_ptr<const SupportSurface> support);

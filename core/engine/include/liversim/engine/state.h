@@ -45,6 +45,7 @@ struct ForceScratch {
   // per region), and the elements it leaves to the general update (yield, collapse).
   std::vector<double> region_constants;
   std::vector<std::uint8_t> needs_general;
+  std::vector<double> no_yield_raise_pa;  // zeros: the kernel's yield raise without in-vivo stress
   // Threads of the loops; null: the calling thread alone. Copies of a state share it (a pool runs
   // one job at a time; a second caller meanwhile runs on its own thread).
   std::shared_ptr<WorkerPool> workers;

@@ -185,14 +185,15 @@ class ViscousHistory {
 // deformations from the same committed state. Allocates nothing. Finite for every finite F,
 // including det F ≤ 0: below J = neo_hookean::kMinVolumeRatio the Maxwell arm is not fed (its
 // 2nd Piola–Kirchhoff elastic stress grows like C⁻¹ without bound as J → 0), it only relaxes, and
-// there is no plastic flow.
+// there is no plastic flow. `yield_raise_pa` raises the yield limit of this element: the stress it
+// bears in vivo (SimModel::in_vivo_stress_pa), which its yield is measured above.
 Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
                                       const ViscousTissueState& committed,
-                                      ViscousTissueState& trial);
+                                      ViscousTissueState& trial, double yield_raise_pa = 0.0);
 
 // viscous_tissue_stress, committing the step into `state`.
 Eigen::Matrix3d viscous_tissue_update(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
-                                      ViscousTissueState& state);
+                                      ViscousTissueState& state, double yield_raise_pa = 0.0);
 
 // The Maxwell arm as an ODE, for integrators that carry it in their own state (Runge–Kutta stages,
 // implicit solves), so that it advances with the scheme's own order. With Q = S_e − H (H the arm
