@@ -17,7 +17,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 namespace liversim {
 namespace {
@@ -70,10 +73,12 @@ TEST(Support, UnderASlopeTheBedHasTheSlopesGradient) {
   EXPECT_NEAR(gradient.y(), 0.0, 1e-9);
 }
 
-SimModel resting_model(const TetMesh& mesh, double damping_per_s) {
+SimModel resting_model(const TetMesh& mesh, double damping_per_s,
+                       double contact_damping_ratio = 1.0) {
   ModelOptions options;
   options.regions[0].tissue = TissueMaterial{20000.0, 0.3, 1060.0};
   options.mass_damping_per_s = damping_per_s;
+  options.support_damping_ratio = contact_damping_ratio;
   options.gravity_m_per_s2 = {0.0, 0.0, -kEarth};
   // The box 5 mm above the support it would rest on.
   TetMesh lifted = mesh;
@@ -202,15 +207,16 @@ TEST(Support, TheGuardLetsGravityBringTheBodyDownOntoIt) {
   EXPECT_GT(deepest, kClearance) << "it did not come down onto the support";
 }
 
-// Undamped, the box falls, hits the support and bounces: the books, holding the support's springs
-// and gravity's potential, stay at the nothing they opened with. RK4, whose velocity is at the
+// Undamped (the tissue and the contact), the box falls, hits the support and bounces: the books,
+// holding the support's springs (its push and its hold) and gravity's potential, stay at the
+// nothing they opened with. RK4, whose velocity is at the
 // positions' time (leapfrog's lags half a step, which in free fall alone puts ½·M·g²·Δt·t
 // between the books' kinetic and potential energy), at a quarter of its stable step: its energy
 // error per period of the fastest mode is O((ωΔt)⁶), and the support's kink at contact costs it
 // an O(Δt²) error there. The tolerance is 4 % of the potential given up.
 TEST(Support, TheEnergyBooksHoldItsSprings) {
   const TetMesh mesh = box();
-  SimModel model = resting_model(mesh, 0.0);
+  SimModel model = resting_model(mesh, 0.0, 0.0);
   model.integrator.kind = IntegratorKind::rk4;
   model.integrator.step_s = 0.25 * model.stable_time_step_s;
   SimState state = make_rest_state(model);
@@ -222,6 +228,73 @@ TEST(Support, TheEnergyBooksHoldItsSprings) {
     EXPECT_NEAR(books.held_j(), 0.0, 0.04 * -books.gravity_j) << "at " << state.time_s << " s";
   }
   EXPECT_TRUE(touched) << "the box never reached the support";
+}
+
+// The bed holds what lies on it where it lay, up to μ times its push: the box, settled on its
+// support, pulled sideways by a quarter of its weight (a tilt of gravity by 14°) stays where it is
+// (its hold yields only to more than μ = 0.5 of its weight); by three quarters of it, more than
+// the hold can bear, it slides away, and past kSupportHoldReleaseM the hold lets go.
+TEST(Support, HoldsWhatLiesOnItWhereItLayUpToItsFriction) {
+  const TetMesh mesh = box();
+  auto slide_after_m = [&](double sideways_g) {
+    SimModel model = resting_model(mesh, 8.0);
+    SimState state = make_rest_state(model);
+    advance(model, state, {}, 0.3);  // down onto the support, and settled
+    auto centre_x = [&] {
+      double sum = 0.0;
+      for (std::size_t n = 0; n < model.node_count; ++n) sum += state.position_m.x[n];
+      return sum / static_cast<double>(model.node_count);
+    };
+    const double before_m = centre_x();
+    set_gravity(model, {sideways_g * kEarth, 0.0, -kEarth}, model.support);
+    advance(model, state, {}, 0.5);
+    return centre_x() - before_m;
+  };
+  EXPECT_EQ(SimModel{}.support_friction_coefficient, 0.5);
+  const double held_m = slide_after_m(0.25);
+  EXPECT_LT(std::abs(held_m), 1e-3) << "the bed did not hold the box";
+  EXPECT_GT(slide_after_m(0.75), kSupportHoldReleaseM) << "the bed held more than its friction";
+}
+
+// Touching the bed, a node is damped at ζ = 1 of critical: the box dropped onto its support with
+// no other damping comes to rest, where without the contact's damping it keeps bouncing, and the
+// books show the energy taken, none made.
+TEST(Support, WhatTouchesItIsDampedAndTheBooksShowWhatItTakes) {
+  const TetMesh mesh = box();
+  auto kinetic_after_j = [&](double ratio, EnergyBalance* books) {
+    SimModel model = resting_model(mesh, 0.0, ratio);
+    SimState state = make_rest_state(model);
+    advance(model, state, {}, 0.3);
+    if (books) *books = energy_balance(model, state, {});
+    return kinetic_energy_j(model, state.velocity_m_per_s);
+  };
+  EnergyBalance books;
+  const double damped_j = kinetic_after_j(1.0, &books);
+  const double undamped_j = kinetic_after_j(0.0, nullptr);
+  EXPECT_LT(damped_j, 0.01 * undamped_j) << damped_j << " J against " << undamped_j << " J";
+  EXPECT_GT(books.dissipated_j(), 0.9 * -books.gravity_j);
+}
+
+TEST(Support, ANegativeOrNotANumberFrictionOrDampingIsRefusedByName) {
+  const TetMesh mesh = box();
+  for (const double bad : {-0.1, std::numeric_limits<double>::quiet_NaN()}) {
+    ModelOptions friction;
+    friction.support_friction_coefficient = bad;
+    try {
+      build_model(mesh, friction);
+      ADD_FAILURE() << "friction " << bad << " was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("friction coefficient"), std::string::npos) << e.what();
+    }
+    ModelOptions damping;
+    damping.support_damping_ratio = bad;
+    try {
+      build_model(mesh, damping);
+      ADD_FAILURE() << "damping ratio " << bad << " was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("damping ratio"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include "liversim/engine/forces.h"
 #include "liversim/engine/state.h"
+#include "liversim/engine/support.h"
 
 #include <Eigen/Dense>
 
@@ -126,9 +127,10 @@ double support_energy_j(const SimModel& model, const NodeArray& position) {
   double energy = 0.0;
   for (std::size_t n = 0; n < model.node_count; ++n) {
     if (model.is_fixed[n]) continue;
-    const double past = model.support->depth_under(position.at(n)).past_m;
-    if (past > 0.0)
-      energy += 0.5 * model.lumped_mass_kg[n] * model.support_stiffness_per_kg * past * past;
+    energy += support_contact(*model.support, position.at(n), model.rest_position_m.at(n),
+                              model.lumped_mass_kg[n] * model.support_stiffness_per_kg,
+                              model.support_friction_coefficient)
+                  .energy_j;
   }
   return energy;
 }

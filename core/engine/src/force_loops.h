@@ -7,6 +7,7 @@
 #include "liversim/engine/forces.h"
 
 #include "liversim/engine/state.h"
+#include "liversim/engine/support.h"
 
 #include "element_kernels.h"
 #include "force_loop_bits.h"
@@ -628,17 +629,42 @@ void add_support_forces(const SimModel& model, const NodeArray& position, NodeAr
   const SupportSurface& support = *model.support;
   for (std::size_t n = 0; n < model.node_count; ++n) {
     if (model.is_fixed[n]) continue;
-    const SupportSurface::Depth under = support.depth_under(position.at(n));
-    const double past = under.past_m;
-    if (!(past > 0.0)) continue;
-    // −∇(½·k·p²), p = x·down − depth(u, v).
-    const double k = model.lumped_mass_kg[n] * model.support_stiffness_per_kg;
-    const Eigen::Vector3d push =
-        -k * past *
-        (support.down - under.slope_u * support.axis_u - under.slope_v * support.axis_v);
-    force.x[n] += push.x();
-    force.y[n] += push.y();
-    force.z[n] += push.z();
+    const SupportContact contact =
+        support_contact(support, position.at(n), model.rest_position_m.at(n),
+                        model.lumped_mass_kg[n] * model.support_stiffness_per_kg,
+                        model.support_friction_coefficient);
+    if (!contact.touching) continue;
+    force.x[n] += contact.force_n.x();
+    force.y[n] += contact.force_n.y();
+    force.z[n] += contact.force_n.z();
+  }
+}
+
+double support_damping_per_s(const SimModel& model) {
+  if constexpr (!kBuiltGravity) return 0.0;
+  if (!model.support) return 0.0;
+  return 2.0 * model.support_damping_ratio * std::sqrt(model.support_stiffness_per_kg);
+}
+
+void add_support_damping_rates(const SimModel& model, const NodeArray& position,
+                               std::vector<double>& damping_per_s) {
+  const double rate = here::support_damping_per_s(model);
+  if (!(rate > 0.0)) return;
+  for (std::size_t n = 0; n < model.node_count; ++n)
+    if (!model.is_fixed[n] && model.support->depth_under(position.at(n)).past_m > 0.0)
+      damping_per_s[n] += rate;
+}
+
+void add_support_damping_forces(const SimModel& model, const NodeArray& position,
+                                const NodeArray& velocity, NodeArray& force) {
+  const double rate = here::support_damping_per_s(model);
+  if (!(rate > 0.0)) return;
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    if (model.is_fixed[n] || !(model.support->depth_under(position.at(n)).past_m > 0.0)) continue;
+    const double c = rate * model.lumped_mass_kg[n];
+    force.x[n] -= c * velocity.x[n];
+    force.y[n] -= c * velocity.y[n];
+    force.z[n] -= c * velocity.z[n];
   }
 }
 

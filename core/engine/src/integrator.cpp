@@ -32,6 +32,7 @@ ElasticEvaluation evaluate_forces(const SimModel& model, SimState& state,
   // The support's push depends on where the nodes are, as the tissue's does: not an input whose
   // change the kick splits.
   add_support_forces(model, state.position_m, state.force_n);
+  add_support_damping_rates(model, state.position_m, state.spring_damping_per_s);
   for (const auto& spring : inputs.springs)
     state.spring_damping_per_s[spring.node] +=
         spring.damping_n_s_per_m * model.inverse_mass_per_kg[spring.node];
@@ -78,6 +79,8 @@ void kick_drift(const SimModel& model, SimState& state, const StepInputs& inputs
     max_speed_sq = std::max(max_speed_sq, v.x[n] * v.x[n] + v.y[n] * v.y[n] + v.z[n] * v.z[n]);
   }
   for (const auto& spring : inputs.springs) state.spring_damping_per_s[spring.node] = 0.0;
+  if (model.support)  // the support's rates, on the nodes it touched
+    std::fill(state.spring_damping_per_s.begin(), state.spring_damping_per_s.end(), 0.0);
   std::swap(state.integrator.previous_external_force_n, state.integrator.external_force_n);
   state.max_speed_m_per_s = std::sqrt(max_speed_sq);
   state.last_step_s = dt_s;
@@ -267,7 +270,7 @@ double explicit_step_limit_s(const SimModel& model, const StepInputs& inputs, do
       omega > 0.0 ? stability_interval(kind) / omega : std::numeric_limits<double>::infinity();
   // Damping is explicit in Runge–Kutta: a decay rate d needs d·Δt inside the real-axis
   // interval (RK4 2.785, Dormand–Prince 3.31; checked from the tableaus).
-  double decay_per_s = model.mass_damping_per_s;
+  double decay_per_s = model.mass_damping_per_s + support_damping_per_s(model);
   for (const auto& spring : inputs.springs)
     decay_per_s = std::max(decay_per_s,
                            model.mass_damping_per_s +
@@ -371,6 +374,7 @@ void add_input_forces(const SimModel& model, const StepInputs& inputs, const Nod
   add_external_forces(inputs, position, force);
   add_gravity_forces(model, force);
   add_support_forces(model, position, force);
+  add_support_damping_forces(model, position, velocity, force);
   for (const auto& spring : inputs.springs) {
     const auto n = spring.node;
     force.x[n] -= spring.damping_n_s_per_m * velocity.x[n];

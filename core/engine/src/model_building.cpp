@@ -90,6 +90,11 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
     throw std::invalid_argument("gravity must be a finite acceleration (m/s²)");
   if (!(options.support_frequency_fraction > 0.0 && options.support_frequency_fraction <= 1.0))
     throw std::invalid_argument("the support's frequency fraction must be in (0, 1]");
+  if (!(options.support_damping_ratio >= 0.0) || !std::isfinite(options.support_damping_ratio))
+    throw std::invalid_argument("the support's damping ratio must be a finite value ≥ 0");
+  if (!(options.support_friction_coefficient >= 0.0) ||
+      !std::isfinite(options.support_friction_coefficient))
+    throw std::invalid_argument("the support's friction coefficient must be a finite value ≥ 0");
   validate_integrator(options.integrator);
 
   SimModel model;
@@ -104,6 +109,8 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   model.gravity_m_per_s2 = options.gravity_m_per_s2;
   model.support = options.support;
   model.support_frequency_fraction = options.support_frequency_fraction;
+  model.support_damping_ratio = options.support_damping_ratio;
+  model.support_friction_coefficient = options.support_friction_coefficient;
 
   const std::size_t tets = model.tet_count;
   for (auto& entry : model.dm_inverse) entry.resize(tets);

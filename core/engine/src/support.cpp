@@ -178,4 +178,40 @@ SupportSurface support_under(const TetMesh& mesh, const Eigen::Vector3d& down) {
   return support_under(mesh.rest_position_m, extract_surface(mesh), down);
 }
 
+SupportContact support_contact(const SupportSurface& support, const Eigen::Vector3d& position_m,
+                               const Eigen::Vector3d& rest_position_m, double stiffness_n_per_m,
+                               double friction_coefficient) {
+  SupportContact contact;
+  const SupportSurface::Depth under = support.depth_under(position_m);
+  const double past = under.past_m;
+  if (!(past > 0.0)) return contact;
+  contact.touching = true;
+  const double k = stiffness_n_per_m;
+  // −∇(½·k·p²), p = x·down − depth(u, v).
+  const Eigen::Vector3d push =
+      -k * past * (support.down - under.slope_u * support.axis_u - under.slope_v * support.axis_v);
+  contact.force_n = push;
+  contact.energy_j = 0.5 * k * past * past;
+  // The hold: the force −min(k·d, μ·P·(1 − d/R)) along the offset d across gravity, the gradient
+  // of its potential for the push P as it is now.
+  Eigen::Vector3d offset = position_m - rest_position_m;
+  offset -= offset.dot(support.down) * support.down;
+  const double d = offset.norm();
+  const double limit_n = friction_coefficient * push.norm();
+  const double reach = kSupportHoldReleaseM;
+  if (!(d > 0.0) || !(limit_n > 0.0)) return contact;
+  // Where the spring meets the fading limit: k·s = μ·P·(1 − s/R).
+  const double held = limit_n / (k + limit_n / reach);
+  if (d <= held) {
+    contact.force_n -= k * offset;
+    contact.energy_j += 0.5 * k * d * d;
+    return contact;
+  }
+  const double beyond = std::min(d, reach);
+  contact.energy_j += 0.5 * k * held * held +
+                      limit_n * ((beyond - held) - (beyond * beyond - held * held) / (2.0 * reach));
+  if (d < reach) contact.force_n -= limit_n * (1.0 - d / reach) / d * offset;
+  return contact;
+}
+
 }  // namespace liversim

@@ -108,6 +108,14 @@ void add_gravity_forces(const SimModel& model, NodeArray& force);
 // Adds the push of the model's support (support.h) on the free nodes deeper than it at `position`;
 // nothing without a support.
 void add_support_forces(const SimModel& model, const NodeArray& position, NodeArray& force);
+// The contact damping of the support (support.h): its rate 2·ζ·ω (1/s; 0 without a support), added
+// to the rate of each free node touching it at `position`, or as forces −c·v on those nodes, for
+// schemes that take damping as a force.
+double support_damping_per_s(const SimModel& model);
+void add_support_damping_rates(const SimModel& model, const NodeArray& position,
+                               std::vector<double>& damping_per_s);
+void add_support_damping_forces(const SimModel& model, const NodeArray& position,
+                                const NodeArray& velocity, NodeArray& force);
 
 double strain_energy_j(const SimModel& model, const NodeArray& position);
 double kinetic_energy_j(const SimModel& model, const NodeArray& velocity);

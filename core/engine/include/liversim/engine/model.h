@@ -91,6 +91,10 @@ struct ModelOptions {
   // the mesh's highest at rest, so that it lowers the stable step by about f²/2 (2 % at 0.2).
   std::shared_ptr<const SupportSurface> support;
   double support_frequency_fraction = 0.2;
+  // The support's contact damping as a fraction of critical (support.h); ≥ 0.
+  double support_damping_ratio = 1.0;
+  // How hard the bed holds the organ where it lay, as a friction coefficient (support.h); ≥ 0.
+  double support_friction_coefficient = 0.5;
   IntegratorSettings integrator;
 };
 
@@ -138,6 +142,8 @@ struct SimModel {
   std::shared_ptr<const SupportSurface> support;
   double support_frequency_fraction = 0.2;  // ModelOptions'
   double support_stiffness_per_kg = 0.0;
+  double support_damping_ratio = 1.0;         // ModelOptions'
+  double support_friction_coefficient = 0.5;  // ModelOptions'
   // Largest eigenfrequency of M⁻¹K at rest (free nodes), from power iteration, and the explicit
   // step used: safety · 2/ω_max (reduced for damping).
   double max_frequency_rad_per_s = 0.0;

@@ -7,7 +7,15 @@
 // penalty spring, the gradient of ½·k·p² with p the depth past the support and k = m·ω², so that
 // every node meets the same contact frequency ω and a light node pushes no harder than a heavy
 // one. On a slope the push has a sideways part: the bed holds the organ as a bowl would.
-// Frictionless.
+//
+// The bed also holds the organ where it lay: a node touching it is pulled back across gravity
+// toward its rest place by the same k, up to μ times the push (static friction anchored at the
+// rest position: the organ's attachments to its bed), fading to nothing once it is
+// kSupportHoldReleaseM from it, so that a freed piece set down elsewhere lies free. Without it the
+// liver slid on its frictionless bed for as long as the scene ran, and its stress never settled
+// (issue 42). And a node touching the bed is damped, a fraction ζ of critical (2·ζ·ω per second,
+// integrated implicitly by the leapfrog): light surface nodes held by one or two elements rang
+// against the bed's creases at ~1 m/s without it.
 
 #include "liversim/engine/surface.h"
 #include "liversim/engine/tet_mesh.h"
@@ -44,6 +52,20 @@ struct SupportSurface {
 // node at the rim sideways dozens of times harder than up, and the sagging liver's rim chattered
 // against it at metres per second, setting the explicit step (issue 42).
 inline constexpr double kSupportMaxSlope = 1.0;
+
+// How far across gravity from its rest place the bed's hold on a node reaches (m).
+inline constexpr double kSupportHoldReleaseM = 0.01;
+
+// The support's force on one node and the energy it holds: the push out of the bed and the hold
+// toward the rest place (above), for a node of stiffness k = m·ω² (N/m).
+struct SupportContact {
+  bool touching = false;
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  double energy_j = 0.0;  // ½·k·p² of the push and the hold's potential
+};
+SupportContact support_contact(const SupportSurface& support, const Eigen::Vector3d& position_m,
+                               const Eigen::Vector3d& rest_position_m, double stiffness_n_per_m,
+                               double friction_coefficient);
 
 // Deepens the support wherever it rises more steeply than `max_slope` toward a deeper neighbour:
 // afterwards depth(p) >= depth(q) - max_slope·|p - q| for all neighbouring grid points p, q.
