@@ -277,23 +277,20 @@ TEST(Support, WhatTouchesItIsDampedAndTheBooksShowWhatItTakes) {
 
 TEST(Support, ANegativeOrNotANumberFrictionOrDampingIsRefusedByName) {
   const TetMesh mesh = box();
+  auto expect_refused = [&](const ModelOptions& options, const std::string& named) {
+    try {
+      build_model(mesh, options);
+      ADD_FAILURE() << "a bad " << named << " was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  };
   for (const double bad : {-0.1, std::numeric_limits<double>::quiet_NaN()}) {
-    ModelOptions friction;
+    ModelOptions friction, damping;
     friction.support_friction_coefficient = bad;
-    try {
-      build_model(mesh, friction);
-      ADD_FAILURE() << "friction " << bad << " was taken";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("friction coefficient"), std::string::npos) << e.what();
-    }
-    ModelOptions damping;
     damping.support_damping_ratio = bad;
-    try {
-      build_model(mesh, damping);
-      ADD_FAILURE() << "damping ratio " << bad << " was taken";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("damping ratio"), std::string::npos) << e.what();
-    }
+    expect_refused(friction, "friction coefficient");
+    expect_refused(damping, "damping ratio");
   }
 }
 
