@@ -47,11 +47,13 @@ struct SupportSurface {
   Depth depth_under(const Eigen::Vector3d& point_m) const;
 };
 
-// The steepest the support may rise, as rise over run (1: 45°). The organ's underside rises to its
+// The steepest the support may rise, as rise over run (3: 72°). The organ's underside rises to its
 // rim within a cell or two; a penalty pushes along the support's gradient, so such a wall pushed a
 // node at the rim sideways dozens of times harder than up, and the sagging liver's rim chattered
-// against it at metres per second, setting the explicit step (issue 42).
-inline constexpr double kSupportMaxSlope = 1.0;
+// against it at metres per second, setting the explicit step (issue 42). Limited to 1 (45°), the
+// bed fell away under the rim and the left lobe's tip drooped more than 2 cm into the gap; with the
+// bed's hold and damping, 3 keeps the rim quiet and the tip within 1 cm (docs/tissue-model.md).
+inline constexpr double kSupportMaxSlope = 3.0;
 
 // How far across gravity from its rest place the bed's hold on a node reaches (m).
 inline constexpr double kSupportHoldReleaseM = 0.01;
