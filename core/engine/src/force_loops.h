@@ -5,6 +5,7 @@
 // its mask of kWithout* bits; unset, this is the engine's build.
 
 #include "liversim/engine/forces.h"
+#include "liversim/engine/in_vivo_stress.h"
 
 #include "liversim/engine/state.h"
 #include "liversim/engine/support.h"
@@ -102,10 +103,6 @@ struct ViscousContext {
   const ViscousArmInputs* arm = nullptr;  // set: the arm is carried by the integrator
   double* dissipated_j = nullptr;         // committing: the dashpots' work of the step is added
 };
-
-double yield_raise_pa(const SimModel& model, std::size_t e) {
-  return model.in_vivo_stress_pa.empty() ? 0.0 : model.in_vivo_stress_pa[e];
-}
 
 bool in_viscous_region(const SimModel& model, std::size_t e) {
   return built(model).viscous &&
@@ -623,10 +620,18 @@ void add_gravity_forces(const SimModel& model, NodeArray& force) {
   }
 }
 
-void add_support_forces(const SimModel& model, const NodeArray& position, NodeArray& force) {
+double support_damping_per_s(const SimModel& model) {
+  if constexpr (!kBuiltGravity) return 0.0;
+  if (!model.support) return 0.0;
+  return 2.0 * model.support_damping_ratio * std::sqrt(model.support_stiffness_per_kg);
+}
+
+void add_support_forces(const SimModel& model, const NodeArray& position, NodeArray& force,
+                        const SupportDamping& damping) {
   if constexpr (!kBuiltGravity) return;
   if (!model.support) return;
   const SupportSurface& support = *model.support;
+  const double rate = here::support_damping_per_s(model);
   for (std::size_t n = 0; n < model.node_count; ++n) {
     if (model.is_fixed[n]) continue;
     const SupportContact contact =
@@ -634,37 +639,14 @@ void add_support_forces(const SimModel& model, const NodeArray& position, NodeAr
                         model.lumped_mass_kg[n] * model.support_stiffness_per_kg,
                         model.support_friction_coefficient);
     if (!contact.touching) continue;
-    force.x[n] += contact.force_n.x();
-    force.y[n] += contact.force_n.y();
-    force.z[n] += contact.force_n.z();
-  }
-}
-
-double support_damping_per_s(const SimModel& model) {
-  if constexpr (!kBuiltGravity) return 0.0;
-  if (!model.support) return 0.0;
-  return 2.0 * model.support_damping_ratio * std::sqrt(model.support_stiffness_per_kg);
-}
-
-void add_support_damping_rates(const SimModel& model, const NodeArray& position,
-                               std::vector<double>& damping_per_s) {
-  const double rate = here::support_damping_per_s(model);
-  if (!(rate > 0.0)) return;
-  for (std::size_t n = 0; n < model.node_count; ++n)
-    if (!model.is_fixed[n] && model.support->depth_under(position.at(n)).past_m > 0.0)
-      damping_per_s[n] += rate;
-}
-
-void add_support_damping_forces(const SimModel& model, const NodeArray& position,
-                                const NodeArray& velocity, NodeArray& force) {
-  const double rate = here::support_damping_per_s(model);
-  if (!(rate > 0.0)) return;
-  for (std::size_t n = 0; n < model.node_count; ++n) {
-    if (model.is_fixed[n] || !(model.support->depth_under(position.at(n)).past_m > 0.0)) continue;
-    const double c = rate * model.lumped_mass_kg[n];
-    force.x[n] -= c * velocity.x[n];
-    force.y[n] -= c * velocity.y[n];
-    force.z[n] -= c * velocity.z[n];
+    Eigen::Vector3d f = contact.force_n;
+    if (damping.rate_per_s)
+      (*damping.rate_per_s)[n] += rate;
+    else if (damping.velocity)
+      f -= rate * model.lumped_mass_kg[n] * damping.velocity->at(n);
+    force.x[n] += f.x();
+    force.y[n] += f.y();
+    force.z[n] += f.z();
   }
 }
 
@@ -672,7 +654,7 @@ ElasticEvaluation compute_tissue_forces(const SimModel& model, SimState& state,
                                         double dt_since_last_s) {
   const ElasticEvaluation seen = here::compute_internal_forces(model, state, dt_since_last_s);
   here::add_gravity_forces(model, state.force_n);
-  here::add_support_forces(model, state.position_m, state.force_n);
+  here::add_support_forces(model, state.position_m, state.force_n, {});
   return seen;
 }
 

@@ -3,6 +3,7 @@
 #include "integrator_internal.h"
 
 #include "liversim/engine/energy.h"
+#include "liversim/engine/in_vivo_stress.h"
 
 #include <algorithm>
 #include <cmath>
@@ -31,8 +32,7 @@ ElasticEvaluation evaluate_forces(const SimModel& model, SimState& state,
   }
   // The support's push depends on where the nodes are, as the tissue's does: not an input whose
   // change the kick splits.
-  add_support_forces(model, state.position_m, state.force_n);
-  add_support_damping_rates(model, state.position_m, state.spring_damping_per_s);
+  add_support_forces(model, state.position_m, state.force_n, {&state.spring_damping_per_s});
   for (const auto& spring : inputs.springs)
     state.spring_damping_per_s[spring.node] +=
         spring.damping_n_s_per_m * model.inverse_mass_per_kg[spring.node];
@@ -373,8 +373,7 @@ void add_input_forces(const SimModel& model, const StepInputs& inputs, const Nod
                       const NodeArray& velocity, NodeArray& force) {
   add_external_forces(inputs, position, force);
   add_gravity_forces(model, force);
-  add_support_forces(model, position, force);
-  add_support_damping_forces(model, position, velocity, force);
+  add_support_forces(model, position, force, {nullptr, &velocity});
   for (const auto& spring : inputs.springs) {
     const auto n = spring.node;
     force.x[n] -= spring.damping_n_s_per_m * velocity.x[n];
@@ -430,9 +429,7 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
     }
     // Plastic flow after the step, the arm's Q held (g = h = 1): first order in the flow, exact
     // under a held stress as the seed's Eq. 4.
-    if (step.viscoplastic)
-      viscous_tissue_update(F, step, committed,
-                            model.in_vivo_stress_pa.empty() ? 0.0 : model.in_vivo_stress_pa[e]);
+    if (step.viscoplastic) viscous_tissue_update(F, step, committed, yield_raise_pa(model, e));
     dissipated_j += model.rest_volume_m3[e] / step.relaxation_time_s *
                     (arm_before + maxwell_arm_energy_density(committed.maxwell_stress_pa, step));
     state.viscous_history.store(e, committed);

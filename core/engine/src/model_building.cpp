@@ -281,7 +281,7 @@ void set_gravity(SimModel& model, const Eigen::Vector3d& gravity_m_per_s2,
   model.support_stiffness_per_kg = model.support ? support_omega * support_omega : 0.0;
   model.stable_time_step_s = stable_time_step_s(model, StepInputs{});
   // The yield is measured above the stress the organ bears under its weight (in_vivo_stress.h).
-  model.in_vivo_stress_pa.clear();
+  model.in_vivo_stress_pa.clear();  // (the settling copies the model: not the old stress too)
   model.in_vivo_stress_pa = in_vivo_stress_pa(model);
 }
 

@@ -105,17 +105,18 @@ void add_external_forces(const StepInputs& inputs, const NodeArray& position, No
 // Adds each node's weight m·g to `force` when the model's gravity effect is on; nothing otherwise.
 void add_gravity_forces(const SimModel& model, NodeArray& force);
 
-// Adds the push of the model's support (support.h) on the free nodes deeper than it at `position`;
-// nothing without a support.
-void add_support_forces(const SimModel& model, const NodeArray& position, NodeArray& force);
-// The contact damping of the support (support.h): its rate 2·ζ·ω (1/s; 0 without a support), added
-// to the rate of each free node touching it at `position`, or as forces −c·v on those nodes, for
-// schemes that take damping as a force.
+// The support's contact damping rate 2·ζ·ω_s (1/s; 0 without a support; support.h).
 double support_damping_per_s(const SimModel& model);
-void add_support_damping_rates(const SimModel& model, const NodeArray& position,
-                               std::vector<double>& damping_per_s);
-void add_support_damping_forces(const SimModel& model, const NodeArray& position,
-                                const NodeArray& velocity, NodeArray& force);
+// Where the contact damping of add_support_forces goes: added to each touching node's rate (the
+// leapfrog integrates it implicitly), or as forces −c·v from these velocities; neither: none.
+struct SupportDamping {
+  std::vector<double>* rate_per_s = nullptr;
+  const NodeArray* velocity = nullptr;
+};
+// Adds the push and hold of the model's support (support.h) on the free nodes touching it at
+// `position`, and its damping as `damping` says; nothing without a support.
+void add_support_forces(const SimModel& model, const NodeArray& position, NodeArray& force,
+                        const SupportDamping& damping = {});
 
 double strain_energy_j(const SimModel& model, const NodeArray& position);
 double kinetic_energy_j(const SimModel& model, const NodeArray& velocity);

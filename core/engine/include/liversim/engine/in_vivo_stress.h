@@ -24,9 +24,14 @@ inline constexpr double kInVivoSettlingTime_s = 2.0;
 
 // Per element, the largest von Mises stress of the Kirchhoff stress (Pa) while `model`, started at
 // rest with its viscoplasticity switched off, settles under its gravity on its support for
-// `settling_time_s`, sampled every millisecond; 0 in elements of regions that do not yield. Empty
+// `settling_time_s`, sampled every 2 ms (the law read at each sample); 0 in elements of regions that do not yield. Empty
 // when the model has no gravity or no region that yields. Runs on the calling thread.
 std::vector<double> in_vivo_stress_pa(const SimModel& model,
                                       double settling_time_s = kInVivoSettlingTime_s);
+
+// What element e's yield limit is raised by: its in-vivo stress (Pa), 0 when the model has none.
+inline double yield_raise_pa(const SimModel& model, std::size_t e) {
+  return model.in_vivo_stress_pa.empty() ? 0.0 : model.in_vivo_stress_pa[e];
+}
 
 }  // namespace liversim
