@@ -326,6 +326,7 @@ TEST(ViscousHistory, StoresEachElementApartAtRestFirst) {
     for (int k = 0; k < 9; ++k) s.inverse_plastic_deformation.data()[k] = 1000.0 * e + 12 + k;
     s.equivalent_plastic_strain = 1000.0 * e + 21;
     s.yield_clock_s = 1000.0 * e + 22;
+    s.flow_stiffening = 1000.0 * e + 23;
     return s;
   };
   for (std::size_t e = 0; e < history.size(); ++e) history.store(e, distinct(e));
@@ -335,6 +336,7 @@ TEST(ViscousHistory, StoresEachElementApartAtRestFirst) {
     EXPECT_EQ(loaded.elastic_stress_pa, expected.elastic_stress_pa);
     EXPECT_EQ(loaded.inverse_plastic_deformation, expected.inverse_plastic_deformation);
     EXPECT_EQ(loaded.yield_clock_s, expected.yield_clock_s);
+    EXPECT_EQ(loaded.flow_stiffening, expected.flow_stiffening);
     EXPECT_EQ(history.equivalent_plastic_strain(e), expected.equivalent_plastic_strain);
     EXPECT_EQ(history.inverse_plastic_deformation(e), expected.inverse_plastic_deformation);
     EXPECT_EQ(history.maxwell_stress_pa(e), expected.maxwell_stress_pa);

@@ -38,10 +38,10 @@ struct ElasticKernelSeen {
 // The viscous tissue law (viscous_tissue.cpp) of elements whose regions all have one: the
 // elements' history in blocks of kViscousHistoryBlock (ViscousHistory: component k of element e at
 // history[(e / block · components + k) · block + e % block]; Voigt H in components [0, 6), S_e
-// in [6, 12), Fp⁻¹ column-major in [12, 21)), the step's constants per region. The loops run a
-// block at a time (element ranges start at a block's first element).
+// in [6, 12), Fp⁻¹ column-major in [12, 21), the flow's stiffening in 23), the step's constants per
+// region. The loops run a block at a time (element ranges start at a block's first element).
 inline constexpr std::size_t kViscousHistoryBlock = 64;
-inline constexpr std::size_t kViscousHistoryComponents = 23;
+inline constexpr std::size_t kViscousHistoryComponents = 24;
 struct ViscousKernelData {
   ElasticKernelData elastic;  // geometry, fibres, outputs (its moduli arrays are not read)
   const std::int32_t* region;

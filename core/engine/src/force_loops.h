@@ -535,11 +535,12 @@ ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state
       for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
         if (model.viscous_parameters[r])
           state.viscous_step[r].emplace(*model.viscous_parameters[r], dt_since_last_s);
-      const ElasticEvaluation seen =
+      ElasticEvaluation seen =
           element_forces_for_effects<true>(model, state.position_m, state.force_scratch,
                                            {&state.viscous_history, &state.viscous_step, nullptr,
                                             &state.energy.viscous_dissipated_j});
       gather_corner_forces(model, state.force_scratch, state.force_n);
+      seen.max_flow_stiffening = state.viscous_history.largest_flow_stiffening();
       return seen;
     }
   }
@@ -556,10 +557,11 @@ ElasticEvaluation compute_internal_forces_rate_form(const SimModel& model, SimSt
       for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
         if (model.viscous_parameters[r] && !state.viscous_step[r])
           state.viscous_step[r].emplace(*model.viscous_parameters[r], 0.0);
-      const ElasticEvaluation seen =
+      ElasticEvaluation seen =
           element_forces_for_effects<true>(model, position, state.force_scratch,
                                            {&state.viscous_history, &state.viscous_step, &arm});
       gather_corner_forces(model, state.force_scratch, force);
+      seen.max_flow_stiffening = state.viscous_history.largest_flow_stiffening();
       return seen;
     }
   }

@@ -227,7 +227,10 @@ double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& see
                           : neo_hookean::volumetric_stiffening(seen.min_volume_ratio, mu, lambda));
     stiffening = std::max(stiffening, 1.0 + seen.max_fibre_modulus_pa / (lambda + 2.0 * mu));
   }
-  return stiffening;
+  // Each element's stiffness is at most its flow's stiffening times its unflowed one, so the
+  // assembled ω² is at most the largest of them times the rest's (a lifted specimen's neck, flowed
+  // to 1.5 plastic strain, had outgrown the rest step and blown up).
+  return stiffening * seen.max_flow_stiffening;
 }
 
 namespace detail {

@@ -174,6 +174,26 @@ Eigen::Matrix<double, 9, 9> viscoelastic_stress_tangent_rate_form(
          step.arm_fraction * keep * right_factor(w);
 }
 
+namespace {
+
+// Equivalent (von Mises) deviatoric Hencky strain of Fe: √(2/3)·|dev ln V|, V² = Fe·Feᵀ.
+double elastic_equivalent_strain(const Eigen::Matrix3d& fe) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> stretch_squared;
+  stretch_squared.computeDirect(fe * fe.transpose(), Eigen::EigenvaluesOnly);
+  const Eigen::Array3d log_stretch =
+      0.5 * stretch_squared.eigenvalues().array().max(std::numeric_limits<double>::min()).log();
+  return std::sqrt(2.0 / 3.0 * (log_stretch - log_stretch.mean()).matrix().squaredNorm());
+}
+
+// σ_max(Fp⁻¹)² (ViscousTissueState::flow_stiffening); at least 1, as det Fp⁻¹ = 1.
+double flow_stiffening(const Eigen::Matrix3d& fp_inverse) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> squared;
+  squared.computeDirect(fp_inverse * fp_inverse.transpose(), Eigen::EigenvaluesOnly);
+  return std::max(1.0, squared.eigenvalues()(2));
+}
+
+}  // namespace
+
 Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTissueStep& step,
                                       const ViscousTissueState& committed,
                                       ViscousTissueState& trial, double yield_raise_pa) {
@@ -203,6 +223,7 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
   Eigen::Matrix3d pk2 = step.relaxed_fraction * elastic + step.arm_fraction * arm;
   double plastic_strain = committed.equivalent_plastic_strain;
   double clock_s = committed.yield_clock_s;
+  double stiffening = committed.flow_stiffening;
 
   if (step.viscoplastic) {
     const ViscoplasticParameters& vp = *step.viscoplastic;
@@ -211,7 +232,7 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
         kirchhoff - kirchhoff.trace() / 3.0 * Eigen::Matrix3d::Identity();
     const double equivalent_pa = std::sqrt(1.5 * deviator.squaredNorm());
     const double yield_limit_pa = vp.yield_limit_pa + yield_raise_pa;
-    if (equivalent_pa > yield_limit_pa) {
+    if (equivalent_pa > yield_limit_pa && committed.flow_stiffening < kMaxFlowStiffening) {
       // Time hardening with increments of tⁿ (exact under a held stress, never the singular
       // rate n·tⁿ⁻¹), solved implicitly in closed form: the end-of-step equivalent stress is
       // σ_trial − 3·G·Δε, so Δε·η2 = (σ_end − σs)·Δ(tⁿ) gives the expression below. However
@@ -219,17 +240,37 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
       // strain).
       const double clock_increment = clock_power_increment(clock_s, step.dt_s, vp.creep_index_n);
       clock_s += step.dt_s;
-      const double increment =
-          (equivalent_pa - yield_limit_pa) * clock_increment /
-          (vp.eta2_pa_s_pow_n + 3.0 * step.step_shear_modulus_pa * clock_increment);
+      double increment = (equivalent_pa - yield_limit_pa) * clock_increment /
+                         (vp.eta2_pa_s_pow_n + 3.0 * step.step_shear_modulus_pa * clock_increment);
+      // No more than the share above yield of the elastic strain there is to flow out (its
+      // equivalent Hencky strain): a radial return, exact for a Hencky law. The increment above
+      // takes the step's modulus; the Neo-Hookean stress outgrows 3·G·ε at large stretch, and a
+      // flow by that stress overshot the elastic strain, reversed it the next step, and ran away
+      // (a lifted specimen's neck reached a plastic strain of 28, Fp⁻¹ ~ 10⁶, then NaN).
+      increment = std::min(increment,
+                           elastic_equivalent_strain(fe) * (1.0 - yield_limit_pa / equivalent_pa));
       if (increment > 0.0) {
         // Fe ← exp(−Δε·N)·Fe with N = (3/2)·dev τ/σ_eq: flow along the Kirchhoff deviator,
         // exactly isochoric (tr N = 0).
-        const Eigen::Matrix3d flow =
-            matrix_exponential(-increment * 1.5 / equivalent_pa * deviator);
-        fp_inverse = fp_inverse * (cof.transpose() / J) * flow * fe;
-        fp_inverse /= std::cbrt(fp_inverse.determinant());  // keep det Fp = 1 against round-off
+        const Eigen::Matrix3d to_intermediate = fp_inverse * (cof.transpose() / J);
+        auto flowed = [&](double by) {
+          Eigen::Matrix3d m =
+              to_intermediate * matrix_exponential(-by * 1.5 / equivalent_pa * deviator) * fe;
+          return Eigen::Matrix3d(m / std::cbrt(m.determinant()));  // det Fp = 1 against round-off
+        };
+        Eigen::Matrix3d flowed_inverse = flowed(increment);
+        double flowed_stiffening = flow_stiffening(flowed_inverse);
+        if (flowed_stiffening > kMaxFlowStiffening && flowed_stiffening > stiffening) {
+          // Stop at the limit: ln σ_max² grows about linearly along the flow (exactly on a
+          // proportional path), so one rescaled increment lands on it.
+          increment *=
+              std::log(kMaxFlowStiffening / stiffening) / std::log(flowed_stiffening / stiffening);
+          flowed_inverse = flowed(increment);
+          flowed_stiffening = flow_stiffening(flowed_inverse);
+        }
+        fp_inverse = flowed_inverse;
         plastic_strain += increment;
+        stiffening = flowed_stiffening;
 
         fe = F * fp_inverse;
         cof = cofactor(fe);
@@ -245,6 +286,7 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
   trial.inverse_plastic_deformation = fp_inverse;
   trial.equivalent_plastic_strain = plastic_strain;
   trial.yield_clock_s = clock_s;
+  trial.flow_stiffening = stiffening;
   return fe * pk2 * fp_inverse.transpose();  // P = F·S with S = Fp⁻¹·S̄·Fp⁻ᵀ
 }
 
@@ -259,9 +301,11 @@ ViscousHistory::ViscousHistory(std::size_t elements)
     : elements_(elements),
       values_((elements + kBlock - 1) / kBlock * kBlock * kComponents, 0.0),
       plastic_blocks_((elements + kBlock - 1) / kBlock, 0) {
-  for (std::size_t e = 0; e < elements; ++e)
+  for (std::size_t e = 0; e < elements; ++e) {
     for (int k : {0, 4, 8})  // the diagonal of Fp⁻¹, column-major
       slot(kInversePlasticDeformation + k, e) = 1.0;
+    slot(kFlowStiffening, e) = 1.0;
+  }
 }
 
 ViscousTissueState ViscousHistory::load(std::size_t e) const {
@@ -273,6 +317,7 @@ ViscousTissueState ViscousHistory::load(std::size_t e) const {
   history.inverse_plastic_deformation = inverse_plastic_deformation(e);
   history.equivalent_plastic_strain = value(kEquivalentPlasticStrain, e);
   history.yield_clock_s = value(kYieldClock, e);
+  history.flow_stiffening = value(kFlowStiffening, e);
   return history;
 }
 
@@ -285,7 +330,19 @@ void ViscousHistory::store(std::size_t e, const ViscousTissueState& history) {
     slot(kInversePlasticDeformation + k, e) = history.inverse_plastic_deformation.data()[k];
   slot(kEquivalentPlasticStrain, e) = history.equivalent_plastic_strain;
   slot(kYieldClock, e) = history.yield_clock_s;
+  slot(kFlowStiffening, e) = history.flow_stiffening;
   note_flow(e);
+}
+
+double ViscousHistory::largest_flow_stiffening() const {
+  double largest = 1.0;
+  for (std::size_t b = 0; b < plastic_blocks_.size(); ++b) {
+    if (plastic_blocks_[b] == 0) continue;
+    const double* stiffening = values_.data() + (b * kComponents + kFlowStiffening) * kBlock;
+    const std::size_t count = std::min(kBlock, elements_ - b * kBlock);
+    for (std::size_t i = 0; i < count; ++i) largest = std::max(largest, stiffening[i]);
+  }
+  return largest;
 }
 
 void ViscousHistory::copy_element(const ViscousHistory& from, std::size_t from_e,

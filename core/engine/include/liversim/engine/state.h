@@ -17,13 +17,14 @@ namespace liversim {
 // What a force evaluation saw that bears on the stable explicit step: the extremes of the element
 // volume ratio J = det F (compression stiffens the volumetric response), the smallest nodal
 // average of it where the λ pressure is averaged over nodes (it is that average the λ part
-// stiffens with), and the largest fibre tangent stiffness (stretched fibres stiffen
-// exponentially).
+// stiffens with), the largest fibre tangent stiffness (stretched fibres stiffen
+// exponentially), and the largest stiffening by plastic flow (ViscousHistory::kFlowStiffening).
 struct ElasticEvaluation {
   double min_volume_ratio = 1.0;
   double max_volume_ratio = 1.0;
   double max_fibre_modulus_pa = 0.0;
   double min_nodal_volume_ratio = 1.0;
+  double max_flow_stiffening = 1.0;
 };
 
 // Scratch of one force evaluation, sized once for a model.

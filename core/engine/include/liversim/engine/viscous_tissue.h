@@ -114,7 +114,7 @@ inline double maxwell_arm_energy_density(const std::array<double, 6>& h,
 
 // History of one element, committed once per step. Its tensors live in the intermediate
 // configuration of F = Fe·Fp (unloaded, plastically deformed), so a rigid rotation of the
-// current configuration leaves the state unchanged. 23 doubles.
+// current configuration leaves the state unchanged. 24 doubles.
 struct ViscousTissueState {
   // Symmetric tensors in Voigt order (xx, yy, zz, yz, xz, xy), 2nd Piola–Kirchhoff-like, Pa.
   std::array<double, 6> maxwell_stress_pa{};  // H: the Maxwell arm carries g1·H
@@ -123,14 +123,24 @@ struct ViscousTissueState {
   double equivalent_plastic_strain = 0.0;
   // Time spent above the yield limit (time hardening); it holds, not resets, below the limit.
   double yield_clock_s = 0.0;
+  // σ_max(Fp⁻¹)², 1 at rest: how much the flow has stiffened the element. Its stiffness is
+  // ∇Nᵀ·Fp⁻¹·C·Fp⁻ᵀ·∇N, so its highest frequency² is at most this times that of its unflowed
+  // shape (the explicit step takes it: stiffening_since_rest).
+  double flow_stiffening = 1.0;
 };
+
+// The flow stops where it has stiffened an element by this much (kFlowStiffening), a plastic
+// stretch of 4 along or of ½ across it: tissue drawn further would tear, which is not modelled,
+// and an element flowed on into a needle (a lifted specimen's neck drawn out ninefold) outgrew
+// any step. Past it the element answers elastically.
+inline constexpr double kMaxFlowStiffening = 4.0;
 
 // The committed history of every element of a mesh, stored component by component in blocks of
 // kBlock elements (component k of element e at block(e)[k·kBlock + e % kBlock]) so that the
 // element loops read and write several elements per vector instruction, each component of a
 // block at a fixed offset from one pointer. The components are ViscousTissueState's fields in
 // order: H [0, 6), S_e [6, 12) in Voigt order, Fp⁻¹ column-major [12, 21), the equivalent plastic
-// strain and the yield clock.
+// strain, the yield clock and the flow's stiffening.
 class ViscousHistory {
  public:
   static constexpr std::size_t kBlock = 64;
@@ -139,7 +149,8 @@ class ViscousHistory {
   static constexpr int kInversePlasticDeformation = 12;
   static constexpr int kEquivalentPlasticStrain = 21;
   static constexpr int kYieldClock = 22;
-  static constexpr int kComponents = 23;
+  static constexpr int kFlowStiffening = 23;  // ViscousTissueState::flow_stiffening
+  static constexpr int kComponents = 24;
 
   ViscousHistory() = default;
   // `elements` histories at rest: no stress, Fp = I.
@@ -155,6 +166,9 @@ class ViscousHistory {
   double equivalent_plastic_strain(std::size_t e) const {
     return value(kEquivalentPlasticStrain, e);
   }
+  // The largest kFlowStiffening of all elements (1 where none has flowed). Reads the blocks that
+  // have flowed only.
+  double largest_flow_stiffening() const;
 
   double value(int k, std::size_t e) const {
     return values_[(e / kBlock * kComponents + k) * kBlock + e % kBlock];
