@@ -228,8 +228,8 @@ double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& see
     stiffening = std::max(stiffening, 1.0 + seen.max_fibre_modulus_pa / (lambda + 2.0 * mu));
   }
   // Each element's stiffness is at most its flow's stiffening times its unflowed one, so the
-  // assembled ω² is at most the largest of them times the rest's (a lifted specimen's neck, flowed
-  // to 1.5 plastic strain, had outgrown the rest step and blown up).
+  // assembled ω² is at most the largest of them times the rest's: without it an element that has
+  // flowed is stepped with its rest shape's limit.
   return stiffening * seen.max_flow_stiffening;
 }
 

@@ -132,7 +132,8 @@ struct ViscousTissueState {
 // The flow stops where it has stiffened an element by this much (kFlowStiffening), a plastic
 // stretch of 4 along or of ½ across it: tissue drawn further would tear, which is not modelled,
 // and an element flowed on into a needle (a lifted specimen's neck drawn out ninefold) outgrew
-// any step. Past it the element answers elastically.
+// any step. Past it the element answers elastically: it does not flow back either (a flow that
+// would lower its stiffening is not told apart), a simplification of this limit.
 inline constexpr double kMaxFlowStiffening = 4.0;
 
 // The committed history of every element of a mesh, stored component by component in blocks of
