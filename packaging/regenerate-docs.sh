@@ -444,7 +444,24 @@ step_cutting-live() {
   ((!quick)) || tets=1500
   run "$cli" bench-cut --live --trajectory tests/data/trajectories/free-practice-three-strokes.txt \
     --tets "$tets" --output-dir "$out"
+  # The shipped wedge resection (its own liver), as a section of the same page.
+  ((listing)) || mkdir -p "$w/wedge"
+  run "$cli" bench-cut --live --trajectory tests/data/trajectories/wedge-resection-too-close.txt \
+    --scenario scenarios/wedge-resection-peripheral-tumour.json --output-dir "$w/wedge"
   doing || return 0
+  python3 - "$out/cutting-live.md" "$w/wedge/cutting-live.md" "${commands[1]}" <<'PYTHON'
+import sys
+page, section, command = sys.argv[1:4]
+body = open(section, encoding="utf-8").read().split("\n")
+# The section's text after its title and the line naming its command.
+body = [l for l in body[1:] if not l.startswith("Written by `")]
+while body and not body[0].strip():
+    body.pop(0)
+text = open(page, encoding="utf-8").read().rstrip("\n")
+text += "\n\n## The shipped wedge resection\n\nThis section: `" + command + "`.\n\n"
+text += "\n".join(body).rstrip("\n") + "\n"
+open(page, "w", encoding="utf-8").write(text)
+PYTHON
   stamp cutting-live.md
 }
 

@@ -154,6 +154,43 @@ TEST(ErrorEstimate, IsReportedForEveryScheme) {
   }
 }
 
+// A fixed-pace caller (the real-time loop) asks for intervals a little longer than the stable
+// step. Covered exactly, each interval takes two steps; in whole steps (advance's whole_step_s),
+// steps of the limit run on across the intervals, ending past each by less than one step: the
+// evaluations are the time over the step, not twice the intervals.
+TEST(WholeSteps, AnIntervalALittleOverTheLimitTakesOneStepNotTwo) {
+  const Cantilever bar(elastic_tissue());
+  const SimModel model = build_model(bar.mesh, bar.options);
+  const double limit_s = model.stable_time_step_s, interval_s = 1.05 * limit_s;
+  const int intervals = 200;
+  auto run = [&](bool whole, double& lead_s) {
+    SimState state = make_rest_state(model);
+    for (std::size_t n = 0; n < bar.mesh.node_count(); ++n) {
+      const double s = bar.mesh.rest_position_m.x[n] / kBarLength;
+      state.position_m.y[n] += 1e-3 * s * s;
+    }
+    int evaluations = 0;
+    lead_s = 0.0;
+    for (int k = 0; k < intervals; ++k) {
+      const double asked_s = interval_s - lead_s;
+      const double before_s = state.time_s;
+      if (asked_s > 0.0)
+        evaluations +=
+            advance(model, state, {}, asked_s, whole ? interval_s : 0.0).force_evaluations;
+      lead_s = std::max(0.0, state.time_s - before_s - asked_s);
+      EXPECT_LT(lead_s, limit_s * (1.0 + 1e-9));
+      EXPECT_NEAR(state.time_s, (k + 1) * interval_s + lead_s, 1e-12);
+    }
+    return evaluations;
+  };
+  double lead_s = 0.0;
+  EXPECT_EQ(run(false, lead_s), 2 * intervals);
+  EXPECT_EQ(lead_s, 0.0);
+  // At the limit (the step may not grow past it): ⌈200 × 1.05⌉ = 210 steps, give or take the
+  // first, which kicks from rest.
+  EXPECT_LE(run(true, lead_s), static_cast<int>(std::ceil(intervals * 1.05)) + 1);
+}
+
 // A free bar pulled by equal and opposite end tractions: with the volumetric and deviatoric
 // parts relaxing alike the 3-D response is the 1-D model, so the strain follows seed Eq. 3,
 // ε(t) = σ/E2 + σ·(1/(E1+E2) − 1/E2)·exp(−t/τc). Mass damping α = 20/s removes the elastic

@@ -59,12 +59,16 @@ TEST(ViscousFem, HeldBlockRelaxesAsSeedEquationTwo) {
 
 // Free bar pulled by equal and opposite end tractions for a while, then released.
 double residual_strain_after_pull(const RegionMaterial& material, double sigma_pa,
-                                  double* mean_plastic_strain) {
+                                  double* mean_plastic_strain,
+                                  double flow_interval_s = kPlasticFlowIntervalS,
+                                  int elements_across = 1) {
   const double length = 0.04, width = 0.01;
-  const TetMesh mesh = block_mesh(4, 1, 1, {length, width, width});
+  const int across = elements_across;
+  const TetMesh mesh = block_mesh(4 * across, across, across, {length, width, width});
   ModelOptions options;
   options.regions[0] = material;
   options.mass_damping_per_s = 60.0;
+  options.plastic_flow_interval_s = flow_interval_s;
   const SimModel model = build_model(mesh, options);
   SimState state = make_rest_state(model);
   // Ramped over 0.5 s: a sudden load would overshoot up to twice its static stress and yield.
@@ -100,6 +104,26 @@ TEST(ViscousFem, PermanentSetAboveYieldAndNoneBelow) {
   // Below yield (60 % of it): fully recovered, to e^(−20) ≈ 2e-9 of the peak strain (~2e-4).
   const double below = residual_strain_after_pull(viscous_tissue(plastic), 0.3, nullptr);
   EXPECT_LT(std::abs(below), 1e-9);
+}
+
+// Central difference takes the flow once per SimModel::plastic_flow_interval_s with the increment
+// of the whole interval, which under a held stress is the sum of the steps' increments (Δ(tⁿ)
+// telescopes). The stress does not hold, so the flow lags that of every step by at most one
+// interval's flow, largest where the yield clock starts: (σ − σs)/η2 · Δⁿ = 0.5/500 · √0.002 =
+// 4.5e-5 of plastic strain. The bar is three elements across, so its steps (~0.7 ms) are shorter
+// than the interval and the flow is indeed deferred.
+TEST(ViscousFem, FlowTakenOncePerIntervalStaysWithinOneIntervalsFlowOfFlowAtEveryStep) {
+  const ViscoplasticParameters plastic{0.5, 500.0, 0.5};
+  const double lag_bound = (1.0 - 0.5) / 500.0 * std::sqrt(kPlasticFlowIntervalS);
+  double every_step = 0.0, per_interval = 0.0;
+  const double set_every_step =
+      residual_strain_after_pull(viscous_tissue(plastic), 1.0, &every_step, 0.0, 3);
+  const double set_per_interval = residual_strain_after_pull(
+      viscous_tissue(plastic), 1.0, &per_interval, kPlasticFlowIntervalS, 3);
+  ASSERT_GT(every_step, 1e-4);
+  EXPECT_NE(per_interval, every_step) << "the flow was not deferred";
+  EXPECT_NEAR(per_interval, every_step, lag_bound);
+  EXPECT_NEAR(set_per_interval, set_every_step, lag_bound);
 }
 
 TEST(ViscousFem, InconsistentModulusAndPlasticityWithoutViscoelasticityAreNamed) {

@@ -356,17 +356,12 @@ ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& positio
     const ViscousTissueStep& step = *(*viscous.step_by_region)[r];
     const double mu = step.mu_instant_pa, lambda = step.lambda_instant_pa;
     const double values[10] = {
-        mu,
-        lambda,
-        step.relaxed_fraction,
-        step.arm_fraction,
-        step.arm_decay,
-        step.arm_loading,
-        step.viscoplastic ? step.viscoplastic->yield_limit_pa
-                          : std::numeric_limits<double>::infinity(),
+        mu, lambda, step.relaxed_fraction, step.arm_fraction, step.arm_decay, step.arm_loading,
+        // No flow this step: nothing yields (the general update would take none).
+        step.viscoplastic && step.flow_dt_s > 0.0 ? step.viscoplastic->yield_limit_pa
+                                                  : std::numeric_limits<double>::infinity(),
         step.arm_fraction / (4.0 * mu),  // maxwell_arm_energy_density's factors
-        lambda / (2.0 * mu + 3.0 * lambda),
-        step.dt_s / step.relaxation_time_s};
+        lambda / (2.0 * mu + 3.0 * lambda), step.dt_s / step.relaxation_time_s};
     for (int k = 0; k < 10; ++k) constants[k * regions + r] = values[k];
   }
   detail::ViscousKernelData data{};
@@ -532,9 +527,20 @@ ElasticEvaluation compute_internal_forces(const SimModel& model, SimState& state
   require_built(model);
   if constexpr (kBuiltViscous) {
     if (model.effects.viscous) {
+      // The flow is due once the interval has passed; then it covers all the time since the last.
+      double flow_dt_s = dt_since_last_s;
+      if (model.plastic_flow_interval_s > 0.0) {
+        double& pending = state.viscous_history.flow_pending_s;
+        pending += dt_since_last_s;
+        const bool due = pending >= model.plastic_flow_interval_s * (1.0 - 1e-9);
+        flow_dt_s = due ? pending : 0.0;
+        if (due) pending = 0.0;
+      }
       for (std::size_t r = 0; r < model.viscous_parameters.size(); ++r)
-        if (model.viscous_parameters[r])
+        if (model.viscous_parameters[r]) {
           state.viscous_step[r].emplace(*model.viscous_parameters[r], dt_since_last_s);
+          state.viscous_step[r]->flow_dt_s = flow_dt_s;
+        }
       ElasticEvaluation seen =
           element_forces_for_effects<true>(model, state.position_m, state.force_scratch,
                                            {&state.viscous_history, &state.viscous_step, nullptr,

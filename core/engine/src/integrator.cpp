@@ -444,9 +444,13 @@ void commit_arm(const SimModel& model, SimState& state, const NodeArray& positio
 
 namespace {
 
-void advance_central_difference(const SimModel& model, SimState& state, const StepInputs& inputs,
-                                double interval_s, StepReport& report) {
-  const double requested_s = model.integrator.step_s;
+// Returns the time it advanced: the interval, or with whole steps (whole_step_s > 0) at least it.
+double advance_central_difference(const SimModel& model, SimState& state, const StepInputs& inputs,
+                                  double interval_s, double whole_step_s, StepReport& report) {
+  const bool whole_steps = whole_step_s > 0.0;
+  const double requested_s = whole_steps ? whole_step_s : model.integrator.step_s;
+  double advanced_s = 0.0;
+  if (whole_steps) report.smallest_substep_s = std::numeric_limits<double>::infinity();
   double remaining = interval_s;
   bool first = true;
   while (remaining > 0.0) {
@@ -479,30 +483,36 @@ void advance_central_difference(const SimModel& model, SimState& state, const St
     if (state.integrator.chosen_step_s > 0.0)
       step = std::min(step, detail::kStepGrowth * state.integrator.chosen_step_s);
     state.integrator.chosen_step_s = step;
-    // Equal steps over what is left, so the interval ends exactly where asked.
+    // Equal steps over what is left, so the interval ends exactly where asked; or whole steps.
     const double steps_left = detail::steps_to_cover(remaining, step);
-    const double dt = steps_left <= 1.0 ? remaining : remaining / steps_left;
+    const double dt = whole_steps ? step : (steps_left <= 1.0 ? remaining : remaining / steps_left);
     kick_drift(model, state, inputs, dt, first && state.integrator.inputs_changed);
     first = false;
     detail::note_error_estimate(
         report, detail::history_error_estimate(model, state.integrator, state.velocity_m_per_s, dt,
                                                IntegratorKind::central_difference));
-    remaining = steps_left <= 1.0 ? 0.0 : remaining - dt;
+    advanced_s += dt;
+    if (whole_steps)
+      remaining = remaining - dt > 1e-9 * dt ? remaining - dt : 0.0;
+    else
+      remaining = steps_left <= 1.0 ? 0.0 : remaining - dt;
     ++report.substeps;
     report.smallest_substep_s = std::min(report.smallest_substep_s, dt);
     report.largest_substep_s = std::max(report.largest_substep_s, dt);
   }
+  return whole_steps ? advanced_s : interval_s;
 }
 
 }  // namespace
 
 StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
-                   double interval_s) {
+                   double interval_s, double whole_step_s) {
   StepReport report;
   if (!(interval_s > 0.0)) return report;
   report.smallest_substep_s = interval_s;
   report.error_estimate_m = std::numeric_limits<double>::quiet_NaN();
-  const double end_time = state.time_s + interval_s;
+  const double start_time = state.time_s;
+  double end_time = start_time + interval_s;
   const std::uint64_t fingerprint = detail::fingerprint(inputs);
   state.integrator.inputs_changed = fingerprint != state.integrator.inputs_fingerprint;
   state.integrator.inputs_fingerprint = fingerprint;
@@ -514,7 +524,9 @@ StepReport advance(const SimModel& model, SimState& state, const StepInputs& inp
     books.tool_work_j -= load.force_n.dot(state.position_m.at(load.node));
   switch (model.integrator.kind) {
     case IntegratorKind::central_difference:
-      advance_central_difference(model, state, inputs, interval_s, report);
+      // No drift from summing substeps: the time they covered, added once.
+      end_time = start_time +
+                 advance_central_difference(model, state, inputs, interval_s, whole_step_s, report);
       break;
     case IntegratorKind::rk4:
     case IntegratorKind::dopri5:

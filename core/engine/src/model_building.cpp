@@ -86,6 +86,8 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
     throw std::invalid_argument("mass damping must be a finite value >= 0 (1/s)");
   if (!(options.stable_step_safety > 0.0 && options.stable_step_safety <= 1.0))
     throw std::invalid_argument("stable step safety factor must be in (0, 1]");
+  if (!(options.plastic_flow_interval_s >= 0.0) || !std::isfinite(options.plastic_flow_interval_s))
+    throw std::invalid_argument("the plastic flow's interval must be a finite time ≥ 0 (s)");
   if (!options.gravity_m_per_s2.allFinite())
     throw std::invalid_argument("gravity must be a finite acceleration (m/s²)");
   if (!(options.support_frequency_fraction > 0.0 && options.support_frequency_fraction <= 1.0))
@@ -104,6 +106,7 @@ SimModel build_model(const TetMesh& mesh, const ModelOptions& options) {
   model.rest_position_m = mesh.rest_position_m;
   model.mass_damping_per_s = options.mass_damping_per_s;
   model.stable_step_safety = options.stable_step_safety;
+  model.plastic_flow_interval_s = options.plastic_flow_interval_s;
   model.integrator = options.integrator;
   // Gravity and the support are set with the stable step, at the end (set_gravity).
   model.gravity_m_per_s2 = options.gravity_m_per_s2;

@@ -103,7 +103,7 @@ std::optional<std::string> validate(const ViscousTissueParameters& p) {
 }
 
 ViscousTissueStep::ViscousTissueStep(const ViscousTissueParameters& parameters, double dt)
-    : dt_s(dt), viscoplastic(parameters.viscoplastic) {
+    : dt_s(dt), viscoplastic(parameters.viscoplastic), flow_dt_s(dt) {
   if (!(dt >= 0.0) || !std::isfinite(dt))
     throw std::invalid_argument("time step " + std::to_string(dt) + " s is not a finite value ≥ 0");
   const ViscoelasticParameters& ve = parameters.viscoelastic;
@@ -225,7 +225,7 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
   double clock_s = committed.yield_clock_s;
   double stiffening = committed.flow_stiffening;
 
-  if (step.viscoplastic) {
+  if (step.viscoplastic && step.flow_dt_s > 0.0) {
     const ViscoplasticParameters& vp = *step.viscoplastic;
     const Eigen::Matrix3d kirchhoff = symmetric_part(fe * pk2 * fe.transpose());
     const Eigen::Matrix3d deviator =
@@ -238,8 +238,9 @@ Eigen::Matrix3d viscous_tissue_stress(const Eigen::Matrix3d& F, const ViscousTis
       // σ_trial − 3·G·Δε, so Δε·η2 = (σ_end − σs)·Δ(tⁿ) gives the expression below. However
       // long the step, the stress stops at the yield limit, not below it (to first order in the
       // strain).
-      const double clock_increment = clock_power_increment(clock_s, step.dt_s, vp.creep_index_n);
-      clock_s += step.dt_s;
+      const double clock_increment =
+          clock_power_increment(clock_s, step.flow_dt_s, vp.creep_index_n);
+      clock_s += step.flow_dt_s;
       double increment = (equivalent_pa - yield_limit_pa) * clock_increment /
                          (vp.eta2_pa_s_pow_n + 3.0 * step.step_shear_modulus_pa * clock_increment);
       // No more than the share above yield of the elastic strain there is to flow out (its

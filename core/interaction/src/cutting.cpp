@@ -1107,6 +1107,7 @@ SimState carried_state(const SimModel& m, const SimState& old, NodeArray positio
     for (std::size_t i = 0; i < m.tet_count; ++i)
       next.viscous_history.copy_element(old.viscous_history,
                                         static_cast<std::size_t>(element_origin[i]), i);
+  next.viscous_history.flow_pending_s = old.viscous_history.flow_pending_s;
   next.time_s = old.time_s;
   next.step_count = old.step_count;
   next.last_step_s = old.last_step_s;

@@ -47,6 +47,9 @@ struct GuardOptions {
   // back to the cycle's start.
   bool checkpoint_on_entry = true;
   bool checkpoint_after_advance = true;
+  // advance's whole_step_s (integrator.h): > 0, central difference ends at or past the interval's
+  // end in steps of at most this.
+  double whole_step_s = 0.0;
 };
 
 // Finite positions and velocities, no node faster than the speed limit, none with more kinetic

@@ -83,8 +83,15 @@ double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& see
 // model.integrator.step_s (0: the stable step of explicit schemes), shortened where an explicit
 // scheme's stability limit requires it, and equalised so that the interval ends exactly. Allocates
 // nothing.
+//
+// whole_step_s > 0 (central difference; the other schemes ignore it): steps of at most
+// whole_step_s, each as long as the limits allow, the last not shortened, so the state ends at or
+// past the interval's end by less than one step. A real-time loop stepping at a fixed pace asks
+// for this: with each of its intervals covered exactly, a limit a little under its step split
+// every interval in two, twice the force evaluations for a limit 1 % short (the state's time
+// then carries the difference to the next interval).
 StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
-                   double interval_s);
+                   double interval_s, double whole_step_s = 0.0);
 
 // One central-difference step of length dt_s (the caller guarantees stability). Returns what the
 // force evaluation of the configuration the step started from saw.

@@ -88,6 +88,9 @@ struct ViscousTissueStep {
   double arm_loading;            // h = (1 − g)/(Δt/τ): weight of this step's elastic increment
   double step_shear_modulus_pa;  // (g0 + g1·h)·μ: shear stiffness of the response within the step
   std::optional<ViscoplasticParameters> viscoplastic;
+  // The time the plastic flow of this step covers (dt_s unless set): the explicit scheme lets the
+  // flow of several steps be taken at once (SimModel::plastic_flow_interval_s); 0: no flow.
+  double flow_dt_s;
 
   // A step whose Maxwell arm follows the elastic stress without relaxing (g = h = 1): plastic
   // flow alone over dt_s, for integrators that advance the arm in their own state (see
@@ -182,6 +185,9 @@ class ViscousHistory {
   // Per block of kBlock elements: 1 once an element of it has stored Fp ≠ I. Blocks with 0 skip
   // the products with Fp⁻¹ (most tissue never yields).
   const std::uint8_t* plastic_blocks() const { return plastic_blocks_.data(); }
+
+  // Simulated time since the plastic flow was last taken (SimModel::plastic_flow_interval_s).
+  double flow_pending_s = 0.0;
 
   bool operator==(const ViscousHistory&) const = default;
 

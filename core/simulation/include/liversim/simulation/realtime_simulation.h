@@ -186,6 +186,14 @@ class StepAccumulator {
 // LoopStep.ACuttingScalpelTakesOneForceEvaluationPerLoopStep). A pressing probe or forceps lower
 // the limit 20–40 % and still split.
 inline constexpr double kLoopStepFraction = 0.9;
+// The loop saves its checkpoint (the state a bad step goes back to) once per this much simulated
+// time: a rollback loses at most this, and the copy is made a few hundred times a second, not at
+// every step.
+inline constexpr double kCheckpointIntervalS = 0.005;
+// The outcome tracker (tissue_outcome.h) looks at the tissue once per this much simulated time,
+// not per cycle: a strain past its damage limit is seen unless a hand makes and undoes it within
+// 2 ms.
+inline constexpr double kOutcomeIntervalS = 0.002;
 double realtime_step_s(const SimModel& model);
 // The loop's step before it was kept with each session (ReplaySetup::loop_step_s): the model's
 // integrator step, or its stable step. Sessions recorded then replay with it.
@@ -326,6 +334,11 @@ class RealtimeSimulation {
   SimState state_;
   Options options_;
   double step_s_;
+  // Simulated time the outcome tracker last looked at the tissue (< 0: never).
+  double outcome_observed_s_ = -1.0;
+  // How far the state's time is past the time the loop's steps have asked for: whole steps end
+  // past it by less than one step (advance_cycle).
+  double loop_lead_s_ = 0.0;
   int max_steps_per_cycle_;
   TripleBuffer<SimulationSnapshot> snapshots_;
 
