@@ -507,13 +507,14 @@ TEST_F(StationTest, APacedScriptWaitsForTheSimulationAlsoAfterAModelChange) {
     return start.x() + kSpeedMmPerS * std::max(0.0, simulated_s - begin_s - 1.0);
   };
   // The device's reading a snapshot shows is the servo's last before the cycle: it lags the
-  // snapshot's time by at most a cycle (1/60 s of simulated time), so it lies between where the
-  // script puts it kOriginS + 20 ms before and at the snapshot's time.
+  // snapshot's time by at most a cycle (2/60 s of simulated time), so it lies between where the
+  // script puts it kOriginS + 35 ms before and at the snapshot's time.
   auto on_the_script = [&] {
     const SimulationSnapshot& seen = snapshot();
     if (!seen.hand(Hand::right).device_sample) return ::testing::AssertionFailure() << "no sample";
     const double x = seen.hand(Hand::right).device_sample->position_mm.x();
-    const double lo = expected_x_mm(seen.time_s - kOriginS - 0.02), hi = expected_x_mm(seen.time_s);
+    const double lo = expected_x_mm(seen.time_s - kOriginS - 0.035),
+                 hi = expected_x_mm(seen.time_s);
     if (x >= lo - 1e-9 && x <= hi + 1e-9) return ::testing::AssertionSuccess();
     return ::testing::AssertionFailure()
            << "the device at x = " << x << " mm, the script between " << lo << " and " << hi

@@ -203,10 +203,11 @@ class RealtimeSimulation {
  public:
   struct Options {
     std::size_t spring_capacity = 1024;
-    // Simulated time a cycle may cover, when max_steps_per_cycle=0: a display frame, so that the
-    // loop catches up a cycle held up by a cut update (at most a frame, issue 42) instead of
-    // dropping the time.
-    double cycle_s = 1.0 / 60.0;
+    // Simulated time a cycle may cover, when max_steps_per_cycle=0: two display frames, so that
+    // the loop catches up a cycle held up by a cut update instead of dropping the time. One frame
+    // was not enough: a parting update of 14 ms and its cycle's steps outlast a frame (the wedge
+    // resection's live bench dropped a step or two so, issue 42).
+    double cycle_s = 2.0 / 60.0;
     // Steps one cycle (one published snapshot) may take at most; 0: as many as fit in cycle_s
     // (at least one).
     int max_steps_per_cycle = 0;
