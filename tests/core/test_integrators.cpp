@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 
@@ -189,6 +190,27 @@ TEST(WholeSteps, AnIntervalALittleOverTheLimitTakesOneStepNotTwo) {
   // At the limit (the step may not grow past it): ⌈200 × 1.05⌉ = 210 steps, give or take the
   // first, which kicks from rest.
   EXPECT_LE(run(true, lead_s), static_cast<int>(std::ceil(intervals * 1.05)) + 1);
+}
+
+// A caller asked to stop (the real-time loop, by SIGTERM) gives advance a flag: once it reads true,
+// the interval ends where the step under way ends, what was done kept, however many steps were
+// left.
+TEST(GiveUp, AnAdvanceAskedToGiveUpEndsWithTheStepUnderWay) {
+  const Cantilever bar(elastic_tissue());
+  const SimModel model = build_model(bar.mesh, bar.options);
+  SimState state = make_rest_state(model);
+  std::atomic<bool> give_up{false};
+  const StepReport whole = advance(model, state, {}, 0.01, 0.0, &give_up);
+  EXPECT_FALSE(whole.gave_up_early);
+  EXPECT_GT(whole.substeps, 1);
+  EXPECT_DOUBLE_EQ(state.time_s, 0.01);
+  give_up = true;
+  const std::uint64_t steps_before = state.step_count;
+  const StepReport none = advance(model, state, {}, 1000.0, 0.0, &give_up);
+  EXPECT_TRUE(none.gave_up_early);
+  EXPECT_EQ(none.substeps, 0);
+  EXPECT_EQ(state.step_count, steps_before);
+  EXPECT_DOUBLE_EQ(state.time_s, 0.01);
 }
 
 // A free bar pulled by equal and opposite end tractions: with the volumetric and deviatoric

@@ -2,6 +2,8 @@
 // and the backlog beyond the cap dropped (simulated time slows down instead of spiralling). The
 // clock is tested with made-up elapsed times; the running loop only for what a tiny cap on a
 // heavy model must give whatever the machine's speed.
+#include "block_mesh.h"
+
 #include "liversim/engine/integrator.h"
 #include "liversim/engine/model_building.h"
 #include "liversim/engine/surface.h"
@@ -165,6 +167,26 @@ TEST_F(RealtimeSteppingFixture, TheFixedStepIsTheIntegratorStepOrElseJustUnderTh
   options.max_steps_per_cycle = 7;
   const RealtimeSimulation capped(stable, make_rest_state(*stable), options);
   EXPECT_EQ(capped.max_steps_per_cycle(), 7);
+}
+
+// A cycle whose steps have fallen far under its loop step (here a block so stiff that its stable
+// step is ~10 ns, under a loop step of 0.1 s: ten million force evaluations, seconds of work) would
+// hold stop() for as long as it runs; stop() gives it up after kGiveUpCycleAfterS, where its step
+// under way ends. Whole, the cycle would end at 0.1 s of simulated time.
+TEST(GiveUpCycle, StopEndsACycleThatWouldRunForSeconds) {
+  ModelOptions options;
+  options.regions[0].tissue = TissueMaterial{1e14, 0.3, 1000.0};
+  const TetMesh mesh = testing::block_mesh(2, 2, 2, {0.01, 0.01, 0.01});
+  const auto model = std::make_shared<const SimModel>(build_model(mesh, options));
+  ASSERT_LT(model->stable_time_step_s, 1e-7);
+  RealtimeSimulation::Options loop;
+  loop.loop_step_s = 0.1;
+  loop.max_steps_per_cycle = 1;
+  RealtimeSimulation simulation(model, make_rest_state(*model), loop);
+  simulation.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the first cycle is due at 0.1 s
+  simulation.stop();
+  EXPECT_LT(simulation.state().time_s, 0.1 - 1e-9);
 }
 
 TEST_F(RealtimeSteppingFixture, ATinyCapOnAHeavyModelReportsBehindAndKeepsWholeSteps) {

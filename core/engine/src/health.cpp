@@ -128,7 +128,7 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
   double scale = checkpoint.step_scale;
   for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
     state.integrator.step_scale = scale;
-    const StepReport steps = advance(model, state, effective, interval_s, options.whole_step_s);
+    const StepReport steps = advance(model, state, effective, interval_s, options.whole_step_s, options.give_up);
     // An unconverged implicit step is not a solution, however finite it looks.
     const HealthProblem problem = steps.unconverged_steps > 0 ? HealthProblem::solver_failed
                                                               : check_health(model, state, options);

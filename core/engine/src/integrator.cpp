@@ -151,6 +151,7 @@ double stability_interval(IntegratorKind kind) {
 }
 
 void accumulate(StepReport& total, const StepReport& part) {
+  total.gave_up_early |= part.gave_up_early;
   if (part.substeps == 0) return;
   if (total.substeps == 0) {
     total.smallest_substep_s = part.smallest_substep_s;
@@ -446,7 +447,8 @@ namespace {
 
 // Returns the time it advanced: the interval, or with whole steps (whole_step_s > 0) at least it.
 double advance_central_difference(const SimModel& model, SimState& state, const StepInputs& inputs,
-                                  double interval_s, double whole_step_s, StepReport& report) {
+                                  double interval_s, double whole_step_s,
+                                  const std::atomic<bool>* give_up, StepReport& report) {
   const bool whole_steps = whole_step_s > 0.0;
   const double requested_s = whole_steps ? whole_step_s : model.integrator.step_s;
   double advanced_s = 0.0;
@@ -454,6 +456,10 @@ double advance_central_difference(const SimModel& model, SimState& state, const 
   double remaining = interval_s;
   bool first = true;
   while (remaining > 0.0) {
+    if (give_up && give_up->load(std::memory_order_relaxed)) {
+      report.gave_up_early = true;
+      return advanced_s;
+    }
     const double stiffening = stiffening_since_rest(model, evaluate_forces(model, state, inputs));
     ++report.force_evaluations;
     report.max_stiffening = std::max(report.max_stiffening, stiffening);
@@ -506,7 +512,7 @@ double advance_central_difference(const SimModel& model, SimState& state, const 
 }  // namespace
 
 StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
-                   double interval_s, double whole_step_s) {
+                   double interval_s, double whole_step_s, const std::atomic<bool>* give_up) {
   StepReport report;
   if (!(interval_s > 0.0)) return report;
   report.smallest_substep_s = interval_s;
@@ -525,8 +531,8 @@ StepReport advance(const SimModel& model, SimState& state, const StepInputs& inp
   switch (model.integrator.kind) {
     case IntegratorKind::central_difference:
       // No drift from summing substeps: the time they covered, added once.
-      end_time = start_time +
-                 advance_central_difference(model, state, inputs, interval_s, whole_step_s, report);
+      end_time = start_time + advance_central_difference(model, state, inputs, interval_s,
+                                                         whole_step_s, give_up, report);
       break;
     case IntegratorKind::rk4:
     case IntegratorKind::dopri5:

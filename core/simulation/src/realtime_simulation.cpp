@@ -110,12 +110,27 @@ RealtimeSimulation::~RealtimeSimulation() {
 void RealtimeSimulation::start() {
   if (thread_.joinable()) return;
   stop_requested_ = false;
-  thread_ = std::thread([this] { run(); });
+  give_up_cycle_ = false;
+  loop_ended_ = false;
+  thread_ = std::thread([this] {
+    run();
+    loop_ended_ = true;
+  });
 }
 
 void RealtimeSimulation::stop() {
   stop_requested_ = true;
-  if (thread_.joinable()) thread_.join();
+  if (!thread_.joinable()) return;
+  // A cycle ends within milliseconds and is kept whole (a session's replay takes whole cycles).
+  // One that has not ended after kGiveUpCycleAfterS (steps fallen to microseconds: a crawl that
+  // held `record` past SIGTERM for minutes) is given up where its step under way ends; a replay
+  // then takes that last cycle further than the live loop did.
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(kGiveUpCycleAfterS);
+  while (!loop_ended_.load() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  give_up_cycle_ = true;
+  thread_.join();
 }
 
 void RealtimeSimulation::enable_tools(const BoundarySurface& surface, ContactSettings contact,
@@ -535,6 +550,9 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   // Whole steps as long as the limits allow, up to the loop's step: the state may end a little
   // past the time the loop asked for (lead_s_), and the next step asks for that much less.
   guard.whole_step_s = step_s_;
+  // Given up (stop(), a cycle that would not end), the cycle ends where its step under way ends,
+  // what it did kept: in a crawl one cycle's steps took minutes, and `record` ignored SIGTERM.
+  guard.give_up = &give_up_cycle_;
   // The checkpoint (a copy of the whole state, its viscous history 1 MB at 5450 elements) once per
   // kCheckpointIntervalS of simulated time: saved every cycle, it was 7 % of a stroke's time.
   const bool checkpoint_due = !checkpoint_.valid ||
@@ -554,7 +572,7 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   GuardedReport guarded;
   if (tool_acts) {
     bool first = true;
-    for (int s = 0; s < steps; ++s) {
+    for (int s = 0; s < steps && !give_up_cycle_.load(std::memory_order_relaxed); ++s) {
       const double interval_s = step_s_ - loop_lead_s_;
       // Already there: the last step's lead covers it. The cycle's last step is still taken (an
       // empty advance), so its checkpoint is saved.

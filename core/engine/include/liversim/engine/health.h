@@ -50,6 +50,8 @@ struct GuardOptions {
   // advance's whole_step_s (integrator.h): > 0, central difference ends at or past the interval's
   // end in steps of at most this.
   double whole_step_s = 0.0;
+  // advance's give_up (integrator.h): set, the advance may end early when it reads true.
+  const std::atomic<bool>* give_up = nullptr;
 };
 
 // Finite positions and velocities, no node faster than the speed limit, none with more kinetic

@@ -7,6 +7,7 @@
 #include "liversim/engine/forces.h"
 
 #include <array>
+#include <atomic>
 #include <limits>
 #include <optional>
 #include <string>
@@ -51,9 +52,10 @@ struct StepReport {
   // The mesh's limit lowered by the springs (stable_time_step_s with the inputs), the smallest of
   // the interval, whether or not it limited a step.
   double smallest_spring_limit_s = std::numeric_limits<double>::infinity();
-  int rejected_steps = 0;     // dopri5: steps redone because the error was too large
-  int force_evaluations = 0;  // internal-force evaluations of the whole mesh
-  int newton_iterations = 0;  // implicit schemes
+  int rejected_steps = 0;      // dopri5: steps redone because the error was too large
+  int force_evaluations = 0;   // internal-force evaluations of the whole mesh
+  bool gave_up_early = false;  // advance's give_up ended the interval before its end
+  int newton_iterations = 0;   // implicit schemes
   int linear_solves = 0;
   int factorizations = 0;
   int unconverged_steps = 0;  // implicit steps whose Newton iteration hit its limit
@@ -90,8 +92,13 @@ double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& see
 // for this: with each of its intervals covered exactly, a limit a little under its step split
 // every interval in two, twice the force evaluations for a limit 1 % short (the state's time
 // then carries the difference to the next interval).
+//
+// `give_up` set (central difference): the interval ends early, where the step under way ends, once
+// it reads true (StepReport::gave_up_early): a loop asked to stop is not held for the rest of an
+// interval whose steps have fallen to microseconds.
 StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
-                   double interval_s, double whole_step_s = 0.0);
+                   double interval_s, double whole_step_s = 0.0,
+                   const std::atomic<bool>* give_up = nullptr);
 
 // One central-difference step of length dt_s (the caller guarantees stability). Returns what the
 // force evaluation of the configuration the step started from saw.

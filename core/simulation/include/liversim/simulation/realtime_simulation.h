@@ -190,6 +190,8 @@ inline constexpr double kLoopStepFraction = 0.9;
 // time: a rollback loses at most this, and the copy is made a few hundred times a second, not at
 // every step.
 inline constexpr double kCheckpointIntervalS = 0.005;
+// stop() lets the cycle under way end on its own for this long (wall time), then gives it up.
+inline constexpr double kGiveUpCycleAfterS = 1.0;
 // The outcome tracker (tissue_outcome.h) looks at the tissue once per this much simulated time,
 // not per cycle: a strain past its damage limit is seen unless a hand makes and undoes it within
 // 2 ms.
@@ -424,6 +426,8 @@ class RealtimeSimulation {
   double trace_wall_s() const;
 
   std::atomic<bool> stop_requested_{false};
+  std::atomic<bool> give_up_cycle_{false};  // stop(): the cycle under way ends early
+  std::atomic<bool> loop_ended_{false};
   // Statistics, written by the simulation thread once per window; each field on its own (a reader
   // may see fields of two neighbouring windows, which is harmless for a display).
   std::atomic<double> steps_per_second_{0.0}, real_time_factor_{0.0}, smallest_step_s_{0.0};
