@@ -175,6 +175,29 @@ TEST_P(GuardFixture, TheStepsOfOneCycleShareOneCheckpoint) {
   EXPECT_NEAR(saved_each.time_s, 0.008, 1e-12);
 }
 
+// A caller that saves seldom (the real-time loop: once per 5 ms of simulated time) still moves its
+// checkpoint past a failure: an advance that had to roll back saves the good state it reached,
+// whatever the options say. Before, each failure went back to the same old checkpoint, the retry
+// got no further than the failure, and a live loop went round 23.84 s of a bimanual resection for
+// minutes.
+TEST_P(GuardFixture, AnAdvanceThatRolledBackSavesWhereItGotToEvenWhenAskedNotTo) {
+  SimState state = make_rest_state(model);
+  StateCheckpoint checkpoint = make_checkpoint(model);
+  const StepInputs inputs{pull, {}};
+  ASSERT_EQ(guarded_advance(model, state, inputs, 0.01, checkpoint).problem, HealthProblem::none);
+  GuardOptions seldom;
+  seldom.checkpoint_on_entry = seldom.checkpoint_after_advance = false;
+  ASSERT_FALSE(guarded_advance(model, state, inputs, 0.002, checkpoint, seldom).rollbacks);
+  const double saved_s = checkpoint.time_s;
+  EXPECT_LT(saved_s, state.time_s) << "a good advance is not saved when asked not to";
+  state.position_m.y[3] = std::numeric_limits<double>::quiet_NaN();
+  const GuardedReport report = guarded_advance(model, state, inputs, 0.002, checkpoint, seldom);
+  ASSERT_GE(report.rollbacks, 1);
+  EXPECT_FALSE(report.gave_up);
+  EXPECT_NEAR(state.time_s, saved_s + 0.002, 1e-12);
+  EXPECT_EQ(checkpoint.time_s, state.time_s) << "the retry's good state was not saved";
+}
+
 TEST(Guard, UnconvergedImplicitStepsAreRolledBack) {
   const TetMesh mesh = testing::block_mesh(4, 1, 1, {0.04, 0.01, 0.01});
   ModelOptions options;

@@ -128,12 +128,16 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
   double scale = checkpoint.step_scale;
   for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
     state.integrator.step_scale = scale;
-    const StepReport steps = advance(model, state, effective, interval_s, options.whole_step_s, options.give_up);
+    const StepReport steps =
+        advance(model, state, effective, interval_s, options.whole_step_s, options.give_up);
     // An unconverged implicit step is not a solution, however finite it looks.
     const HealthProblem problem = steps.unconverged_steps > 0 ? HealthProblem::solver_failed
                                                               : check_health(model, state, options);
     if (problem == HealthProblem::none) {
-      if (options.checkpoint_after_advance) save_checkpoint(state, checkpoint);  // newest good
+      // Newest good. After a rollback always: a caller saving seldom (the real-time loop, every 5
+      // ms) would otherwise go back to the same old state at each failure and never get past it.
+      if (options.checkpoint_after_advance || report.rollbacks > 0)
+        save_checkpoint(state, checkpoint);
       report.steps = steps;
       report.step_scale = scale;
       checkpoint.step_scale = std::min(1.0, 2.0 * scale);

@@ -41,10 +41,10 @@ struct GuardOptions {
   bool check_energy = false;
   double energy_tolerance = 0.05;
   // Whether the good state is saved as the checkpoint on entry (unless saved already) and after a
-  // good advance. A caller stepping one cycle step by step saves on entry to its first step and
-  // after its last only: a full copy of the state (its viscous history above all) after every
-  // 0.43 ms step was a tenth of the loop's time while a tool acted. A bad step in between goes
-  // back to the cycle's start.
+  // good advance (after one that had to roll back, always). A caller stepping one cycle step by
+  // step saves on entry to its first step and after its last only: a full copy of the state (its
+  // viscous history above all) after every 0.43 ms step was a tenth of the loop's time while a tool
+  // acted. A bad step in between goes back to the cycle's start.
   bool checkpoint_on_entry = true;
   bool checkpoint_after_advance = true;
   // advance's whole_step_s (integrator.h): > 0, central difference ends at or past the interval's
