@@ -574,8 +574,9 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
     bool first = true;
     for (int s = 0; s < steps && !give_up_cycle_.load(std::memory_order_relaxed); ++s) {
       const double interval_s = step_s_ - loop_lead_s_;
-      // Already there: the last step's lead covers it. The cycle's last step is still taken (an
-      // empty advance), so its checkpoint is saved.
+      // Already there: the last step's lead covers it. The cycle's last loop step still goes
+      // through the guard, taking no step: its tools are updated (and, when due, the checkpoint
+      // saved), as when every loop step was stepped.
       const bool reached = interval_s <= reached_s;
       if (reached && s < steps - 1) {
         loop_lead_s_ = std::max(0.0, -interval_s);
