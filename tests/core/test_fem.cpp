@@ -12,7 +12,9 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <limits>
 #include <random>
+#include <string>
 
 namespace liversim {
 namespace {
@@ -359,6 +361,26 @@ TEST(Model, RejectsBadMeshesAndFixedNodes) {
   std::swap(inverted.corner[2][0], inverted.corner[3][0]);
   EXPECT_THROW(build_model(inverted, ModelOptions{}), std::invalid_argument);
   EXPECT_THROW(build_model(TetMesh{}, ModelOptions{}), std::invalid_argument);
+}
+
+// The plastic flow's interval is a time: negative, NaN or infinite is refused by name.
+TEST(Model, RejectsAPlasticFlowIntervalThatIsNoTime) {
+  const TetMesh mesh = block_mesh(1, 1, 1, {0.01, 0.01, 0.01});
+  for (double bad : {-0.001, std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::infinity()}) {
+    ModelOptions options;
+    options.plastic_flow_interval_s = bad;
+    try {
+      build_model(mesh, options);
+      ADD_FAILURE() << "an interval of " << bad << " s was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("plastic flow's interval"), std::string::npos)
+          << e.what();
+    }
+  }
+  ModelOptions every_step;
+  every_step.plastic_flow_interval_s = 0.0;
+  EXPECT_EQ(build_model(mesh, every_step).plastic_flow_interval_s, 0.0);
 }
 
 }  // namespace

@@ -356,12 +356,19 @@ ElasticEvaluation viscous_forces(const SimModel& model, const NodeArray& positio
     const ViscousTissueStep& step = *(*viscous.step_by_region)[r];
     const double mu = step.mu_instant_pa, lambda = step.lambda_instant_pa;
     const double values[10] = {
-        mu, lambda, step.relaxed_fraction, step.arm_fraction, step.arm_decay, step.arm_loading,
+        mu,
+        lambda,
+        step.relaxed_fraction,
+        step.arm_fraction,
+        step.arm_decay,
+        step.arm_loading,
         // No flow this step: nothing yields (the general update would take none).
         step.viscoplastic && step.flow_dt_s > 0.0 ? step.viscoplastic->yield_limit_pa
                                                   : std::numeric_limits<double>::infinity(),
         step.arm_fraction / (4.0 * mu),  // maxwell_arm_energy_density's factors
-        lambda / (2.0 * mu + 3.0 * lambda), step.dt_s / step.relaxation_time_s};
+        lambda / (2.0 * mu + 3.0 * lambda),
+        step.dt_s / step.relaxation_time_s,
+    };
     for (int k = 0; k < 10; ++k) constants[k * regions + r] = values[k];
   }
   detail::ViscousKernelData data{};

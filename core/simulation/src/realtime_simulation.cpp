@@ -334,13 +334,14 @@ void RealtimeSimulation::observe_outcome() {
         OutcomeTracking{OutcomeTracker(*model_, outcome_request_->first, outcome_request_->second),
                         model_, model_});
     outcome_request_.reset();
+    outcome_observed_s_ = -std::numeric_limits<double>::infinity();
   }
   if (!outcome_) return;
   outcome_->model = model_;
   // A pass over every element: once per kOutcomeIntervalS of simulated time, not per cycle (at
   // one 0.43 ms step a cycle, it was 8 % of a cutting stroke's time).
-  if (state_.time_s < outcome_observed_s_ + kOutcomeIntervalS && outcome_observed_s_ >= 0.0 &&
-      state_.time_s >= outcome_observed_s_)
+  if (state_.time_s >= outcome_observed_s_ &&
+      state_.time_s < outcome_observed_s_ + kOutcomeIntervalS)
     return;
   outcome_observed_s_ = state_.time_s;
   outcome_->tracker.observe(*model_, state_.position_m);
@@ -560,15 +561,17 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
                               state_.time_s < checkpoint_.time_s;
   guard.checkpoint_on_entry = checkpoint_due;
   guard.checkpoint_after_advance = false;
+  // Less than this left to cover: the loop's time is reached (round-off of the lead).
+  const double reached_s = 1e-9 * step_s_;
+  // Advances by what is left of `interval_s` (nothing when it is reached: the guard still runs)
+  // and keeps the lead past it.
   auto advance_by = [&](double interval_s, const StepInputs& inputs, const GuardOptions& options) {
     const double before_s = state_.time_s;
-    const GuardedReport one =
-        guarded_advance(model, state_, inputs, interval_s, checkpoint_, options);
+    const GuardedReport one = guarded_advance(
+        model, state_, inputs, interval_s > reached_s ? interval_s : 0.0, checkpoint_, options);
     loop_lead_s_ = one.gave_up ? 0.0 : std::max(0.0, (state_.time_s - before_s) - interval_s);
     return one;
   };
-  // Less than this left to cover: the loop's time is reached (round-off of the lead).
-  const double reached_s = 1e-9 * step_s_;
   GuardedReport guarded;
   if (tool_acts) {
     bool first = true;
@@ -577,8 +580,7 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
       // Already there: the last step's lead covers it. The cycle's last loop step still goes
       // through the guard, taking no step: its tools are updated (and, when due, the checkpoint
       // saved), as when every loop step was stepped.
-      const bool reached = interval_s <= reached_s;
-      if (reached && s < steps - 1) {
+      if (interval_s <= reached_s && s < steps - 1) {
         loop_lead_s_ = std::max(0.0, -interval_s);
         continue;
       }
@@ -586,16 +588,12 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
       step_guard.check_energy = guard.check_energy && first;
       step_guard.checkpoint_on_entry = checkpoint_due && first;
       first = false;
-      const GuardedReport one = advance_by(reached ? 0.0 : interval_s, tool_inputs(), step_guard);
-      if (reached) loop_lead_s_ = std::max(0.0, -interval_s);
+      const GuardedReport one = advance_by(interval_s, tool_inputs(), step_guard);
       merge_guarded(guarded, one);
       if (one.gave_up) break;
     }
   } else {
-    const double interval_s = steps * step_s_ - loop_lead_s_;
-    const bool reached = interval_s <= reached_s;
-    guarded = advance_by(reached ? 0.0 : interval_s, StepInputs{{}, active_springs_}, guard);
-    if (reached) loop_lead_s_ = std::max(0.0, -interval_s);
+    guarded = advance_by(steps * step_s_ - loop_lead_s_, StepInputs{{}, active_springs_}, guard);
   }
   if (guarded.energy) {
     energy_created_ = guarded.energy_created;

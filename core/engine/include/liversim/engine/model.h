@@ -77,8 +77,9 @@ struct IntegratorSettings {
   bool operator==(const IntegratorSettings&) const = default;
 };
 
-// The default SimModel::plastic_flow_interval_s: the haptic servo's period, so the flow changes a
-// felt force no more often than the device reads it.
+// The default SimModel::plastic_flow_interval_s: two haptic servo periods. At 1 ms the scalar flow
+// update was still about a fifth of a stroke's time on the wedge scenario (perf); a flow taken every
+// 2 ms lags that of every step by at most (σ − σs)/η2·(2 ms)ⁿ (docs/viscous-tissue.md).
 inline constexpr double kPlasticFlowIntervalS = 0.002;
 
 struct ModelOptions {

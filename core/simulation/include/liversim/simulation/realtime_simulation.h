@@ -337,8 +337,8 @@ class RealtimeSimulation {
   SimState state_;
   Options options_;
   double step_s_;
-  // Simulated time the outcome tracker last looked at the tissue (< 0: never).
-  double outcome_observed_s_ = -1.0;
+  // Simulated time the outcome tracker last looked at the tissue (−∞: not yet).
+  double outcome_observed_s_ = -std::numeric_limits<double>::infinity();
   // How far the state's time is past the time the loop's steps have asked for: whole steps end
   // past it by less than one step (advance_cycle).
   double loop_lead_s_ = 0.0;
