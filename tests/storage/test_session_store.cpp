@@ -546,11 +546,15 @@ std::optional<std::string> other_build_than_the_digests() {
 //   command;
 // - once the blade followed its groove and a cut's mass scaling looked one element beyond the cut
 //   (issue 42), by the same command;
-// - once a stroke refined the mesh only over its first stretch (issue 42), by the same command.
+// - once a stroke refined the mesh only over its first stretch (issue 42), by the same command;
+// - once the loop stepped in whole steps across its intervals and the plastic flow was taken once
+//   per 2 ms (issue 42), by the same command.
 // The second and third were bit for bit until cuts came to refine the mesh at the blade and give
 // small parts mass (issue 42); the fourth until the blade came to follow its groove (issue 42); the
 // fifth until a stroke came to refine only over its first stretch (issue 42); the sixth until the
-// loop came to step in whole steps and the flow to be taken once per interval (issue 42).
+// loop came to step in whole steps and the flow to be taken once per interval (issue 42); the
+// seventh until a stroke's sweep came to start a blade's width back, holes in the cut and strands
+// at a stroke's end to be parted (issue 42).
 struct OlderSession {
   const char* file;    // in tests/data/storage
   const char* label;   // of its replay's working folder
@@ -580,16 +584,18 @@ INSTANTIATE_TEST_SUITE_P(
                       OlderSession{"session-v7-scalpel-cuts-guided.sqlite",
                                    "recorded-following-the-groove", 2.59},
                       OlderSession{"session-v7-scalpel-cuts-first-stretch.sqlite",
-                                   "recorded-refining-the-first-stretch", 2.59}),
+                                   "recorded-refining-the-first-stretch", 2.59},
+                      OlderSession{"session-v7-scalpel-cuts-whole-steps.sqlite",
+                                   "recorded-in-whole-steps", 2.59}),
     [](const ::testing::TestParamInfo<OlderSession>& info) {
       std::string name = info.param.label;
       std::replace(name.begin(), name.end(), '-', '_');
       return name;
     });
 
-// A session recorded once the loop steps in whole steps across its intervals and the plastic flow
-// is taken once per 2 ms (issue 42), by the same command as above
-// (tests/data/storage/session-v7-scalpel-cuts-whole-steps.sqlite): replayed by today's engine,
+// A session recorded once a stroke's sweep starts a blade's width back where it starts to draw,
+// and holes in the cut and strands at a stroke's end are parted (issue 42), by the same command as
+// above (tests/data/storage/session-v7-scalpel-cuts-seams.sqlite): replayed by today's engine,
 // its final positions and velocities are those its replay gave when it was recorded, to the last
 // bit. Bit for bit holds for one build of the engine, the one the digest was taken with: GCC's
 // optimised build with the AVX2+FMA element kernels. Other builds skip. A deliberate change of the
@@ -598,14 +604,14 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(SessionReplay, ARecordedSessionReplaysToTheSameStateBitForBit) {
   if (const auto why = other_build_than_the_digests()) GTEST_SKIP() << *why;
   const ReplayedEnd end = replay_to_the_end(
-      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v7-scalpel-cuts-whole-steps.sqlite",
-      "recorded-in-whole-steps");
+      fs::path(LIVERSIM_TEST_DATA_DIR) / "storage" / "session-v7-scalpel-cuts-seams.sqlite",
+      "recorded-parting-seams");
   // Each refinement around the blade is a topology change of its own.
-  EXPECT_EQ(end.cuts, 23u);
-  EXPECT_EQ(end.nodes, 469u);
-  EXPECT_EQ(end.steps, 2570u);
-  EXPECT_EQ(end.time_s, 2.5997185484337448);
-  EXPECT_EQ(end.digest, 0x9e5e96ad118ab1c7ull);
+  EXPECT_EQ(end.cuts, 26u);
+  EXPECT_EQ(end.nodes, 475u);
+  EXPECT_EQ(end.steps, 2571u);
+  EXPECT_EQ(end.time_s, 2.6002314822790278);
+  EXPECT_EQ(end.digest, 0x57c0d07f44f9ee7aull);
 }
 
 // A free-practice session whose live loop the health guard halted (recorded at 3ec318a by

@@ -56,6 +56,10 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
                         "a value >= 0 (infinity: take every freed piece out)");
   if (!(settings.groove_guide_m >= 0.0) || !std::isfinite(settings.groove_guide_m))
     return out_of_range("groove guide (m)", settings.groove_guide_m, "a finite value >= 0");
+  if (!(settings.blade_width_m >= 0.0 && settings.blade_width_m <= 0.02))
+    return out_of_range("blade width (m)", settings.blade_width_m, "a value in [0, 0.02]");
+  if (!(settings.hole_angle_deg >= 0.0 && settings.hole_angle_deg <= 45.0))
+    return out_of_range("hole angle (°)", settings.hole_angle_deg, "a value in [0, 45]");
   return std::nullopt;
 }
 
@@ -250,14 +254,57 @@ struct SweepSurface {
 // groove (bend_onto_grooves).
 using EdgePoints = std::vector<Eigen::Vector3d>;
 
+// The slit a blade makes where it enters and starts to draw (CuttingSettings::blade_width_m): at
+// each instant where the edge, having been still or moving along itself (pressed in), starts to
+// move across itself, the blade's body lies behind its edge, as wide as the blade: the quad from
+// the edge back against the motion by `width_m`, as two triangles, with the instant it belongs to.
+// Without it the edge's sweep starts at the edge's line, and passes drawn apart from one entry (a
+// resection's) each left the elements at their seam entered but not passed through: uncut.
+struct EntrySlit {
+  std::size_t instant;
+  Triangle triangle;
+};
+std::vector<EntrySlit> entry_slits(std::span<const std::array<Eigen::Vector3d, 2>> straight,
+                                   double width_m) {
+  std::vector<EntrySlit> slits;
+  if (!(width_m > 0.0)) return slits;
+  // The edge's travel from instant i to i + 1 across itself, when it moves more across than along.
+  auto across = [&](std::size_t i) -> std::optional<Eigen::Vector3d> {
+    const Eigen::Vector3d along = straight[i][1] - straight[i][0];
+    const Eigen::Vector3d travel =
+        0.5 * ((straight[i + 1][0] + straight[i + 1][1]) - (straight[i][0] + straight[i][1]));
+    if (!(along.norm() > 0.0)) return std::nullopt;
+    const Eigen::Vector3d unit = along.normalized();
+    const Eigen::Vector3d perpendicular = travel - travel.dot(unit) * unit;
+    if (!(perpendicular.norm() > std::abs(travel.dot(unit))) || !(perpendicular.norm() > 0.0))
+      return std::nullopt;
+    return Eigen::Vector3d(perpendicular.normalized());
+  };
+  bool drawing = false;
+  for (std::size_t i = 0; i + 1 < straight.size(); ++i) {
+    const auto direction = across(i);
+    if (direction && !drawing) {
+      const Eigen::Vector3d back = -width_m * *direction;
+      const Eigen::Vector3d &heel = straight[i][0], &tip = straight[i][1];
+      slits.push_back({i, {heel + back, tip + back, tip}});
+      slits.push_back({i, {heel + back, tip, heel}});
+    }
+    drawing = direction.has_value();
+  }
+  return slits;
+}
+
 // The stroke's triangles, oriented alike (a stroke that turns back keeps one side one side);
 // degenerate ones (the blade still, or moving along itself) are left out. Between two instants
 // given by their ends, the triangles (heel_i, tip_i, tip_i+1) and (heel_i, tip_i+1, heel_i+1);
 // between instants bent onto a groove (as many points each), those of each stretch, on the side
 // of the straight ones (a stretch that climbs from a groove to the blade's own plane stands across
 // it, and its own normal says nothing of the stroke's sides).
+// `slits`: the entry slits of the whole stroke, of which those of instants `first_instant` on are
+// added (the sweep of the instants from there).
 SweepSurface sweep_surface(const std::vector<EdgePoints>& edges,
-                           std::span<const std::array<Eigen::Vector3d, 2>> straight) {
+                           std::span<const std::array<Eigen::Vector3d, 2>> straight,
+                           std::span<const EntrySlit> slits = {}, std::size_t first_instant = 0) {
   SweepSurface surface;
   double extent = 0.0;
   auto normal_of = [](const Triangle& tri, double& longest) -> std::optional<Eigen::Vector3d> {
@@ -330,6 +377,8 @@ SweepSurface sweep_surface(const std::vector<EdgePoints>& edges,
       add({a, b1, b}, &*side);
     }
   }
+  for (const EntrySlit& slit : slits)
+    if (slit.instant >= first_instant) add(slit.triangle, nullptr);
   surface.tolerance_m = 1e-9 * extent;
   for (const Triangle& tri : surface.triangle) {
     Aabb box;
@@ -1463,11 +1512,95 @@ struct AfterSplitting {
   bool may_make_nodes = false;                // after the front's refinement, not after a split
 };
 
+// Holes in the cut (CuttingSettings::hole_angle_deg): an interior face whose three nodes all lie
+// on cut faces (made by earlier updates, or separated by this one) and that lies in the cut's
+// surface there (within the angle of parallel to a cut face at each of its nodes, and in that cut
+// face's plane to within a millimetre) is a remnant of the cut that its rules for settling
+// elements left joined: where two strokes meet end to end (a resection's passes entering at one
+// place), neither passed all the way through the elements at the seam, and after four passes a
+// 56 cm³ lobe hung by one such face of 35 mm². Such faces are added to `separated` (sorted), so the
+// cut is exact to within one face. Parting them makes no node newly on the cut, so this does not
+// spread along a cut's front.
+void add_holes_in_the_cut(const SimModel& model, const NodeArray& rest_m,
+                          FaceNeighbours& neighbours, double angle_deg,
+                          std::vector<FaceKey>& separated) {
+  const std::size_t tets = model.tet_count;
+  const bool earlier_cuts = !model.cut_face_mask.empty();
+  if (angle_deg <= 0.0 || (!earlier_cuts && separated.empty())) return;
+  auto is_cut_face = [&](std::size_t e, int f) {
+    return (earlier_cuts && (model.cut_face_mask[e] >> f & 1u)) ||
+           std::binary_search(separated.begin(), separated.end(), face_key(model, e, f));
+  };
+  std::vector<std::uint8_t> on_cut(model.node_count, 0);
+  if (earlier_cuts)
+    for (std::size_t e = 0; e < tets; ++e)
+      for (int f = 0; f < 4; ++f)
+        if (model.cut_face_mask[e] >> f & 1u)
+          for (int k = 0; k < 3; ++k) on_cut[model.corner[kTetFace[f][k]][e]] = 1;
+  for (const FaceKey& key : separated)
+    for (NodeIndex n : key) on_cut[n] = 1;
+  auto unit_normal = [&](std::size_t e, int f) {
+    const Eigen::Vector3d a = rest_m.at(model.corner[kTetFace[f][0]][e]),
+                          b = rest_m.at(model.corner[kTetFace[f][1]][e]),
+                          c = rest_m.at(model.corner[kTetFace[f][2]][e]);
+    return (b - a).cross(c - a).normalized();
+  };
+  const double least_cos = std::cos(angle_deg * std::numbers::pi / 180.0);
+  // A cut face at node n within the angle of parallel to the candidate, whose plane holds the
+  // candidate's corners to within kHoleOffPlaneM: the candidate lies in that sheet of the cut,
+  // not across the slab between two sheets a few millimetres apart.
+  constexpr double kHoleOffPlaneM = 0.001;
+  auto in_a_cut_face_plane_at = [&](NodeIndex n, const Eigen::Vector3d& normal,
+                                    const std::array<Eigen::Vector3d, 3>& corners) {
+    bool found = false;
+    for_each_element_of(model, n, [&](std::size_t e) {
+      for (int f = 0; f < 4 && !found; ++f) {
+        bool holds_n = false;
+        for (int k = 0; k < 3; ++k) holds_n |= model.corner[kTetFace[f][k]][e] == n;
+        if (!holds_n || !is_cut_face(e, f)) continue;
+        const Eigen::Vector3d cut_normal = unit_normal(e, f);
+        if (std::abs(cut_normal.dot(normal)) < least_cos) continue;
+        bool on_plane = true;
+        for (const Eigen::Vector3d& p : corners)
+          on_plane &= std::abs(cut_normal.dot(p - rest_m.at(n))) <= kHoleOffPlaneM;
+        found = on_plane;
+      }
+    });
+    return found;
+  };
+  std::vector<FaceKey> holes;
+  for (std::size_t e = 0; e < tets; ++e)
+    for (int f = 0; f < 4; ++f) {
+      bool all_on_cut = true;
+      for (int k = 0; k < 3; ++k) all_on_cut &= on_cut[model.corner[kTetFace[f][k]][e]] != 0;
+      if (!all_on_cut) continue;
+      const auto across = neighbours(e, f);
+      if (!across || *across < e || is_cut_face(e, f)) continue;  // each interior face once
+      const Eigen::Vector3d normal = unit_normal(e, f);
+      std::array<Eigen::Vector3d, 3> corners;
+      for (int k = 0; k < 3; ++k) corners[k] = rest_m.at(model.corner[kTetFace[f][k]][e]);
+      bool in_the_cut = true;
+      for (int k = 0; k < 3 && in_the_cut; ++k)
+        in_the_cut = in_a_cut_face_plane_at(model.corner[kTetFace[f][k]][e], normal, corners);
+      if (in_the_cut) holes.push_back(face_key(model, e, f));
+    }
+  if (holes.empty()) return;
+  separated.insert(separated.end(), holes.begin(), holes.end());
+  std::sort(separated.begin(), separated.end());
+}
+
 // The frequency a cut's mass scaling holds the model to: the uncut model's.
 double frequency_ceiling(const SimModel& model) {
   return model.uncut_frequency_rad_per_s > 0.0 ? model.uncut_frequency_rad_per_s
                                                : model.max_frequency_rad_per_s;
 }
+
+CutResult separate_faces(const SimModel& model, const SimState& state, FaceNeighbours& neighbours,
+                         Geometry geometry, const std::vector<std::uint8_t>& snapped,
+                         std::vector<FaceKey> separated, const CuttingSettings& settings,
+                         const AfterSplitting* after, CutReport so_far,
+                         const std::vector<std::uint8_t>* left_whole,
+                         std::vector<std::uint8_t>* rerun_thinner, bool keep_pinched = false);
 
 // cut_tissue on a sweep. Unless `after` says otherwise, nodes may be made on edges, and the cut
 // then runs again on the model with them, given what this one found.
@@ -1789,8 +1922,35 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
       separated.push_back(face_key(model, a, f));
     }
   }
-  if (separated.empty()) return result;
   std::sort(separated.begin(), separated.end());
+  add_holes_in_the_cut(model, geometry.rest_m, neighbours, settings.hole_angle_deg, separated);
+  if (separated.empty()) return result;
+  std::vector<std::uint8_t> thinner;
+  CutResult cut =
+      separate_faces(model, state, neighbours, std::move(geometry), snapped, std::move(separated),
+                     settings, after, report, half_floor ? nullptr : &left_whole, &thinner);
+  if (!thinner.empty())
+    return cut_along(model, state, surface, settings, after, front, &thinner, recent);
+  return cut;
+}
+
+// Steps 5 to 8 of a cut (cut_along): parts the faces `separated` (sorted) of the model, with the
+// geometry its snapping left, and builds the new model and state. `left_whole` (per element: the
+// sweep passed through it and left it whole), when given, may ask for the cut to run again with
+// those of them a merge took and their neighbours split down to half the height floor: then
+// `rerun_thinner` is set to them and what is returned is to be dropped. `keep_pinched`: a node the
+// faces pinch (its copy's surface not one fan) stays so, instead of the faces around it joining
+// again (part_strands).
+CutResult separate_faces(const SimModel& model, const SimState& state, FaceNeighbours& neighbours,
+                         Geometry geometry, const std::vector<std::uint8_t>& snapped,
+                         std::vector<FaceKey> separated, const CuttingSettings& settings,
+                         const AfterSplitting* after, CutReport so_far,
+                         const std::vector<std::uint8_t>* left_whole,
+                         std::vector<std::uint8_t>* rerun_thinner, bool keep_pinched) {
+  CutResult result;
+  result.report = so_far;
+  CutReport& report = result.report;
+  const std::size_t tets = model.tet_count;
   auto is_separated = [&](const FaceKey& key) {
     return std::binary_search(separated.begin(), separated.end(), key);
   };
@@ -1894,7 +2054,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
       }
       if (is_pinched) pinched.push_back(n);
     }
-    if (pinched.empty()) break;
+    if (pinched.empty() || keep_pinched) break;
     // At a pinched node, the separated faces around it fall into groups joined through edges
     // from it: keep the largest group when there are several (the others rejoin, to be cut as
     // the stroke goes on), none when one group alone pinches it (against the organ's surface).
@@ -2009,17 +2169,20 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
   // deep then met 4 mm less tissue. The cut runs once more with those elements split down to
   // half the floor, their thinner parts held by added mass. (Half the floor for every element
   // the stroke passes through halted a live stroke; only these few are let through.)
-  if (!half_floor) {
+  if (left_whole) {
     std::vector<std::uint8_t> thinner(tets, 0);
     bool any = false;
     // (With the elements around them: an edge is split only if every element holding it may be.)
     for (std::size_t e = 0; e < tets; ++e)
-      if (merged[e] && left_whole[e]) {
+      if (merged[e] && (*left_whole)[e]) {
         any = true;
         for (int c = 0; c < 4; ++c)
           for_each_element_of(model, model.corner[c][e], [&](std::size_t o) { thinner[o] = 1; });
       }
-    if (any) return cut_along(model, state, surface, settings, after, front, &thinner, recent);
+    if (any) {
+      *rerun_thinner = std::move(thinner);
+      return result;
+    }
   }
 
   // A free body the merges left one element is a flap of its own: a crumb (a lone element's
@@ -2245,7 +2408,8 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
       if (!point.allFinite()) throw std::invalid_argument("the blade's stroke is not finite");
   const std::vector<EdgePoints> edges =
       cutting_edges(model, state.position_m, stroke, settings.groove_guide_m);
-  const SweepSurface surface = sweep_surface(edges, stroke.edges_m);
+  const std::vector<EntrySlit> slits = entry_slits(stroke.edges_m, settings.blade_width_m);
+  const SweepSurface surface = sweep_surface(edges, stroke.edges_m, slits);
   if (surface.size() == 0) return {};
   std::optional<SweepSurface> recent;
   if (stroke.settled_instants > 0) {
@@ -2255,12 +2419,13 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
             : 0;
     if (from > 0)
       recent = sweep_surface(std::vector<EdgePoints>(edges.begin() + from, edges.end()),
-                             std::span(stroke.edges_m).subspan(from));
+                             std::span(stroke.edges_m).subspan(from), slits, from);
   }
   if (settings.refine_edge_m > 0.0 && edges.size() >= 2 &&
       refines_at(model, stroke.edges_m, settings)) {
-    const SweepSurface front = sweep_surface(std::vector<EdgePoints>(edges.end() - 2, edges.end()),
-                                             std::span(stroke.edges_m).last(2));
+    const SweepSurface front =
+        sweep_surface(std::vector<EdgePoints>(edges.end() - 2, edges.end()),
+                      std::span(stroke.edges_m).last(2), slits, edges.size() - 2);
     if (front.size() > 0)
       return cut_along(model, state, surface, settings, nullptr, &front, nullptr,
                        recent ? &*recent : nullptr);
@@ -2275,6 +2440,111 @@ CutResult cut_stroke_so_far(const SimModel& model, const SimState& state, BladeS
   CutResult cut = cut_tissue(model, state, stroke, settings);
   stroke.settled_instants = stroke.edges_m.size();
   return cut;
+}
+
+CutResult part_strands(const SimModel& model, const SimState& state, const BladeStroke& stroke,
+                       const CuttingSettings& settings) {
+  if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
+  if (stroke.edges_m.size() < 2) return {};
+  const std::vector<EdgePoints> edges =
+      cutting_edges(model, state.position_m, stroke, settings.groove_guide_m);
+  const std::vector<EntrySlit> slits = entry_slits(stroke.edges_m, settings.blade_width_m);
+  const SweepSurface surface = sweep_surface(edges, stroke.edges_m, slits);
+  if (surface.size() == 0) return {};
+  Aabb sweep_box;
+  for (const Aabb& box : surface.box) sweep_box.grow(box);
+  // The elements the sweep touches, on its two sides (by their centroids).
+  const std::size_t tets = model.tet_count;
+  std::vector<std::int8_t> side(tets, 0);
+  bool plus = false, minus = false;
+  for (std::size_t e = 0; e < tets; ++e) {
+    const auto p = corners_at(model, state.position_m, e);
+    Aabb box;
+    for (const auto& q : p) box.grow(q);
+    if (!box.overlaps(sweep_box) || !tet_touches_sweep(p, box, surface)) continue;
+    const Eigen::Vector3d centroid = 0.25 * (p[0] + p[1] + p[2] + p[3]);
+    side[e] = surface.side_distance_m(centroid) >= 0.0 ? 1 : -1;
+    (side[e] > 0 ? plus : minus) = true;
+  }
+  if (!plus || !minus) return {};
+  // A maximum flow of unit capacity per face from one side to the other, given up past
+  // kStrandFaces: flow[4e + f] is what leaves element e through its face f.
+  FaceNeighbours neighbours(model);
+  std::vector<std::int8_t> flow(4 * tets, 0);
+  std::vector<std::int64_t> reached_by(tets, -1);  // 4e + f of the face it was reached through
+  std::vector<std::uint8_t> reached(tets, 0);
+  std::vector<std::size_t> queue;
+  auto face_into = [&](std::size_t e, int f, std::size_t other) {
+    const FaceKey key = face_key(model, e, f);
+    for (int g = 0; g < 4; ++g)
+      if (face_key(model, other, g) == key) return g;
+    return -1;
+  };
+  int strand_faces = 0;
+  for (;;) {
+    std::fill(reached.begin(), reached.end(), 0);
+    queue.clear();
+    for (std::size_t e = 0; e < tets; ++e)
+      if (side[e] > 0) {
+        reached[e] = 1;
+        reached_by[e] = -1;
+        queue.push_back(e);
+      }
+    std::optional<std::size_t> sink;
+    for (std::size_t h = 0; h < queue.size() && !sink; ++h) {
+      const std::size_t a = queue[h];
+      for (int f = 0; f < 4; ++f) {
+        const auto b = neighbours(a, f);
+        if (!b || reached[*b] || flow[4 * a + f] >= 1) continue;
+        reached[*b] = 1;
+        reached_by[*b] = static_cast<std::int64_t>(4 * a + f);
+        if (side[*b] < 0) {
+          sink = *b;
+          break;
+        }
+        queue.push_back(*b);
+      }
+    }
+    if (!sink) break;
+    if (++strand_faces > kStrandFaces) return {};
+    for (std::size_t b = *sink; reached_by[b] >= 0;) {
+      const std::size_t a = static_cast<std::size_t>(reached_by[b] / 4);
+      const int f = static_cast<int>(reached_by[b] % 4);
+      ++flow[4 * a + f];
+      --flow[4 * b + face_into(a, f, b)];
+      b = a;
+    }
+  }
+  if (strand_faces == 0) return {};  // the sides are apart already
+  // The strand: the faces from what the last search reached to the rest, each reached by the
+  // sweep; the piece it frees, the side that holds no fixed node.
+  double reached_m3 = 0.0, rest_m3 = 0.0;
+  bool reached_fixed = false, rest_fixed = false;
+  for (std::size_t e = 0; e < tets; ++e) {
+    bool holds_fixed = false;
+    for (int c = 0; c < 4; ++c) holds_fixed |= model.is_fixed[model.corner[c][e]] != 0;
+    (reached[e] ? reached_m3 : rest_m3) += model.rest_volume_m3[e];
+    (reached[e] ? reached_fixed : rest_fixed) |= holds_fixed;
+  }
+  const bool frees_reached = !reached_fixed && (rest_fixed || reached_m3 <= rest_m3);
+  if (!frees_reached && rest_fixed) return {};
+  if ((frees_reached ? reached_m3 : rest_m3) < settings.min_free_body_volume_m3) return {};
+  std::vector<FaceKey> strand;
+  for (std::size_t a = 0; a < tets; ++a) {
+    if (!reached[a]) continue;
+    for (int f = 0; f < 4; ++f) {
+      const auto b = neighbours(a, f);
+      if (!b || reached[*b]) continue;
+      if (side[a] == 0 && side[*b] == 0) return {};  // tissue the blade did not pass
+      strand.push_back(face_key(model, a, f));
+    }
+  }
+  std::sort(strand.begin(), strand.end());
+  // Parted at a node of the organ's surface, a strand may leave the node pinched on the piece
+  // (its surface and the strand's faces meet there at a point): the piece is free all the same.
+  return separate_faces(model, state, neighbours, geometry_as_is(model, state),
+                        std::vector<std::uint8_t>(model.node_count, 0), std::move(strand), settings,
+                        nullptr, CutReport{}, nullptr, nullptr, true);
 }
 
 std::vector<std::uint8_t> organ_elements(const SimModel& model) {

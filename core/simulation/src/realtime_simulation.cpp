@@ -191,10 +191,15 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   const auto& last = hand.stroke.edges_m.back();
   if ((edge[0] - last[0]).norm() < kStrokeInstantM && (edge[1] - last[1]).norm() < kStrokeInstantM)
     return;
-  // Drawn out of the tissue, the blade has to break in again.
-  if (!in.within_reach) return hand.end_stroke();
+  // Drawn out of the tissue, the blade has to break in again; a piece the stroke left hanging by a
+  // strand is parted from it (part_strands).
+  if (!in.within_reach) {
+    part_strands_of(hand);
+    return hand.end_stroke();
+  }
   // Disarmed, the blade passes on without cutting; armed again, the stroke goes on from here.
   if (!scalpel.blade_armed) {
+    part_strands_of(hand);
     hand.stroke.restart(edge);
     return;
   }
@@ -211,7 +216,17 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   // the shipped meshes (elements 10–14 mm across).
   propagating.refine_edge_m = kBladeRefineEdgeM;
   // Each instant follows the groove it is in as the tissue is now (CuttingSettings).
-  CutResult cut = cut_stroke_so_far(*model_, state_, hand.stroke, propagating);
+  swap_in_cut(hand, cut_stroke_so_far(*model_, state_, hand.stroke, propagating), update_start);
+}
+
+void RealtimeSimulation::part_strands_of(HandInLoop& hand) {
+  if (hand.stroke.edges_m.size() < 2) return;
+  const auto update_start = std::chrono::steady_clock::now();
+  swap_in_cut(hand, part_strands(*model_, state_, hand.stroke, *cutting_), update_start);
+}
+
+void RealtimeSimulation::swap_in_cut(const HandInLoop& hand, CutResult cut,
+                                     std::chrono::steady_clock::time_point update_start) {
   const auto trace_cut = [&](bool parted) {
     if (!trace_) return;
     LoopRecord record;
