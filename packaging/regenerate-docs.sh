@@ -444,9 +444,11 @@ step_cutting-live() {
   ((!quick)) || tets=1500
   run "$cli" bench-cut --live --trajectory tests/data/trajectories/free-practice-three-strokes.txt \
     --tets "$tets" --output-dir "$out"
-  # The shipped wedge resection (its own liver), as a section of the same page.
+  # The shipped wedge resection (its own liver) with both hands, the scripted resection that
+  # frees the tumour (issue 42), as a section of the same page.
   ((listing)) || mkdir -p "$w/wedge"
-  run "$cli" bench-cut --live --trajectory tests/data/trajectories/wedge-resection-too-close.txt \
+  run "$cli" bench-cut --live --trajectory tests/data/trajectories/wedge-resection-right-hand.txt \
+    --left-trajectory tests/data/trajectories/wedge-resection-left-hand.txt --left-tool forceps \
     --scenario scenarios/wedge-resection-peripheral-tumour.json --output-dir "$w/wedge"
   doing || return 0
   python3 - "$out/cutting-live.md" "$w/wedge/cutting-live.md" "${commands[1]}" <<'PYTHON'
@@ -458,7 +460,7 @@ body = [l for l in body[1:] if not l.startswith("Written by `")]
 while body and not body[0].strip():
     body.pop(0)
 text = open(page, encoding="utf-8").read().rstrip("\n")
-text += "\n\n## The shipped wedge resection\n\nThis section: `" + command + "`.\n\n"
+text += "\n\n## The shipped wedge resection, both hands\n\nThis section: `" + command + "`.\n\n"
 text += "\n".join(body).rstrip("\n") + "\n"
 open(page, "w", encoding="utf-8").write(text)
 PYTHON

@@ -208,6 +208,56 @@ TEST(CliResection, TheWedgeResectionCutTooCloseBreachesTheTumourAndFails) {
   EXPECT_EQ(failed, 2);
 }
 
+// The shipped wedge resection done as the scenario asks (issue 42, item 6), its lesion where the
+// scenario puts it: the forceps in the left hand hold the lobe tip while the scalpel in the right
+// cuts around the tumour in five passes, then lift the specimen out of the field. The session is
+// complete, the specimen is taken out and holds the tumour whole with a margin at or above the
+// scenario's (R0), nothing breached it, and every criterion of the scenario's rubric passes.
+TEST(CliResection, TheScriptedWedgeResectionLiftsOutTheTumourWithItsMargin) {
+  const fs::path folder = fresh_folder("resection");
+  const fs::path database = folder / "sessions.sqlite";
+  const fs::path root = fs::path(LIVERSIM_TEST_DATA_DIR) / ".." / "..";
+  const fs::path trajectories = fs::path(LIVERSIM_TEST_DATA_DIR) / "trajectories";
+  const pid_t cli =
+      spawn({LIVERSIM_CLI, "record", "--paced", "--scenario",
+             (root / "scenarios" / "wedge-resection-peripheral-tumour.json").string(),
+             "--trajectory", (trajectories / "wedge-resection-right-hand.txt").string(),
+             "--left-trajectory", (trajectories / "wedge-resection-left-hand.txt").string(),
+             "--left-tool", "forceps", "--database", database.string()},
+            folder);
+  ASSERT_GT(cli, 0);
+  ASSERT_EQ(wait_for(cli), 0) << read_text(folder / "stderr.txt");
+  SqliteSessionStore store(database, SqliteSessionStore::Access::read_only);
+  const SessionSummary summary = store.sessions().at(0);
+  EXPECT_EQ(summary.status, SessionStatus::complete);
+  const std::int64_t session = summary.id;
+  auto metric = [&](const std::string& name) -> std::optional<double> {
+    for (const MetricValue& m : store.metrics(session))
+      if (m.name == name) return m.value;
+    return std::nullopt;
+  };
+  const ScenarioReading scenario = read_scenario(store.scenario_text(session));
+  ASSERT_TRUE(scenario.scenario);
+  const double margin_mm = scenario.scenario->task.margin_mm;
+  ASSERT_GT(margin_mm, 0.0);
+  EXPECT_EQ(metric("lesion_breached"), 0.0);
+  EXPECT_EQ(metric("specimen_contains_lesion"), 1.0);
+  EXPECT_EQ(metric("specimen_r0"), 1.0);
+  ASSERT_TRUE(metric("specimen_margin_mm").has_value());
+  EXPECT_GE(*metric("specimen_margin_mm"), margin_mm);
+  EXPECT_EQ(metric("task_success"), 1.0);
+  int removed = 0;
+  for (const SessionEvent& event : store.events(session)) {
+    EXPECT_NE(event.kind, SessionEventKind::lesion_breach);
+    removed += event.kind == SessionEventKind::specimen_removed;
+  }
+  EXPECT_EQ(removed, 1) << "the specimen was not lifted out of the field";
+  const RubricResult graded =
+      grade_against_rubric(scenario.scenario->rubric, store.metrics(session));
+  for (const CriterionResult& criterion : graded.criteria)
+    EXPECT_TRUE(criterion.passed) << criterion.criterion.metric;
+}
+
 TEST(CliRecordCrash, KilledMidSessionItLosesNothingCommittedAndTheNextRunRecovers) {
   const fs::path folder = fresh_folder("killed");
   const fs::path database = folder / "sessions.sqlite";
