@@ -708,8 +708,8 @@ TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
   settings = {};
   settings.snap_min_shape_fraction = std::nan("");
   EXPECT_TRUE(validate(settings).has_value());
-  // The refinement, the height floor, the mass budget, the groove guide, the hole angle and the
-  // blade's width, each by its name.
+  // The refinement, the height floor, the mass budget, the groove guide and the hole angle, each
+  // by its name.
   const std::pair<double CuttingSettings::*, std::vector<double>> bad[] = {
       {&CuttingSettings::refine_edge_m, {-0.001, std::nan(""), INFINITY}},
       {&CuttingSettings::refine_over_stroke_m, {-0.001, std::nan(""), -INFINITY}},
@@ -717,11 +717,10 @@ TEST(Cutting, BadStrokesAndSettingsAreRefusedByName) {
       {&CuttingSettings::max_added_mass_fraction, {-0.001, 0.5, std::nan("")}},
       {&CuttingSettings::min_free_body_volume_m3, {-1e-6, -INFINITY, std::nan("")}},
       {&CuttingSettings::groove_guide_m, {-0.001, std::nan(""), INFINITY}},
-      {&CuttingSettings::hole_angle_deg, {-1.0, 46.0, std::nan("")}},
-      {&CuttingSettings::blade_width_m, {-0.001, 0.03, std::nan(""), INFINITY}}};
+      {&CuttingSettings::hole_angle_deg, {-1.0, 46.0, std::nan("")}}};
   const char* names[] = {"refinement edge",     "refinement stretch", "smallest part height",
                          "added mass fraction", "smallest free body", "groove guide",
-                         "hole angle",          "blade width"};
+                         "hole angle"};
   for (std::size_t k = 0; k < std::size(bad); ++k)
     for (double value : bad[k].second) {
       settings = {};
@@ -997,17 +996,15 @@ CutResult cut_as_the_loop_does(const SimModel& model, const SimState& state,
 // Passes drawn apart from one entry free what they enclose (issue 42: after the four passes of a
 // wedge resection, all entering at one place, the lobe stayed joined at their seam in 2 runs of 5,
 // once by a single face left in the cut). Two strokes start at one line across a jittered block (y
-// = 2.87 cm) and are drawn apart, each cut as the loop cuts it: together they sweep the whole
-// plane z = 2.35 cm, but each alone enters the elements at the seam without passing through them.
-// Two rules part the seam, each enough here: the blade's width (CuttingSettings::blade_width_m:
-// where a stroke starts to draw, its sweep starts that far back, so the passes overlap there) and
-// the holes in the cut (CuttingSettings::hole_angle_deg: a face left in the cut's surface with its
-// three nodes on the cut is parted with it). With neither the top stays on the block; with either,
-// and with both (the default), it comes free, a sound manifold piece of what lies above the plane
-// (to within the cut's jag of one element).
+// = 2.13 cm) and are drawn apart, each cut as the loop cuts it and ended as the loop ends it
+// (part_remnants): together they sweep the whole plane z = 2.48 cm, but each alone enters the
+// elements at the seam without passing through them. With holes in the cut left joined
+// (CuttingSettings::hole_angle_deg 0) the top stays on the block; with them parted at each
+// stroke's end it comes free, a sound manifold piece of what lies above the plane (to within the
+// cut's jag of one element).
 TEST(Cutting, PassesDrawnApartFromOneEntryFreeWhatTheyEncloseTogether) {
   const SimModel model = block_model(0.15);
-  const double z = 0.0235, entry_y = 0.0287;
+  const double z = 0.0248, entry_y = 0.0213;
   // The edge across the block from the entry, drawn `to_y` (an instant every 0.5 mm, as the loop).
   auto drawn = [&](double to_y) {
     BladeStroke stroke;
@@ -1018,49 +1015,47 @@ TEST(Cutting, PassesDrawnApartFromOneEntryFreeWhatTheyEncloseTogether) {
     }
     return stroke;
   };
-  auto apart = [&](double blade_width_m, double hole_angle_deg) {
+  // The stroke cut as the loop cuts it, then what it left parted as the loop does at its end.
+  auto stroke_and_end = [&](const SimModel& on, const SimState& state, const BladeStroke& stroke,
+                            const CuttingSettings& settings) {
+    CutResult cut = cut_as_the_loop_does(on, state, stroke, settings);
+    if (!cut.cut()) return cut;
+    CutResult remnants = part_remnants(*cut.model, cut.state, stroke, settings);
+    return remnants.cut() ? remnants : cut;
+  };
+  auto apart = [&](double hole_angle_deg) {
     CuttingSettings settings = cut_anything();
     settings.refine_edge_m = 0.008;
-    settings.blade_width_m = blade_width_m;
     settings.hole_angle_deg = hole_angle_deg;
-    const CutResult first =
-        cut_as_the_loop_does(model, make_rest_state(model), drawn(-0.01), settings);
+    const CutResult first = stroke_and_end(model, make_rest_state(model), drawn(-0.01), settings);
     EXPECT_TRUE(first.cut());
     if (!first.cut()) return first;
-    CutResult second = cut_as_the_loop_does(*first.model, first.state, drawn(0.06), settings);
+    CutResult second = stroke_and_end(*first.model, first.state, drawn(0.06), settings);
     return second.cut() ? second : first;
   };
-  const CuttingSettings defaults;
-  ASSERT_EQ(defaults.blade_width_m, 0.005);
-  ASSERT_EQ(defaults.hole_angle_deg, 20.0);
-  const CutResult joined = apart(0.0, 0.0);
+  ASSERT_EQ(CuttingSettings{}.hole_angle_deg, 20.0);
+  const CutResult joined = apart(0.0);
   ASSERT_TRUE(joined.cut());
   ASSERT_TRUE(free_bodies(*joined.model).empty())
-      << "the strokes freed the top with neither rule: the test shows nothing";
+      << "the strokes freed the top with holes left joined: the test shows nothing";
+  const CutResult parted = apart(20.0);
+  ASSERT_TRUE(parted.cut());
+  const std::vector<FreeBody> freed = free_bodies(*parted.model);
+  ASSERT_EQ(freed.size(), 1u) << "the seam kept the top joined";
   const double top_m3 = 0.06 * 0.05 * (0.04 - z);
-  for (const auto& [width_m, angle_deg] :
-       {std::pair{0.0, 20.0}, std::pair{0.005, 0.0}, std::pair{0.005, 20.0}}) {
-    SCOPED_TRACE(::testing::Message()
-                 << "blade width " << width_m << " m, hole angle " << angle_deg);
-    const CutResult parted = apart(width_m, angle_deg);
-    ASSERT_TRUE(parted.cut());
-    const std::vector<FreeBody> freed = free_bodies(*parted.model);
-    ASSERT_EQ(freed.size(), 1u) << "the seam kept the top joined";
-    EXPECT_NEAR(freed[0].rest_volume_m3, top_m3, 0.1 * top_m3);
-    EXPECT_TRUE(boundary_is_manifold(*parted.model));
-    EXPECT_TRUE(elements_are_sound(*parted.model, parted.state));
-  }
+  EXPECT_NEAR(freed[0].rest_volume_m3, top_m3, 0.1 * top_m3);
+  EXPECT_TRUE(boundary_is_manifold(*parted.model));
+  EXPECT_TRUE(elements_are_sound(*parted.model, parted.state));
 }
 
-// A piece the strokes leave hanging by a strand is parted at the stroke's end (part_strands;
-// issue 42: a resected lobe stayed on by 1 to 6 faces in some runs). Three strokes in the plane
-// z = 2.53 cm of the block, each across it along y and cut as the loop cuts it: the first with its
-// edge over x < 2.62 cm, the second over x > 3.38 cm, the third over the strip between (inside one
-// column of cubes, it parts nothing itself), stopped short of the block's far side. At 4.3 cm the
-// strip's last 7 mm hold the top by faces the third stroke reached: they are parted and the top
-// comes free, sound and manifold. Stopped at 3.5 cm, the strip's uncut 15 mm lie beyond the
-// stroke's reach: nothing is parted. After the second
-// stroke the whole strip (8 mm by 5 cm) holds the top: more than a strand, nothing is parted.
+// A piece the strokes leave hanging by a strand is parted at the stroke's end (part_remnants;
+// issue 42: a resected lobe stayed on by 1 to 6 faces in some runs). Two strokes in the plane
+// z = 2.53 cm of the block, across it along y and cut as the loop cuts it: the first with its edge
+// over x < 5.3 cm, all the way across, leaves the top on by the 7 mm strip beyond (6 by 0.7 cm:
+// more than a strand, nothing is parted at its end); the second with its edge over x > 5 cm,
+// stopped 7 mm short of the far side, leaves the strip's last corner, which its sweep reached:
+// parted at the stroke's end, and the top comes free, sound and manifold. Stopped 15 mm short, the
+// corner's tissue lies beyond the stroke's reach: nothing is parted.
 TEST(Cutting, APieceHangingByAStrandTheStrokeReachedIsPartedAtItsEnd) {
   const SimModel model = block_model();
   const double z = 0.0253;
@@ -1074,28 +1069,26 @@ TEST(Cutting, APieceHangingByAStrandTheStrokeReachedIsPartedAtItsEnd) {
     return stroke;
   };
   const CuttingSettings settings = cut_anything();
+  const BladeStroke first_stroke = along_y(-0.01, 0.053, 0.06);
   const CutResult first =
-      cut_as_the_loop_does(model, make_rest_state(model), along_y(-0.01, 0.0262, 0.06), settings);
+      cut_as_the_loop_does(model, make_rest_state(model), first_stroke, settings);
   ASSERT_TRUE(first.cut());
-  const BladeStroke second_stroke = along_y(0.0338, 0.07, 0.06);
-  const CutResult second = cut_as_the_loop_does(*first.model, first.state, second_stroke, settings);
-  ASSERT_TRUE(second.cut());
-  ASSERT_TRUE(free_bodies(*second.model).empty());
-  EXPECT_FALSE(part_strands(*second.model, second.state, second_stroke, settings).cut())
-      << "the strip 8 mm wide across the block was parted as a strand";
-  // The third stroke, over the strip (what it cuts, if anything, swapped in), and what is parted
-  // at its end.
-  auto third = [&](double to_y) {
-    const BladeStroke stroke = along_y(0.024, 0.036, to_y);
-    CutResult cut = cut_as_the_loop_does(*second.model, second.state, stroke, settings);
+  ASSERT_TRUE(free_bodies(*first.model).empty());
+  EXPECT_FALSE(part_remnants(*first.model, first.state, first_stroke, settings).cut())
+      << "the strip 7 mm wide along the block was parted as a strand";
+  // The second stroke, short of the far side (what it cuts, if anything, swapped in), and what is
+  // parted at its end.
+  auto second = [&](double to_y) {
+    const BladeStroke stroke = along_y(0.05, 0.07, to_y);
+    CutResult cut = cut_as_the_loop_does(*first.model, first.state, stroke, settings);
     if (!cut.cut()) {
-      cut.model = second.model;
-      cut.state = second.state;
+      cut.model = first.model;
+      cut.state = first.state;
     }
-    EXPECT_TRUE(free_bodies(*cut.model).empty()) << "the third stroke freed the top itself";
-    return part_strands(*cut.model, cut.state, stroke, settings);
+    EXPECT_TRUE(free_bodies(*cut.model).empty()) << "the second stroke freed the top itself";
+    return part_remnants(*cut.model, cut.state, stroke, settings);
   };
-  const CutResult parted = third(0.043);
+  const CutResult parted = second(0.043);
   ASSERT_TRUE(parted.cut()) << "the strand the stroke reached was not parted";
   EXPECT_LE(parted.report.separated_faces, static_cast<std::size_t>(kStrandFaces));
   const std::vector<FreeBody> freed = free_bodies(*parted.model);
@@ -1105,7 +1098,7 @@ TEST(Cutting, APieceHangingByAStrandTheStrokeReachedIsPartedAtItsEnd) {
   EXPECT_NEAR(parted.report.resected_volume_m3, freed[0].rest_volume_m3, 1e-12);
   EXPECT_TRUE(boundary_is_manifold(*parted.model));
   EXPECT_TRUE(elements_are_sound(*parted.model, parted.state));
-  EXPECT_FALSE(third(0.035).cut()) << "tissue beyond the stroke's reach was parted";
+  EXPECT_FALSE(second(0.035).cut()) << "tissue beyond the stroke's reach was parted";
 }
 
 // Refinement serves a stroke's first stretch only (CuttingSettings::refine_over_stroke_m; issue
@@ -1189,16 +1182,13 @@ TEST(Cutting, AStrokeDoesNotRefineOnceTheCutsHaveAddedHalfTheMassTheyMay) {
 // and 3 cm tall, its edges inside cubes, opens a crack inside it. The nodes of the grid plane
 // x = 0.03 it crosses (y = 0.01 … 0.04, z = 0.01 … 0.03) snap onto it; the two off the crack's
 // front (z = 0.02, y = 0.02 and 0.03) get a copy each. Nothing comes free, and the organ's
-// surface is untouched. (An edge of no width: a blade 5 mm wide starting 5 mm inside would have its
-// back at the block's face, CuttingSettings::blade_width_m.)
+// surface is untouched.
 TEST(Cutting, ABladeUnderTheSurfaceOpensACrackInside) {
   const SimModel model = block_model();
   const double x = 0.032;
-  CuttingSettings no_width = cut_anything();
-  no_width.blade_width_m = 0.0;
   const CutResult cut =
       cut_tissue(model, make_rest_state(model),
-                 sweep_of({x, 0.005, 0.035}, {x, 0.005, 0.005}, {0.0, 0.04, 0.0}), no_width);
+                 sweep_of({x, 0.005, 0.035}, {x, 0.005, 0.005}, {0.0, 0.04, 0.0}), cut_anything());
   ASSERT_TRUE(cut.cut()) << "a sweep under the surface cut nothing";
   const SimModel& after = *cut.model;
   EXPECT_EQ(cut.report.removed_elements, 0u);

@@ -56,8 +56,6 @@ std::optional<std::string> validate(const CuttingSettings& settings) {
                         "a value >= 0 (infinity: take every freed piece out)");
   if (!(settings.groove_guide_m >= 0.0) || !std::isfinite(settings.groove_guide_m))
     return out_of_range("groove guide (m)", settings.groove_guide_m, "a finite value >= 0");
-  if (!(settings.blade_width_m >= 0.0 && settings.blade_width_m <= 0.02))
-    return out_of_range("blade width (m)", settings.blade_width_m, "a value in [0, 0.02]");
   if (!(settings.hole_angle_deg >= 0.0 && settings.hole_angle_deg <= 45.0))
     return out_of_range("hole angle (°)", settings.hole_angle_deg, "a value in [0, 45]");
   return std::nullopt;
@@ -254,57 +252,14 @@ struct SweepSurface {
 // groove (bend_onto_grooves).
 using EdgePoints = std::vector<Eigen::Vector3d>;
 
-// The slit a blade makes where it enters and starts to draw (CuttingSettings::blade_width_m): at
-// each instant where the edge, having been still or moving along itself (pressed in), starts to
-// move across itself, the blade's body lies behind its edge, as wide as the blade: the quad from
-// the edge back against the motion by `width_m`, as two triangles, with the instant it belongs to.
-// Without it the edge's sweep starts at the edge's line, and passes drawn apart from one entry (a
-// resection's) each left the elements at their seam entered but not passed through: uncut.
-struct EntrySlit {
-  std::size_t instant;
-  Triangle triangle;
-};
-std::vector<EntrySlit> entry_slits(std::span<const std::array<Eigen::Vector3d, 2>> straight,
-                                   double width_m) {
-  std::vector<EntrySlit> slits;
-  if (!(width_m > 0.0)) return slits;
-  // The edge's travel from instant i to i + 1 across itself, when it moves more across than along.
-  auto across = [&](std::size_t i) -> std::optional<Eigen::Vector3d> {
-    const Eigen::Vector3d along = straight[i][1] - straight[i][0];
-    const Eigen::Vector3d travel =
-        0.5 * ((straight[i + 1][0] + straight[i + 1][1]) - (straight[i][0] + straight[i][1]));
-    if (!(along.norm() > 0.0)) return std::nullopt;
-    const Eigen::Vector3d unit = along.normalized();
-    const Eigen::Vector3d perpendicular = travel - travel.dot(unit) * unit;
-    if (!(perpendicular.norm() > std::abs(travel.dot(unit))) || !(perpendicular.norm() > 0.0))
-      return std::nullopt;
-    return Eigen::Vector3d(perpendicular.normalized());
-  };
-  bool drawing = false;
-  for (std::size_t i = 0; i + 1 < straight.size(); ++i) {
-    const auto direction = across(i);
-    if (direction && !drawing) {
-      const Eigen::Vector3d back = -width_m * *direction;
-      const Eigen::Vector3d &heel = straight[i][0], &tip = straight[i][1];
-      slits.push_back({i, {heel + back, tip + back, tip}});
-      slits.push_back({i, {heel + back, tip, heel}});
-    }
-    drawing = direction.has_value();
-  }
-  return slits;
-}
-
 // The stroke's triangles, oriented alike (a stroke that turns back keeps one side one side);
 // degenerate ones (the blade still, or moving along itself) are left out. Between two instants
 // given by their ends, the triangles (heel_i, tip_i, tip_i+1) and (heel_i, tip_i+1, heel_i+1);
 // between instants bent onto a groove (as many points each), those of each stretch, on the side
 // of the straight ones (a stretch that climbs from a groove to the blade's own plane stands across
 // it, and its own normal says nothing of the stroke's sides).
-// `slits`: the entry slits of the whole stroke, of which those of instants `first_instant` on are
-// added (the sweep of the instants from there).
 SweepSurface sweep_surface(const std::vector<EdgePoints>& edges,
-                           std::span<const std::array<Eigen::Vector3d, 2>> straight,
-                           std::span<const EntrySlit> slits = {}, std::size_t first_instant = 0) {
+                           std::span<const std::array<Eigen::Vector3d, 2>> straight) {
   SweepSurface surface;
   double extent = 0.0;
   auto normal_of = [](const Triangle& tri, double& longest) -> std::optional<Eigen::Vector3d> {
@@ -377,8 +332,6 @@ SweepSurface sweep_surface(const std::vector<EdgePoints>& edges,
       add({a, b1, b}, &*side);
     }
   }
-  for (const EntrySlit& slit : slits)
-    if (slit.instant >= first_instant) add(slit.triangle, nullptr);
   surface.tolerance_m = 1e-9 * extent;
   for (const Triangle& tri : surface.triangle) {
     Aabb box;
@@ -1923,7 +1876,6 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
     }
   }
   std::sort(separated.begin(), separated.end());
-  add_holes_in_the_cut(model, geometry.rest_m, neighbours, settings.hole_angle_deg, separated);
   if (separated.empty()) return result;
   std::vector<std::uint8_t> thinner;
   CutResult cut =
@@ -1940,7 +1892,7 @@ CutResult cut_along(const SimModel& model, const SimState& state, const SweepSur
 // those of them a merge took and their neighbours split down to half the height floor: then
 // `rerun_thinner` is set to them and what is returned is to be dropped. `keep_pinched`: a node the
 // faces pinch (its copy's surface not one fan) stays so, instead of the faces around it joining
-// again (part_strands).
+// again (part_remnants).
 CutResult separate_faces(const SimModel& model, const SimState& state, FaceNeighbours& neighbours,
                          Geometry geometry, const std::vector<std::uint8_t>& snapped,
                          std::vector<FaceKey> separated, const CuttingSettings& settings,
@@ -2408,8 +2360,7 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
       if (!point.allFinite()) throw std::invalid_argument("the blade's stroke is not finite");
   const std::vector<EdgePoints> edges =
       cutting_edges(model, state.position_m, stroke, settings.groove_guide_m);
-  const std::vector<EntrySlit> slits = entry_slits(stroke.edges_m, settings.blade_width_m);
-  const SweepSurface surface = sweep_surface(edges, stroke.edges_m, slits);
+  const SweepSurface surface = sweep_surface(edges, stroke.edges_m);
   if (surface.size() == 0) return {};
   std::optional<SweepSurface> recent;
   if (stroke.settled_instants > 0) {
@@ -2419,13 +2370,12 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
             : 0;
     if (from > 0)
       recent = sweep_surface(std::vector<EdgePoints>(edges.begin() + from, edges.end()),
-                             std::span(stroke.edges_m).subspan(from), slits, from);
+                             std::span(stroke.edges_m).subspan(from));
   }
   if (settings.refine_edge_m > 0.0 && edges.size() >= 2 &&
       refines_at(model, stroke.edges_m, settings)) {
-    const SweepSurface front =
-        sweep_surface(std::vector<EdgePoints>(edges.end() - 2, edges.end()),
-                      std::span(stroke.edges_m).last(2), slits, edges.size() - 2);
+    const SweepSurface front = sweep_surface(std::vector<EdgePoints>(edges.end() - 2, edges.end()),
+                                             std::span(stroke.edges_m).last(2));
     if (front.size() > 0)
       return cut_along(model, state, surface, settings, nullptr, &front, nullptr,
                        recent ? &*recent : nullptr);
@@ -2442,14 +2392,13 @@ CutResult cut_stroke_so_far(const SimModel& model, const SimState& state, BladeS
   return cut;
 }
 
-CutResult part_strands(const SimModel& model, const SimState& state, const BladeStroke& stroke,
-                       const CuttingSettings& settings) {
-  if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
+std::vector<FaceKey> strand_of(const SimModel& model, const SimState& state,
+                               const BladeStroke& stroke, const CuttingSettings& settings,
+                               FaceNeighbours& neighbours) {
   if (stroke.edges_m.size() < 2) return {};
   const std::vector<EdgePoints> edges =
       cutting_edges(model, state.position_m, stroke, settings.groove_guide_m);
-  const std::vector<EntrySlit> slits = entry_slits(stroke.edges_m, settings.blade_width_m);
-  const SweepSurface surface = sweep_surface(edges, stroke.edges_m, slits);
+  const SweepSurface surface = sweep_surface(edges, stroke.edges_m);
   if (surface.size() == 0) return {};
   Aabb sweep_box;
   for (const Aabb& box : surface.box) sweep_box.grow(box);
@@ -2469,7 +2418,6 @@ CutResult part_strands(const SimModel& model, const SimState& state, const Blade
   if (!plus || !minus) return {};
   // A maximum flow of unit capacity per face from one side to the other, given up past
   // kStrandFaces: flow[4e + f] is what leaves element e through its face f.
-  FaceNeighbours neighbours(model);
   std::vector<std::int8_t> flow(4 * tets, 0);
   std::vector<std::int64_t> reached_by(tets, -1);  // 4e + f of the face it was reached through
   std::vector<std::uint8_t> reached(tets, 0);
@@ -2539,10 +2487,21 @@ CutResult part_strands(const SimModel& model, const SimState& state, const Blade
       strand.push_back(face_key(model, a, f));
     }
   }
+  return strand;
+}
+
+CutResult part_remnants(const SimModel& model, const SimState& state, const BladeStroke& stroke,
+                        const CuttingSettings& settings) {
+  if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
+  FaceNeighbours neighbours(model);
+  std::vector<FaceKey> strand = strand_of(model, state, stroke, settings, neighbours);
   std::sort(strand.begin(), strand.end());
+  const Geometry as_is = geometry_as_is(model, state);
+  add_holes_in_the_cut(model, as_is.rest_m, neighbours, settings.hole_angle_deg, strand);
+  if (strand.empty()) return {};
   // Parted at a node of the organ's surface, a strand may leave the node pinched on the piece
   // (its surface and the strand's faces meet there at a point): the piece is free all the same.
-  return separate_faces(model, state, neighbours, geometry_as_is(model, state),
+  return separate_faces(model, state, neighbours, as_is,
                         std::vector<std::uint8_t>(model.node_count, 0), std::move(strand), settings,
                         nullptr, CutReport{}, nullptr, nullptr, true);
 }

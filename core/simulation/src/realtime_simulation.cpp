@@ -191,15 +191,15 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   const auto& last = hand.stroke.edges_m.back();
   if ((edge[0] - last[0]).norm() < kStrokeInstantM && (edge[1] - last[1]).norm() < kStrokeInstantM)
     return;
-  // Drawn out of the tissue, the blade has to break in again; a piece the stroke left hanging by a
-  // strand is parted from it (part_strands).
+  // Drawn out of the tissue, the blade has to break in again; the holes and strands the stroke's
+  // cut left are parted (part_remnants).
   if (!in.within_reach) {
-    part_strands_of(hand);
+    part_remnants_of(hand);
     return hand.end_stroke();
   }
   // Disarmed, the blade passes on without cutting; armed again, the stroke goes on from here.
   if (!scalpel.blade_armed) {
-    part_strands_of(hand);
+    part_remnants_of(hand);
     hand.stroke.restart(edge);
     return;
   }
@@ -219,10 +219,10 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   swap_in_cut(hand, cut_stroke_so_far(*model_, state_, hand.stroke, propagating), update_start);
 }
 
-void RealtimeSimulation::part_strands_of(HandInLoop& hand) {
+void RealtimeSimulation::part_remnants_of(HandInLoop& hand) {
   if (hand.stroke.edges_m.size() < 2) return;
   const auto update_start = std::chrono::steady_clock::now();
-  swap_in_cut(hand, part_strands(*model_, state_, hand.stroke, *cutting_), update_start);
+  swap_in_cut(hand, part_remnants(*model_, state_, hand.stroke, *cutting_), update_start);
 }
 
 void RealtimeSimulation::swap_in_cut(const HandInLoop& hand, CutResult cut,

@@ -93,14 +93,10 @@ struct CuttingSettings {
   double groove_guide_m = 0.004;
   // An interior face whose three nodes lie on cut faces and that lies in the cut's surface (within
   // this angle of parallel to a cut face at each of its nodes) is a hole in the cut: it is parted
-  // with it (0: holes stay joined). Where a resection's passes met end to end, neither passed all
-  // the way through the elements at the seam, and a 56 cm³ lobe hung by one such face (issue 42).
+  // at the stroke's end (part_remnants; 0: holes stay joined). Where a resection's passes met end
+  // to end, neither passed all the way through the elements at the seam, and a 56 cm³ lobe hung by
+  // one such face (issue 42).
   double hole_angle_deg = 20.0;
-  // The blade's width, edge to back (0: a blade of no width). Where the edge starts to move across
-  // itself (drawn after being pressed in, or from where it broke in), the blade's body lies behind
-  // it and has parted that much tissue: the stroke's sweep starts that far back. Passes drawn apart
-  // from one entry then overlap at their seam, which each alone entered without passing through.
-  double blade_width_m = 0.005;
 };
 
 // The share of CuttingSettings::max_added_mass_fraction past which a stroke no longer refines.
@@ -215,18 +211,22 @@ struct CutResult {
 CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeStroke& stroke,
                      const CuttingSettings& settings);
 
-// At a stroke's end (the blade drawn out, or disarmed in the tissue): a piece the stroke leaves
-// joined to the organ only through a strand of at most kStrandFaces faces, each of which the
-// stroke's sweep reached (one of its two elements touches it), is parted along that strand. The
-// strand is the smallest set of faces between the tissue on the sweep's two sides (a maximum flow
-// over the elements' faces from the elements touching it on one side to those on the other); the
-// piece it frees holds no fixed node and is at least CuttingSettings::min_free_body_volume_m3. A
-// cut is exact to within about an element: the elements it leaves whole on one side (none of their
-// crossings could be snapped or split) and the seams where passes met kept a resected lobe on by 1
-// to 6 faces in some runs (issue 42). Nothing: no such strand.
+// At a stroke's end (the blade drawn out, or disarmed in the tissue), what its cut left joined
+// within the cut's resolution (about an element) is parted:
+// - holes in the cut (CuttingSettings::hole_angle_deg): interior faces lying in the cut's surface
+//   with their three nodes on it;
+// - a strand: a piece the stroke leaves joined to the organ only through at most kStrandFaces
+//   faces, each of which the stroke's sweep reached (one of its two elements touches it). The
+//   strand is the smallest set of faces between the tissue on the sweep's two sides (a maximum
+//   flow over the elements' faces from the elements touching it on one side to those on the
+//   other); the piece it frees holds no fixed node and is at least
+//   CuttingSettings::min_free_body_volume_m3.
+// Where a resection's passes met, and around an element the cut left whole on one side (none of
+// its crossings could be snapped or split), a resected lobe stayed on by 1 to 6 faces in some runs
+// (issue 42). Nothing: nothing to part.
 inline constexpr int kStrandFaces = 8;
-CutResult part_strands(const SimModel& model, const SimState& state, const BladeStroke& stroke,
-                       const CuttingSettings& settings);
+CutResult part_remnants(const SimModel& model, const SimState& state, const BladeStroke& stroke,
+                        const CuttingSettings& settings);
 
 // An update of a stroke as the blade goes on: its instants not yet bent are bent onto the cuts
 // they run beside in the tissue as it is now (CuttingSettings::groove_guide_m), the stroke so far

@@ -395,8 +395,8 @@ class RealtimeSimulation {
   IntegratorKind integrator_kind_;  // the model's, fixed: stats() reads it from any thread
   // Extends the hand's stroke with its scalpel's edge, cuts, and swaps in the cut model and state.
   void cut_with_scalpel(HandInLoop& hand);
-  // At the end of the hand's stroke: what it left hanging by a strand is parted (part_strands).
-  void part_strands_of(HandInLoop& hand);
+  // At the end of the hand's stroke: the holes and strands its cut left are parted (part_remnants).
+  void part_remnants_of(HandInLoop& hand);
   // A cut of the hand's scalpel swapped in (when it cut), and traced with the update's time.
   void swap_in_cut(const HandInLoop& hand, CutResult cut,
                    std::chrono::steady_clock::time_point update_start);
