@@ -9,6 +9,7 @@
 #include "liversim/engine/state.h"
 #include "liversim/engine/surface.h"
 #include "liversim/haptics/haptics.h"
+#include "liversim/haptics/spsc_ring.h"
 #include "liversim/interaction/cutting.h"
 #include "liversim/meshing/default_scene.h"
 #include "liversim/meshing/liver_geometry.h"
@@ -485,6 +486,84 @@ TEST(BladeEntry, PutBackIntoItsOwnCutTheBladeIsInAtOnce) {
   // in its groove it is in at the first touch of a cut face.
   EXPECT_GT(uncut.force_before_n, 0.1);
   EXPECT_LT(groove.force_before_n, 0.1 * uncut.force_before_n);
+}
+
+// A blade let go in the tissue ends its stroke as one disarmed there does (issue 42: the mouse's
+// release takes the scalpel away, and what its stroke left, holes in the cut and strands, stayed
+// joined). The upright blade, its tip 15 mm under the top of a jittered block, drawn 3 cm along x
+// at 1 cm/s; then either disarmed and lifted out or taken away, and a few cycles on. Both end with
+// the stroke's pass over what it left (a cut record in the loop's trace at the stroke's end; let
+// go, there was none) and the same block, cut alike. (This stroke leaves nothing to part; what the
+// pass parts is tested in Cutting.PassesDrawnApartFromOneEntry* and
+// Cutting.APieceHangingByAStrand*.)
+TEST(BladeLetGo, TakenAwayInTheTissueTheBladeEndsItsStrokeAsDisarmedAndLifted) {
+  constexpr double kTopM = 0.04;
+  const TetMesh mesh = testing::block_mesh(6, 5, 4, {0.06, 0.05, kTopM}, 0.15);
+  struct Ending {
+    std::shared_ptr<const SimModel> model;
+    std::uint64_t topology_at_end = 0, topology_after = 0;
+    int stroke_end_passes = 0, parted_at_end = 0;
+  };
+  auto stroke_ending = [&](bool let_go) {
+    BlockInTheLoop block = block_in_the_loop(mesh, {400.0});
+    RealtimeSimulation& simulation = *block.simulation;
+    SpscRing<LoopRecord> trace(1 << 12);
+    simulation.trace_loop(&trace);
+    Tool scalpel;
+    scalpel.kind = ToolKind::scalpel;
+    const Eigen::Vector3d start(0.01, 0.025, kTopM - 0.015 + scalpel.geometry.blade_length_m);
+    const int steps =
+        std::max(1, static_cast<int>(std::lround(kCycleS / realtime_step_s(*block.model))));
+    std::vector<SimulationInput> inputs;
+    for (int c = 0; c * kCycleS * 0.01 <= 0.03; ++c) {
+      scalpel.pose.origin_m = start + Eigen::Vector3d(c * kCycleS * 0.01, 0.0, 0.0);
+      add_cycle(inputs, scalpel, steps);
+    }
+    const std::size_t stroke_cycles = inputs.size() / 2;
+    if (let_go) {
+      SimulationInput gone;
+      gone.kind = SimulationInput::Kind::tool;
+      inputs.push_back(gone);
+      for (int c = 0; c < 20; ++c) inputs.push_back({SimulationInput::Kind::cycle, {}, {}, steps});
+    } else {  // disarmed and lifted out, 25 mm in 20 ms
+      scalpel.blade_armed = false;
+      for (int c = 0; c < 20; ++c) {
+        scalpel.pose.origin_m.z() += 0.00125;
+        add_cycle(inputs, scalpel, steps);
+      }
+    }
+    Ending ending;
+    std::size_t cycle = 0;
+    double end_s = 0.0;
+    simulation.replay(inputs, [&](const StepReport&, bool) {
+      if (++cycle == stroke_cycles) {
+        simulation.update_snapshot();
+        ending.topology_at_end = simulation.snapshot().topology_version;
+        end_s = simulation.state().time_s;
+      }
+    });
+    simulation.update_snapshot();
+    ending.topology_after = simulation.snapshot().topology_version;
+    ending.model = simulation.snapshot().model;
+    for (LoopRecord record; trace.pop(record);)
+      if (record.kind == LoopRecord::Kind::cut && record.simulated_s >= end_s) {
+        ++ending.stroke_end_passes;
+        ending.parted_at_end += record.parted;
+      }
+    return ending;
+  };
+  const Ending disarmed = stroke_ending(false), let_go = stroke_ending(true);
+  std::cout << "disarmed: " << disarmed.stroke_end_passes << " pass(es), " << disarmed.parted_at_end
+            << " parted, topology " << disarmed.topology_at_end << " → " << disarmed.topology_after
+            << "; let go: " << let_go.stroke_end_passes << ", " << let_go.parted_at_end << ", "
+            << let_go.topology_at_end << " → " << let_go.topology_after << "\n";
+  ASSERT_GT(disarmed.topology_at_end, 0u) << "the stroke cut nothing";
+  EXPECT_EQ(disarmed.stroke_end_passes, 1);
+  EXPECT_EQ(let_go.stroke_end_passes, 1) << "the blade let go had no stroke end";
+  EXPECT_EQ(let_go.parted_at_end, disarmed.parted_at_end);
+  EXPECT_EQ(let_go.topology_after, disarmed.topology_after);
+  EXPECT_EQ(let_go.model->tet_count, disarmed.model->tet_count);
+  EXPECT_EQ(let_go.model->node_count, disarmed.model->node_count);
 }
 
 }  // namespace

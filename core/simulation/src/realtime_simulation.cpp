@@ -392,6 +392,7 @@ void RealtimeSimulation::resist_cutting(HandInLoop& hand,
 void RealtimeSimulation::HandInLoop::end_stroke() {
   stroke.edges_m.clear();
   blade_in_tissue = false;
+  remnants_due = false;
   cutting_force_n.setZero();
   blade_velocity_m_per_s.setZero();
   blade_time_s = -1.0;
@@ -438,9 +439,25 @@ void RealtimeSimulation::take_tool(Hand which, const std::optional<Tool>& tool) 
 void RealtimeSimulation::change_tool(Hand which, const std::optional<Tool>& tool) {
   HandInLoop& held = hand(which);
   const bool kind_changed = !tool || !held.active_tool || tool->kind != held.active_tool->kind;
+  const bool stroke_ends = kind_changed || tool->kind != ToolKind::scalpel;
   held.active_tool = tool;
   if (!held.active_tool && held.tools) held.tools->release();
-  if (kind_changed || held.active_tool->kind != ToolKind::scalpel) held.end_stroke();
+  if (!stroke_ends) return;
+  // A blade taken away in the tissue (the mouse let go) ends its stroke as drawing it out does,
+  // what the stroke left parted first; not here, where take_inputs may hold the springs' lock,
+  // which a cut's swap takes.
+  if (held.blade_in_tissue && cutting_)
+    held.remnants_due = true;
+  else
+    held.end_stroke();
+}
+
+void RealtimeSimulation::part_remnants_due() {
+  for (HandInLoop& held : hands_)
+    if (held.remnants_due) {
+      part_remnants_of(held);
+      held.end_stroke();
+    }
 }
 
 void RealtimeSimulation::take_inputs() {
@@ -468,6 +485,7 @@ void RealtimeSimulation::take_inputs() {
       }
     }
   }
+  part_remnants_due();
   if (take_out_requested_.exchange(false)) {
     if (logging_inputs_.load(std::memory_order_relaxed))
       log_input({SimulationInput::Kind::take_out_specimens, std::nullopt, {}, 0, false});
@@ -667,11 +685,14 @@ void RealtimeSimulation::log_input(SimulationInput input) {
 void RealtimeSimulation::replay(std::span<const SimulationInput> inputs,
                                 const CycleObserver& each_cycle) {
   if (running()) throw std::logic_error("replay needs the simulation stopped");
+  // The loop parts what a blade taken away left after the tools it takes at once, before anything
+  // else: before the next input that is not a tool, or at the end.
   for (const SimulationInput& input : inputs) switch (input.kind) {
       case SimulationInput::Kind::tool:
         change_tool(input.hand, input.tool);
         break;
       case SimulationInput::Kind::springs:
+        part_remnants_due();
         // A log from another model (or a damaged one) must not index past this one's nodes.
         for (const NodeSpring& spring : input.springs)
           if (spring.node < 0 || static_cast<std::size_t>(spring.node) >= model_->node_count)
@@ -681,9 +702,11 @@ void RealtimeSimulation::replay(std::span<const SimulationInput> inputs,
         active_springs_.assign(input.springs.begin(), input.springs.end());
         break;
       case SimulationInput::Kind::take_out_specimens:
+        part_remnants_due();
         take_out_free_bodies(true);
         break;
       case SimulationInput::Kind::cycle: {
+        part_remnants_due();
         if (halted_.load()) break;
         const std::uint64_t topology_before = topology_version_;
         const GuardedReport guarded = advance_cycle(input.steps, input.check_energy);
@@ -692,6 +715,7 @@ void RealtimeSimulation::replay(std::span<const SimulationInput> inputs,
         break;
       }
     }
+  part_remnants_due();
 }
 
 void RealtimeSimulation::publish_time_to(std::atomic<double>* clock_s) {

@@ -364,6 +364,9 @@ class RealtimeSimulation {
     std::optional<ToolInteraction> tools;       // simulation thread only once started
     BladeStroke stroke;
     bool blade_in_tissue = false;  // the scalpel broke in: its blade passes and cuts
+    // Taken away in the tissue: its stroke's remnants are parted once no lock is held
+    // (part_remnants_due), and then the stroke ends.
+    bool remnants_due = false;
     Eigen::Vector3d cutting_force_n = Eigen::Vector3d::Zero();  // on the blade, while it cuts
     double blade_edge_in_tissue_m = 0.0;  // of the scalpel's edge, after the last cycle
     Eigen::Vector3d blade_velocity_m_per_s = Eigen::Vector3d::Zero();
@@ -397,6 +400,7 @@ class RealtimeSimulation {
   void cut_with_scalpel(HandInLoop& hand);
   // At the end of the hand's stroke: the holes and strands its cut left are parted (part_remnants).
   void part_remnants_of(HandInLoop& hand);
+  void part_remnants_due();
   // A cut of the hand's scalpel swapped in (when it cut), and traced with the update's time.
   void swap_in_cut(const HandInLoop& hand, CutResult cut,
                    std::chrono::steady_clock::time_point update_start);
