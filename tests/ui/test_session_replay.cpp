@@ -12,6 +12,7 @@
 #include "render/liver_scene.h"
 #include "session_replay_window.h"
 #include "session_review_window.h"
+#include "simulated_waits.h"
 #include "tool_panel.h"
 #include "viewport_input.h"
 #include "vtk_viewport.h"
@@ -78,16 +79,13 @@ class SessionReplayWindowTest : public ::testing::Test {
     SceneSetup setup = build_scene(scenario_, QFileInfo(absolute).absolutePath().toStdString());
     window_ = std::make_unique<MainWindow>(std::move(setup),
                                            OpenedScenario{scenario_, absolute.toStdString(), text});
-    window_->show();
-    ASSERT_TRUE(QTest::qWaitForWindowExposed(window_.get()));
-    ASSERT_TRUE(QTest::qWaitFor([&] { return snapshot().time_s > 0.0; }, kTimeoutMs));
+    ASSERT_TRUE(test::showRunning(*window_, window_->simulation(), kTimeoutMs));
   }
   void TearDown() override { window_.reset(); }
 
   const SimulationSnapshot& snapshot() const { return window_->simulation().snapshot(); }
   bool waitSimulated(double seconds) {
-    const double until = snapshot().time_s + seconds;
-    return QTest::qWaitFor([&] { return snapshot().time_s >= until; }, kTimeoutMs);
+    return test::waitSimulated(window_->simulation(), seconds, kTimeoutMs);
   }
   bool waitArrived(SessionReplayWindow& replay) {
     return QTest::qWaitFor([&] { return !replay.seeking(); }, kTimeoutMs);
