@@ -31,6 +31,7 @@
 #include <vtkRenderer.h>
 
 #include <QAction>
+#include <QDir>
 #include <QSettings>
 #include <QSignalSpy>
 #include <QTemporaryDir>
@@ -258,6 +259,11 @@ TEST_F(MouseResectionTest, TheShippedWedgeResectionIsMadeWithTheMouseAndGradedAS
   std::cout << "freed after " << passes_made << " passes (the script makes " << passes.size()
             << ")\n";
   ASSERT_GT(snapshot().free_bodies, 0) << "the passes freed nothing";
+
+  // What the trainee sees then, kept with the test's output.
+  const QString picture = QDir(LIVERSIM_TEST_OUTPUT_DIR).filePath("mouse_resection_freed.png");
+  if (window_->grab().save(picture))
+    std::cout << "the window saved to " << picture.toStdString() << "\n";
 
   QAction* remove = window_->findChild<QAction*>("removeSpecimenAction");
   ASSERT_NE(remove, nullptr);
