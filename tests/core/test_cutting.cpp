@@ -1048,6 +1048,31 @@ TEST(Cutting, PassesDrawnApartFromOneEntryFreeWhatTheyEncloseTogether) {
   EXPECT_TRUE(elements_are_sound(*parted.model, parted.state));
 }
 
+// The plane of the strand tests' strokes, and a stroke in it across the block along y from y = -1
+// cm to `to_y`, its edge over x0 < x < x1 (an instant every 0.5 mm, as the loop takes them).
+constexpr double kStrandPlaneZ = 0.0253;
+BladeStroke stroke_along_y(double x0, double x1, double to_y, double z) {
+  BladeStroke stroke;
+  const int steps = static_cast<int>(std::ceil((to_y + 0.01) / 0.0005));
+  for (int i = 0; i <= steps; ++i) {
+    const double y = -0.01 + (to_y + 0.01) * i / steps;
+    stroke.add({Eigen::Vector3d(x0, y, z), Eigen::Vector3d(x1, y, z)});
+  }
+  return stroke;
+}
+
+// What a strand parted on the block frees: the top above kStrandPlaneZ, one sound, manifold body.
+void expect_the_top_freed_by_a_strand(const CutResult& parted) {
+  EXPECT_LE(parted.report.separated_faces, static_cast<std::size_t>(kStrandFaces));
+  const std::vector<FreeBody> freed = free_bodies(*parted.model);
+  ASSERT_EQ(freed.size(), 1u);
+  const double top_m3 = 0.06 * 0.05 * (0.04 - kStrandPlaneZ);
+  EXPECT_NEAR(freed[0].rest_volume_m3, top_m3, 0.1 * top_m3);
+  EXPECT_NEAR(parted.report.resected_volume_m3, freed[0].rest_volume_m3, 1e-12);
+  EXPECT_TRUE(boundary_is_manifold(*parted.model));
+  EXPECT_TRUE(elements_are_sound(*parted.model, parted.state));
+}
+
 // A piece the strokes leave hanging by a strand is parted at the stroke's end (part_remnants;
 // issue 42: a resected lobe stayed on by 1 to 6 faces in some runs). Two strokes in the plane
 // z = 2.53 cm of the block, across it along y and cut as the loop cuts it: the first with its edge
@@ -1058,16 +1083,8 @@ TEST(Cutting, PassesDrawnApartFromOneEntryFreeWhatTheyEncloseTogether) {
 // corner's tissue lies beyond the stroke's reach: nothing is parted.
 TEST(Cutting, APieceHangingByAStrandTheStrokeReachedIsPartedAtItsEnd) {
   const SimModel model = block_model();
-  const double z = 0.0253;
-  auto along_y = [&](double x0, double x1, double to_y) {
-    BladeStroke stroke;
-    const int steps = static_cast<int>(std::ceil((to_y + 0.01) / 0.0005));
-    for (int i = 0; i <= steps; ++i) {
-      const double y = -0.01 + (to_y + 0.01) * i / steps;
-      stroke.add({Eigen::Vector3d(x0, y, z), Eigen::Vector3d(x1, y, z)});
-    }
-    return stroke;
-  };
+  const double z = kStrandPlaneZ;
+  auto along_y = [&](double x0, double x1, double to_y) { return stroke_along_y(x0, x1, to_y, z); };
   const CuttingSettings settings = cut_anything();
   const BladeStroke first_stroke = along_y(-0.01, 0.053, 0.06);
   const CutResult first =
@@ -1090,15 +1107,60 @@ TEST(Cutting, APieceHangingByAStrandTheStrokeReachedIsPartedAtItsEnd) {
   };
   const CutResult parted = second(0.043);
   ASSERT_TRUE(parted.cut()) << "the strand the stroke reached was not parted";
-  EXPECT_LE(parted.report.separated_faces, static_cast<std::size_t>(kStrandFaces));
-  const std::vector<FreeBody> freed = free_bodies(*parted.model);
-  ASSERT_EQ(freed.size(), 1u);
-  const double top_m3 = 0.06 * 0.05 * (0.04 - z);
-  EXPECT_NEAR(freed[0].rest_volume_m3, top_m3, 0.1 * top_m3);
-  EXPECT_NEAR(parted.report.resected_volume_m3, freed[0].rest_volume_m3, 1e-12);
-  EXPECT_TRUE(boundary_is_manifold(*parted.model));
-  EXPECT_TRUE(elements_are_sound(*parted.model, parted.state));
+  expect_the_top_freed_by_a_strand(parted);
   EXPECT_FALSE(second(0.035).cut()) << "tissue beyond the stroke's reach was parted";
+}
+
+// Where the forceps hold a piece, the piece they hold is the specimen's side: a strand that holds
+// it to the organ near the cut is parted at the stroke's end even where the stroke's sweep did not
+// reach it (part_remnants' `held_nodes`; issue 42: passes a few millimetres apart left remnants
+// inside the organ between them, the minimum cut between the sweep's sides ran through those,
+// and the lobe the forceps held hung by 7 faces). On the block of the test above: the first
+// stroke leaves the top on by the 7 mm strip, the second stops 15 mm short of the far side, its
+// sweep never reaching the strip's last corner. Nothing held, nothing is parted (above); the top
+// held, the corner is parted and the top comes free, sound and manifold. The 6 cm strip the first
+// stroke alone leaves is more than a strand, held or not; held below the cut, the block's own
+// side is not parted off.
+TEST(Cutting, AStrandHoldingWhatTheForcepsHoldIsPartedNearTheCut) {
+  const SimModel model = block_model();
+  const double z = kStrandPlaneZ;
+  auto along_y = [&](double x0, double x1, double to_y) { return stroke_along_y(x0, x1, to_y, z); };
+  // The nodes of the model, at rest, above or below `height_m` (not fixed).
+  auto nodes_of = [](const SimModel& m, auto&& where) {
+    std::vector<NodeIndex> nodes;
+    for (std::size_t n = 0; n < m.node_count; ++n)
+      if (!m.is_fixed[n] && where(m.rest_position_m.at(n).z()))
+        nodes.push_back(static_cast<NodeIndex>(n));
+    return nodes;
+  };
+  auto top_of = [&](const SimModel& m) {
+    return nodes_of(m, [](double height_m) { return height_m > 0.035; });
+  };
+  const CuttingSettings settings = cut_anything();
+  const BladeStroke first_stroke = along_y(-0.01, 0.053, 0.06);
+  const CutResult first =
+      cut_as_the_loop_does(model, make_rest_state(model), first_stroke, settings);
+  ASSERT_TRUE(first.cut());
+  EXPECT_FALSE(
+      part_remnants(*first.model, first.state, first_stroke, settings, top_of(*first.model)).cut())
+      << "the strip 7 mm wide along the block was parted as a strand";
+  const BladeStroke short_stroke = along_y(0.05, 0.07, 0.035);
+  CutResult second = cut_as_the_loop_does(*first.model, first.state, short_stroke, settings);
+  if (!second.cut()) {
+    second.model = first.model;
+    second.state = first.state;
+  }
+  ASSERT_TRUE(free_bodies(*second.model).empty());
+  ASSERT_FALSE(part_remnants(*second.model, second.state, short_stroke, settings).cut())
+      << "parted with nothing held: the test shows nothing";
+  const CutResult below =
+      part_remnants(*second.model, second.state, short_stroke, settings,
+                    nodes_of(*second.model, [](double height_m) { return height_m < 0.015; }));
+  EXPECT_FALSE(below.cut()) << "held below the cut, tissue was parted";
+  const CutResult parted =
+      part_remnants(*second.model, second.state, short_stroke, settings, top_of(*second.model));
+  ASSERT_TRUE(parted.cut()) << "the strand holding what the forceps hold was not parted";
+  expect_the_top_freed_by_a_strand(parted);
 }
 
 // Refinement serves a stroke's first stretch only (CuttingSettings::refine_over_stroke_m; issue

@@ -32,6 +32,7 @@
 
 #include <QAction>
 #include <QDir>
+#include <QFile>
 #include <QSettings>
 #include <QSignalSpy>
 #include <QTemporaryDir>
@@ -82,7 +83,15 @@ class MouseResectionTest : public ::testing::Test {
     window_->resize(1280, 900);
     ASSERT_TRUE(test::showRunning(*window_, window_->simulation(), kTimeoutMs));
   }
-  void TearDown() override { window_.reset(); }
+  // The session is kept with the test's output (mouse_resection_session.sqlite), so that a run
+  // that freed nothing can be replayed and looked into.
+  void TearDown() override {
+    window_.reset();  // ends the session and closes the database
+    const QString kept = QDir(LIVERSIM_TEST_OUTPUT_DIR).filePath("mouse_resection_session.sqlite");
+    QFile::remove(kept);
+    if (QFile::copy(folder_.filePath("sessions.sqlite"), kept))
+      std::cout << "the session kept in " << kept.toStdString() << "\n";
+  }
 
   const SimulationSnapshot& snapshot() const { return window_->simulation().snapshot(); }
   bool waitSimulated(double seconds) {

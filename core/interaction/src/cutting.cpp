@@ -2392,35 +2392,25 @@ CutResult cut_stroke_so_far(const SimModel& model, const SimState& state, BladeS
   return cut;
 }
 
-std::vector<FaceKey> strand_of(const SimModel& model, const SimState& state,
-                               const BladeStroke& stroke, const CuttingSettings& settings,
-                               FaceNeighbours& neighbours) {
-  if (stroke.edges_m.size() < 2) return {};
-  const std::vector<EdgePoints> edges =
-      cutting_edges(model, state.position_m, stroke, settings.groove_guide_m);
-  const SweepSurface surface = sweep_surface(edges, stroke.edges_m);
-  if (surface.size() == 0) return {};
-  Aabb sweep_box;
-  for (const Aabb& box : surface.box) sweep_box.grow(box);
-  // The elements the sweep touches, on its two sides (by their centroids).
+// A maximum flow from the elements `end` marks 1 to those it marks -1 over the elements' faces, one
+// through a face with a `near` element, more than kStrandFaces through any other, given up past
+// kStrandFaces: the elements the last search reached (those on the first ends' side of a minimum
+// cut, which parts near faces only) and the cut's size; none past kStrandFaces. (With one through
+// every face, the cut nearest the first ends was taken, and held by the forceps it ran round the
+// few elements they hold, away from the cut, where the lobe hung by 7 faces near it.)
+struct MinimumCut {
+  std::vector<std::uint8_t> reached;
+  int faces = 0;
+};
+std::optional<MinimumCut> minimum_cut(const SimModel& model, FaceNeighbours& neighbours,
+                                      const std::vector<std::int8_t>& end,
+                                      const std::vector<std::uint8_t>& near) {
   const std::size_t tets = model.tet_count;
-  std::vector<std::int8_t> side(tets, 0);
-  bool plus = false, minus = false;
-  for (std::size_t e = 0; e < tets; ++e) {
-    const auto p = corners_at(model, state.position_m, e);
-    Aabb box;
-    for (const auto& q : p) box.grow(q);
-    if (!box.overlaps(sweep_box) || !tet_touches_sweep(p, box, surface)) continue;
-    const Eigen::Vector3d centroid = 0.25 * (p[0] + p[1] + p[2] + p[3]);
-    side[e] = surface.side_distance_m(centroid) >= 0.0 ? 1 : -1;
-    (side[e] > 0 ? plus : minus) = true;
-  }
-  if (!plus || !minus) return {};
-  // A maximum flow of unit capacity per face from one side to the other, given up past
-  // kStrandFaces: flow[4e + f] is what leaves element e through its face f.
+  // flow[4e + f] is what leaves element e through its face f.
   std::vector<std::int8_t> flow(4 * tets, 0);
   std::vector<std::int64_t> reached_by(tets, -1);  // 4e + f of the face it was reached through
-  std::vector<std::uint8_t> reached(tets, 0);
+  MinimumCut cut;
+  cut.reached.assign(tets, 0);
   std::vector<std::size_t> queue;
   auto face_into = [&](std::size_t e, int f, std::size_t other) {
     const FaceKey key = face_key(model, e, f);
@@ -2428,13 +2418,12 @@ std::vector<FaceKey> strand_of(const SimModel& model, const SimState& state,
       if (face_key(model, other, g) == key) return g;
     return -1;
   };
-  int strand_faces = 0;
   for (;;) {
-    std::fill(reached.begin(), reached.end(), 0);
+    std::fill(cut.reached.begin(), cut.reached.end(), 0);
     queue.clear();
     for (std::size_t e = 0; e < tets; ++e)
-      if (side[e] > 0) {
-        reached[e] = 1;
+      if (end[e] > 0) {
+        cut.reached[e] = 1;
         reached_by[e] = -1;
         queue.push_back(e);
       }
@@ -2443,18 +2432,19 @@ std::vector<FaceKey> strand_of(const SimModel& model, const SimState& state,
       const std::size_t a = queue[h];
       for (int f = 0; f < 4; ++f) {
         const auto b = neighbours(a, f);
-        if (!b || reached[*b] || flow[4 * a + f] >= 1) continue;
-        reached[*b] = 1;
+        if (!b || cut.reached[*b]) continue;
+        if (flow[4 * a + f] >= (near[a] || near[*b] ? 1 : kStrandFaces + 1)) continue;
+        cut.reached[*b] = 1;
         reached_by[*b] = static_cast<std::int64_t>(4 * a + f);
-        if (side[*b] < 0) {
+        if (end[*b] < 0) {
           sink = *b;
           break;
         }
         queue.push_back(*b);
       }
     }
-    if (!sink) break;
-    if (++strand_faces > kStrandFaces) return {};
+    if (!sink) return cut;
+    if (++cut.faces > kStrandFaces) return std::nullopt;
     for (std::size_t b = *sink; reached_by[b] >= 0;) {
       const std::size_t a = static_cast<std::size_t>(reached_by[b] / 4);
       const int f = static_cast<int>(reached_by[b] % 4);
@@ -2463,38 +2453,123 @@ std::vector<FaceKey> strand_of(const SimModel& model, const SimState& state,
       b = a;
     }
   }
-  if (strand_faces == 0) return {};  // the sides are apart already
-  // The strand: the faces from what the last search reached to the rest, each reached by the
-  // sweep; the piece it frees, the side that holds no fixed node.
+}
+
+// The faces a minimum cut parts (from what it reached to the rest) when each of them is `near`
+// (per element: one of its two elements is) and the piece it frees, the side that holds no fixed
+// node, is at least CuttingSettings::min_free_body_volume_m3; otherwise none.
+std::vector<FaceKey> strand_of_cut(const SimModel& model, FaceNeighbours& neighbours,
+                                   const MinimumCut& cut, const std::vector<std::uint8_t>& near,
+                                   const CuttingSettings& settings) {
+  if (cut.faces == 0) return {};  // apart already
+  const std::size_t tets = model.tet_count;
   double reached_m3 = 0.0, rest_m3 = 0.0;
   bool reached_fixed = false, rest_fixed = false;
   for (std::size_t e = 0; e < tets; ++e) {
     bool holds_fixed = false;
     for (int c = 0; c < 4; ++c) holds_fixed |= model.is_fixed[model.corner[c][e]] != 0;
-    (reached[e] ? reached_m3 : rest_m3) += model.rest_volume_m3[e];
-    (reached[e] ? reached_fixed : rest_fixed) |= holds_fixed;
+    (cut.reached[e] ? reached_m3 : rest_m3) += model.rest_volume_m3[e];
+    (cut.reached[e] ? reached_fixed : rest_fixed) |= holds_fixed;
   }
   const bool frees_reached = !reached_fixed && (rest_fixed || reached_m3 <= rest_m3);
   if (!frees_reached && rest_fixed) return {};
   if ((frees_reached ? reached_m3 : rest_m3) < settings.min_free_body_volume_m3) return {};
   std::vector<FaceKey> strand;
   for (std::size_t a = 0; a < tets; ++a) {
-    if (!reached[a]) continue;
+    if (!cut.reached[a]) continue;
     for (int f = 0; f < 4; ++f) {
       const auto b = neighbours(a, f);
-      if (!b || reached[*b]) continue;
-      if (side[a] == 0 && side[*b] == 0) return {};  // tissue the blade did not pass
+      if (!b || cut.reached[*b]) continue;
+      if (!near[a] && !near[*b]) return {};  // tissue away from the cut
       strand.push_back(face_key(model, a, f));
     }
   }
   return strand;
 }
 
+// The elements the stroke's sweep touches, on its two sides (by their centroids): 1 and -1.
+std::vector<std::int8_t> swept_sides(const SimModel& model, const SimState& state,
+                                     const BladeStroke& stroke, const CuttingSettings& settings) {
+  std::vector<std::int8_t> side(model.tet_count, 0);
+  if (stroke.edges_m.size() < 2) return side;
+  const std::vector<EdgePoints> edges =
+      cutting_edges(model, state.position_m, stroke, settings.groove_guide_m);
+  const SweepSurface surface = sweep_surface(edges, stroke.edges_m);
+  if (surface.size() == 0) return side;
+  Aabb sweep_box;
+  for (const Aabb& box : surface.box) sweep_box.grow(box);
+  for (std::size_t e = 0; e < model.tet_count; ++e) {
+    const auto p = corners_at(model, state.position_m, e);
+    Aabb box;
+    for (const auto& q : p) box.grow(q);
+    if (!box.overlaps(sweep_box) || !tet_touches_sweep(p, box, surface)) continue;
+    const Eigen::Vector3d centroid = 0.25 * (p[0] + p[1] + p[2] + p[3]);
+    side[e] = surface.side_distance_m(centroid) >= 0.0 ? 1 : -1;
+  }
+  return side;
+}
+
+// A strand between the sweep's two sides: the smallest set of faces between the elements it
+// touches on one side and those on the other, each reached by the sweep.
+std::vector<FaceKey> strand_across_the_sweep(const SimModel& model, FaceNeighbours& neighbours,
+                                             const std::vector<std::int8_t>& side,
+                                             const CuttingSettings& settings) {
+  if (std::find(side.begin(), side.end(), 1) == side.end() ||
+      std::find(side.begin(), side.end(), -1) == side.end())
+    return {};
+  std::vector<std::uint8_t> swept(model.tet_count);
+  for (std::size_t e = 0; e < model.tet_count; ++e) swept[e] = side[e] != 0;
+  const auto cut = minimum_cut(model, neighbours, side, swept);
+  if (!cut) return {};
+  return strand_of_cut(model, neighbours, *cut, swept, settings);
+}
+
+// A strand that holds what another tool holds: the smallest set of faces between the elements
+// holding a held node and those holding a fixed node, each near the cut (one of its elements
+// reached by the sweep or with a node on a cut face), when the held side holds no fixed node.
+std::vector<FaceKey> strand_of_the_held(const SimModel& model, FaceNeighbours& neighbours,
+                                        const std::vector<std::int8_t>& side,
+                                        std::span<const NodeIndex> held_nodes,
+                                        const CuttingSettings& settings) {
+  if (held_nodes.empty() || model.cut_face_mask.empty()) return {};
+  const std::size_t tets = model.tet_count;
+  std::vector<std::uint8_t> held(model.node_count, 0), on_cut(model.node_count, 0);
+  for (NodeIndex n : held_nodes)
+    if (n >= 0 && static_cast<std::size_t>(n) < model.node_count) held[n] = 1;
+  for (std::size_t e = 0; e < tets; ++e)
+    for (int f = 0; f < 4; ++f)
+      if ((model.cut_face_mask[e] >> f) & 1)
+        for (int k = 0; k < 3; ++k) on_cut[model.corner[kTetFace[f][k]][e]] = 1;
+  std::vector<std::int8_t> end(tets, 0);
+  std::vector<std::uint8_t> near(tets, 0);
+  bool holds = false, anchored = false;
+  for (std::size_t e = 0; e < tets; ++e) {
+    near[e] = side[e] != 0;
+    for (int c = 0; c < 4; ++c) {
+      const NodeIndex n = model.corner[c][e];
+      near[e] |= on_cut[n];
+      if (held[n] && end[e] == 0) end[e] = 1;
+      if (model.is_fixed[n]) end[e] = -1;
+    }
+    holds |= end[e] > 0;
+    anchored |= end[e] < 0;
+  }
+  if (!holds || !anchored) return {};
+  const auto cut = minimum_cut(model, neighbours, end, near);
+  if (!cut) return {};
+  // The held side must be what comes free.
+  for (std::size_t e = 0; e < tets; ++e)
+    if (cut->reached[e] && end[e] < 0) return {};
+  return strand_of_cut(model, neighbours, *cut, near, settings);
+}
+
 CutResult part_remnants(const SimModel& model, const SimState& state, const BladeStroke& stroke,
-                        const CuttingSettings& settings) {
+                        const CuttingSettings& settings, std::span<const NodeIndex> held_nodes) {
   if (auto problem = validate(settings)) throw std::invalid_argument(*problem);
   FaceNeighbours neighbours(model);
-  std::vector<FaceKey> strand = strand_of(model, state, stroke, settings, neighbours);
+  const std::vector<std::int8_t> side = swept_sides(model, state, stroke, settings);
+  std::vector<FaceKey> strand = strand_across_the_sweep(model, neighbours, side, settings);
+  if (strand.empty()) strand = strand_of_the_held(model, neighbours, side, held_nodes, settings);
   std::sort(strand.begin(), strand.end());
   const Geometry as_is = geometry_as_is(model, state);
   add_holes_in_the_cut(model, as_is.rest_m, neighbours, settings.hole_angle_deg, strand);

@@ -222,7 +222,14 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
 void RealtimeSimulation::part_remnants_of(HandInLoop& hand) {
   if (hand.stroke.edges_m.size() < 2) return;
   const auto update_start = std::chrono::steady_clock::now();
-  swap_in_cut(hand, part_remnants(*model_, state_, hand.stroke, *cutting_), update_start);
+  // What the other hand's forceps hold is the specimen's side (part_remnants).
+  std::vector<NodeIndex> held_nodes;
+  for (const HandInLoop& other : hands_)
+    if (&other != &hand && other.tools)
+      if (const ForcepsGrasp* grasp = other.tools->grasp())
+        held_nodes.insert(held_nodes.end(), grasp->nodes.begin(), grasp->nodes.end());
+  swap_in_cut(hand, part_remnants(*model_, state_, hand.stroke, *cutting_, held_nodes),
+              update_start);
 }
 
 void RealtimeSimulation::swap_in_cut(const HandInLoop& hand, CutResult cut,

@@ -34,6 +34,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -220,13 +221,22 @@ CutResult cut_tissue(const SimModel& model, const SimState& state, const BladeSt
 //   strand is the smallest set of faces between the tissue on the sweep's two sides (a maximum
 //   flow over the elements' faces from the elements touching it on one side to those on the
 //   other); the piece it frees holds no fixed node and is at least
-//   CuttingSettings::min_free_body_volume_m3.
+//   CuttingSettings::min_free_body_volume_m3;
+// - else, where another tool holds the tissue (`held_nodes`: the forceps' hold), a strand that
+//   holds what it holds: the smallest set of faces, at most kStrandFaces, between the elements
+//   holding a held node and those holding a fixed node, each near the cut (one of its two elements
+//   touches the sweep or has a node on a cut face), freeing the held side. The hand that retracts
+//   the lobe tells which side is the specimen, where the sweep's sides cannot: passes drawn a few
+//   millimetres apart leave remnants between them inside the organ too, and the minimum cut
+//   between the sides then ran through those (14–28 faces) while the lobe the forceps held hung
+//   by 7 faces (issue 42).
 // Where a resection's passes met, and around an element the cut left whole on one side (none of
-// its crossings could be snapped or split), a resected lobe stayed on by 1 to 6 faces in some runs
+// its crossings could be snapped or split), a resected lobe stayed on by 1 to 7 faces in some runs
 // (issue 42). Nothing: nothing to part.
 inline constexpr int kStrandFaces = 8;
 CutResult part_remnants(const SimModel& model, const SimState& state, const BladeStroke& stroke,
-                        const CuttingSettings& settings);
+                        const CuttingSettings& settings,
+                        std::span<const NodeIndex> held_nodes = {});
 
 // An update of a stroke as the blade goes on: its instants not yet bent are bent onto the cuts
 // they run beside in the tissue as it is now (CuttingSettings::groove_guide_m), the stroke so far
