@@ -30,6 +30,25 @@ QString simulationStatusText(const SimulationStatus& status) {
   if (stats.behind)
     text += QCoreApplication::translate("liversim::MainWindow", " | slower than real time");
   text += QCoreApplication::translate("liversim::MainWindow", " | ") + accuracyStatusText(stats);
+  // What the trainee acts on comes first: a window narrower than the whole line cuts its end off
+  // (at 1280 px the pieces cut free and the Remove Specimen hint were not shown).
+  QString trainee;  // each part begins with the separator
+  if (status.freeBodies > 0)
+    trainee += QCoreApplication::translate(
+        "liversim::MainWindow", " | %n piece(s) cut free: lift out or Session ▸ Remove Specimen",
+        nullptr, status.freeBodies);
+  if (status.specimensTakenOut > 0)
+    trainee += QCoreApplication::translate("liversim::MainWindow", " | %n specimen(s) taken out",
+                                           nullptr, status.specimensTakenOut);
+  if (status.resectedVolume_m3 > 0.0)
+    trainee += QCoreApplication::translate("liversim::MainWindow", " | resected %1 mL")
+                   .arg(status.resectedVolume_m3 * 1e6, 0, 'f', 1);
+  if (status.pullingForce_n)
+    trainee += QCoreApplication::translate("liversim::MainWindow", " | pulling %1 N")
+                   .arg(*status.pullingForce_n, 0, 'f', 2);
+  const QString separator = QCoreApplication::translate("liversim::MainWindow", " | ");
+  if (trainee.startsWith(separator)) trainee.remove(0, separator.size());
+  if (!trainee.isEmpty()) text = trainee + separator + text;
   // The step guards: what went wrong and what the simulation did about it.
   if (stats.halted)
     text = QCoreApplication::translate(
@@ -50,19 +69,6 @@ QString simulationStatusText(const SimulationStatus& status) {
         "liversim::MainWindow",
         " | energy books: the scheme is creating energy (choose a shorter step or an "
         "implicit scheme)");
-  if (status.pullingForce_n)
-    text += QCoreApplication::translate("liversim::MainWindow", " | pulling %1 N")
-                .arg(*status.pullingForce_n, 0, 'f', 2);
-  if (status.resectedVolume_m3 > 0.0)
-    text += QCoreApplication::translate("liversim::MainWindow", " | resected %1 mL")
-                .arg(status.resectedVolume_m3 * 1e6, 0, 'f', 1);
-  if (status.freeBodies > 0)
-    text += QCoreApplication::translate(
-        "liversim::MainWindow", " | %n piece(s) cut free: lift out or Session ▸ Remove Specimen",
-        nullptr, status.freeBodies);
-  if (status.specimensTakenOut > 0)
-    text += QCoreApplication::translate("liversim::MainWindow", " | %n specimen(s) taken out",
-                                        nullptr, status.specimensTakenOut);
   return text;
 }
 

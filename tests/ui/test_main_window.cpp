@@ -497,13 +497,18 @@ TEST_F(MainWindowTest, RemoveSpecimenSaysWhenNoPieceIsFreeAndTheStatusLineCounts
   SimulationStatus status;
   status.freeBodies = 2;
   status.specimensTakenOut = 1;
+  status.resectedVolume_m3 = 51.5e-6;
   const QString text = simulationStatusText(status);
   // (Plural forms come from the translations the workstation installs; a test has none.)
-  EXPECT_TRUE(text.contains("| 2 piece") &&
+  // What the trainee acts on comes first, before the simulation's figures: a window narrower than
+  // the line cuts its end off (at 1280 px the hint to remove the specimen was not shown).
+  EXPECT_TRUE(text.startsWith("2 piece") &&
               text.contains("cut free: lift out or Session ▸ Remove Specimen"))
       << text.toStdString();
   EXPECT_TRUE(text.contains("| 1 specimen")) << text.toStdString();
+  EXPECT_LT(text.indexOf("resected 51.5 mL"), text.indexOf("fps")) << text.toStdString();
   EXPECT_FALSE(simulationStatusText(SimulationStatus{}).contains("cut free"));
+  EXPECT_TRUE(simulationStatusText(SimulationStatus{}).startsWith("0 fps"));
 }
 
 // With the mouse the scalpel's depth is set by the wheel while the button is down (issue 42, item
