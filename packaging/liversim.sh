@@ -13,7 +13,9 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 command=${1:-run}
 preset=release
-xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24")
+# -noreset: otherwise the server resets whenever its last client leaves, and a test connecting
+# then is refused ("could not connect to display" in one CI run, two GUI tests in parallel).
+xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24 -noreset")
 
 case "$command" in
   run | test) ;;

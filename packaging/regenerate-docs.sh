@@ -118,7 +118,9 @@ build=build/release
 cli=$build/app/liversim-cli
 shared=../shared/data
 zhang=("$shared/external/zhang-liver/Liver_Iso.inp" --fixed-set 'FixT&P')
-xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24")
+# -noreset: otherwise the server resets whenever its last client leaves, and a test connecting
+# then is refused ("could not connect to display" in one CI run, two GUI tests in parallel).
+xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24 -noreset")
 jobs=$(nproc)
 
 # The commit and the machine, taken once before anything is written (a page this run rewrites is
@@ -152,7 +154,7 @@ commands=() # the step's commands as the pages show them, in the order run
 shown() {
   local text="" a
   for a in "$@"; do
-    if [ "$a" = "-screen 0 1280x1024x24" ]; then
+    if [ "$a" = "${xvfb[3]}" ]; then
       text=${text% -s}
       continue
     fi
