@@ -2455,12 +2455,11 @@ std::optional<MinimumCut> minimum_cut(const SimModel& model, FaceNeighbours& nei
   }
 }
 
-// The faces a minimum cut parts (from what it reached to the rest) when each of them is `near`
-// (per element: one of its two elements is) and the piece it frees, the side that holds no fixed
-// node, is at least CuttingSettings::min_free_body_volume_m3; otherwise none.
+// The faces a minimum cut parts (from what it reached to the rest; near the cut, as minimum_cut
+// parts no other) when the piece it frees, the side that holds no fixed node, is at least
+// CuttingSettings::min_free_body_volume_m3; otherwise none.
 std::vector<FaceKey> strand_of_cut(const SimModel& model, FaceNeighbours& neighbours,
-                                   const MinimumCut& cut, const std::vector<std::uint8_t>& near,
-                                   const CuttingSettings& settings) {
+                                   const MinimumCut& cut, const CuttingSettings& settings) {
   if (cut.faces == 0) return {};  // apart already
   const std::size_t tets = model.tet_count;
   double reached_m3 = 0.0, rest_m3 = 0.0;
@@ -2479,9 +2478,7 @@ std::vector<FaceKey> strand_of_cut(const SimModel& model, FaceNeighbours& neighb
     if (!cut.reached[a]) continue;
     for (int f = 0; f < 4; ++f) {
       const auto b = neighbours(a, f);
-      if (!b || cut.reached[*b]) continue;
-      if (!near[a] && !near[*b]) return {};  // tissue away from the cut
-      strand.push_back(face_key(model, a, f));
+      if (b && !cut.reached[*b]) strand.push_back(face_key(model, a, f));
     }
   }
   return strand;
@@ -2521,7 +2518,7 @@ std::vector<FaceKey> strand_across_the_sweep(const SimModel& model, FaceNeighbou
   for (std::size_t e = 0; e < model.tet_count; ++e) swept[e] = side[e] != 0;
   const auto cut = minimum_cut(model, neighbours, side, swept);
   if (!cut) return {};
-  return strand_of_cut(model, neighbours, *cut, swept, settings);
+  return strand_of_cut(model, neighbours, *cut, settings);
 }
 
 // A strand that holds what another tool holds: the smallest set of faces between the elements
@@ -2557,10 +2554,7 @@ std::vector<FaceKey> strand_of_the_held(const SimModel& model, FaceNeighbours& n
   if (!holds || !anchored) return {};
   const auto cut = minimum_cut(model, neighbours, end, near);
   if (!cut) return {};
-  // The held side must be what comes free.
-  for (std::size_t e = 0; e < tets; ++e)
-    if (cut->reached[e] && end[e] < 0) return {};
-  return strand_of_cut(model, neighbours, *cut, near, settings);
+  return strand_of_cut(model, neighbours, *cut, settings);  // what it reached holds no fixed node
 }
 
 CutResult part_remnants(const SimModel& model, const SimState& state, const BladeStroke& stroke,
