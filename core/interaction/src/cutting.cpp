@@ -1465,6 +1465,17 @@ struct AfterSplitting {
   bool may_make_nodes = false;                // after the front's refinement, not after a split
 };
 
+// Per node: whether it lies on a face an earlier cut made.
+std::vector<std::uint8_t> nodes_on_cut_faces(const SimModel& model) {
+  std::vector<std::uint8_t> on_cut(model.node_count, 0);
+  if (model.cut_face_mask.empty()) return on_cut;
+  for (std::size_t e = 0; e < model.tet_count; ++e)
+    for (int f = 0; f < 4; ++f)
+      if (model.cut_face_mask[e] >> f & 1u)
+        for (int k = 0; k < 3; ++k) on_cut[model.corner[kTetFace[f][k]][e]] = 1;
+  return on_cut;
+}
+
 // Holes in the cut (CuttingSettings::hole_angle_deg): an interior face whose three nodes all lie
 // on cut faces (made by earlier updates, or separated by this one) and that lies in the cut's
 // surface there (within the angle of parallel to a cut face at each of its nodes, and in that cut
@@ -1484,12 +1495,7 @@ void add_holes_in_the_cut(const SimModel& model, const NodeArray& rest_m,
     return (earlier_cuts && (model.cut_face_mask[e] >> f & 1u)) ||
            std::binary_search(separated.begin(), separated.end(), face_key(model, e, f));
   };
-  std::vector<std::uint8_t> on_cut(model.node_count, 0);
-  if (earlier_cuts)
-    for (std::size_t e = 0; e < tets; ++e)
-      for (int f = 0; f < 4; ++f)
-        if (model.cut_face_mask[e] >> f & 1u)
-          for (int k = 0; k < 3; ++k) on_cut[model.corner[kTetFace[f][k]][e]] = 1;
+  std::vector<std::uint8_t> on_cut = nodes_on_cut_faces(model);
   for (const FaceKey& key : separated)
     for (NodeIndex n : key) on_cut[n] = 1;
   auto unit_normal = [&](std::size_t e, int f) {
@@ -2530,13 +2536,10 @@ std::vector<FaceKey> strand_of_the_held(const SimModel& model, FaceNeighbours& n
                                         const CuttingSettings& settings) {
   if (held_nodes.empty() || model.cut_face_mask.empty()) return {};
   const std::size_t tets = model.tet_count;
-  std::vector<std::uint8_t> held(model.node_count, 0), on_cut(model.node_count, 0);
+  std::vector<std::uint8_t> held(model.node_count, 0);
   for (NodeIndex n : held_nodes)
     if (n >= 0 && static_cast<std::size_t>(n) < model.node_count) held[n] = 1;
-  for (std::size_t e = 0; e < tets; ++e)
-    for (int f = 0; f < 4; ++f)
-      if ((model.cut_face_mask[e] >> f) & 1)
-        for (int k = 0; k < 3; ++k) on_cut[model.corner[kTetFace[f][k]][e]] = 1;
+  const std::vector<std::uint8_t> on_cut = nodes_on_cut_faces(model);
   std::vector<std::int8_t> end(tets, 0);
   std::vector<std::uint8_t> near(tets, 0);
   bool holds = false, anchored = false;
