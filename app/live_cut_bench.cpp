@@ -44,6 +44,7 @@ struct Second {
   double smallest_mesh_limit_s = std::numeric_limits<double>::infinity();
   double smallest_travel_limit_s = std::numeric_limits<double>::infinity();
   double smallest_spring_limit_s = std::numeric_limits<double>::infinity();
+  double max_stiffening = 1.0, least_volume_ratio = 1.0, max_flow_stiffening = 1.0;
   int force_evaluations = 0, cuts = 0, parts = 0, guard_retries = 0;
   bool blade_in_tissue = false, behind = false;
 };
@@ -189,6 +190,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
     s.smallest_mesh_limit_s = std::min(s.smallest_mesh_limit_s, r.smallest_mesh_limit_s);
     s.smallest_travel_limit_s = std::min(s.smallest_travel_limit_s, r.smallest_travel_limit_s);
     s.smallest_spring_limit_s = std::min(s.smallest_spring_limit_s, r.smallest_spring_limit_s);
+    s.max_stiffening = std::max(s.max_stiffening, r.max_stiffening);
+    s.least_volume_ratio = std::min(s.least_volume_ratio, r.least_volume_ratio);
+    s.max_flow_stiffening = std::max(s.max_flow_stiffening, r.max_flow_stiffening);
   }
 
   std::ostringstream command;
@@ -212,7 +216,10 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << ", the session recorded to a database thrown away after. Each second of wall time: the "
          "simulated time it advanced (the real-time factor), the smallest step taken and what "
          "limited it (the mesh with its stiffening, the springs of the tool, or the node-travel "
-         "limit), the steps the guard undid and retried at half the step (a step halved so is "
+         "limit), what stiffened the mesh above its rest (the worst stiffening, a factor on ω², "
+         "and of its causes the smallest element volume ratio J, an element compressed or below 0 "
+         "inverted, and the largest stiffening a viscoplastic flow gave an element, at most "
+         "4), the steps the guard undid and retried at half the step (a step halved so is "
          "smaller than any limit), and the cut updates made in it. The loop is paced by the "
          "clock, so a second that keeps up shows a factor a little under 1 (the cycle it waits "
          "for); one that cannot keep up is capped and "
@@ -220,9 +227,10 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << "real-time factor of " << kLeastRealTimeFactor << "), no step below " << kLeastStepMs
       << " ms, every cut update within a frame (" << kFrameMs << " ms).\n\n"
       << "| second | blade in | real-time factor | fell behind | smallest step (ms) | mesh limit "
-         "(ms) | with springs (ms) | travel limit (ms) | guard retries | force evaluations / "
+         "(ms) | with springs (ms) | travel limit (ms) | stiffening (×) | least J | flow "
+         "stiffening (×) | guard retries | force evaluations / "
          "simulated ms | cut updates | parted |\n"
-      << "|---:|:---:|---:|:---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+      << "|---:|:---:|---:|:---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   double least_factor = std::numeric_limits<double>::infinity();
   int seconds_behind = 0;
   for (const auto& [second, s] : seconds) {
@@ -234,7 +242,9 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
         << std::setprecision(3) << factor << " | " << (s.behind ? "**yes**" : "") << " | "
         << ms_text(s.smallest_step_s) << " | " << ms_text(s.smallest_mesh_limit_s) << " | "
         << ms_text(s.smallest_spring_limit_s) << " | " << ms_text(s.smallest_travel_limit_s)
-        << " | " << s.guard_retries << " | " << std::setprecision(1)
+        << " | " << std::setprecision(2) << s.max_stiffening << " | " << s.least_volume_ratio
+        << " | " << s.max_flow_stiffening << " | " << s.guard_retries << " | "
+        << std::setprecision(1)
         << (s.simulated_s > 0.0 ? s.force_evaluations / (s.simulated_s * 1e3) : 0.0) << " | "
         << s.cuts << " | " << s.parts << " |\n";
   }

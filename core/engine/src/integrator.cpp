@@ -162,6 +162,8 @@ void accumulate(StepReport& total, const StepReport& part) {
   }
   total.substeps += part.substeps;
   total.max_stiffening = std::max(total.max_stiffening, part.max_stiffening);
+  total.least_volume_ratio = std::min(total.least_volume_ratio, part.least_volume_ratio);
+  total.max_flow_stiffening = std::max(total.max_flow_stiffening, part.max_flow_stiffening);
   if (part.stability_limited_steps > 0)
     total.smallest_stable_step_s =
         total.stability_limited_steps > 0
@@ -460,9 +462,12 @@ double advance_central_difference(const SimModel& model, SimState& state, const 
       report.gave_up_early = true;
       return advanced_s;
     }
-    const double stiffening = stiffening_since_rest(model, evaluate_forces(model, state, inputs));
+    const ElasticEvaluation seen = evaluate_forces(model, state, inputs);
+    const double stiffening = stiffening_since_rest(model, seen);
     ++report.force_evaluations;
     report.max_stiffening = std::max(report.max_stiffening, stiffening);
+    report.least_volume_ratio = std::min(report.least_volume_ratio, seen.min_volume_ratio);
+    report.max_flow_stiffening = std::max(report.max_flow_stiffening, seen.max_flow_stiffening);
     double limit = stable_time_step_s(model, inputs, stiffening);
     report.smallest_spring_limit_s = std::min(report.smallest_spring_limit_s, limit);
     report.smallest_mesh_limit_s =

@@ -872,6 +872,9 @@ void RealtimeSimulation::run() {
         record.smallest_mesh_limit_s = window_report.smallest_mesh_limit_s;
         record.smallest_travel_limit_s = window_report.smallest_travel_limit_s;
         record.smallest_spring_limit_s = window_report.smallest_spring_limit_s;
+        record.max_stiffening = window_report.max_stiffening;
+        record.least_volume_ratio = window_report.least_volume_ratio;
+        record.max_flow_stiffening = window_report.max_flow_stiffening;
         record.guard_retries = window_retries;
         trace_->push(record);
       }

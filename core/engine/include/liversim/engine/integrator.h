@@ -38,6 +38,11 @@ struct StepReport {
   double smallest_substep_s = 0.0;
   double largest_substep_s = 0.0;
   double max_stiffening = 1.0;  // worst stiffening met (1 = as at rest), explicit schemes
+  // Of which (explicit schemes): the smallest element volume ratio J met (compression stiffens
+  // the volumetric law as J falls; below 0 an element is inverted) and the largest stiffening a
+  // viscoplastic flow had given an element (at most kMaxFlowStiffening).
+  double least_volume_ratio = 1.0;
+  double max_flow_stiffening = 1.0;
   // Explicit schemes: steps shorter than the requested one because the stability limit (or the
   // node-travel limit) required it, and the smallest such limit met.
   int stability_limited_steps = 0;

@@ -136,6 +136,11 @@ struct LoopRecord {
   double smallest_mesh_limit_s = std::numeric_limits<double>::infinity();
   double smallest_travel_limit_s = std::numeric_limits<double>::infinity();
   double smallest_spring_limit_s = std::numeric_limits<double>::infinity();
+  // What raised the mesh's limit above its rest value (StepReport): the worst stiffening and, of
+  // its causes, the smallest element volume ratio J and the largest flow stiffening met.
+  double max_stiffening = 1.0;
+  double least_volume_ratio = 1.0;
+  double max_flow_stiffening = 1.0;
   // Steps the guard undid and retried at half the step (health.h): a step halved by a retry is
   // told apart from one a limit split.
   int guard_retries = 0;
