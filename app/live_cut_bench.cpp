@@ -2,6 +2,7 @@
 
 #include "cli_commands.h"
 #include "liversim/engine/model_building.h"
+#include "liversim/engine/viscous_tissue.h"
 #include "liversim/haptics/emulated_devices.h"
 #include "liversim/haptics/haptics.h"
 #include "liversim/haptics/spsc_ring.h"
@@ -219,7 +220,8 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
          "limit), what stiffened the mesh above its rest (the worst stiffening, a factor on ω², "
          "and of its causes the smallest element volume ratio J, an element compressed or below 0 "
          "inverted, and the largest stiffening a viscoplastic flow gave an element, at most "
-         "4), the steps the guard undid and retried at half the step (a step halved so is "
+      << kMaxFlowStiffening
+      << "), the steps the guard undid and retried at half the step (a step halved so is "
          "smaller than any limit), and the cut updates made in it. The loop is paced by the "
          "clock, so a second that keeps up shows a factor a little under 1 (the cycle it waits "
          "for); one that cannot keep up is capped and "
