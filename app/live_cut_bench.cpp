@@ -3,6 +3,7 @@
 #include "cli_commands.h"
 #include "liversim/engine/model_building.h"
 #include "liversim/engine/viscous_tissue.h"
+#include "liversim/engine/worker_pool.h"
 #include "liversim/haptics/emulated_devices.h"
 #include "liversim/haptics/haptics.h"
 #include "liversim/haptics/spsc_ring.h"
@@ -214,7 +215,11 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << (o.left_trajectory ? std::string(" (and in the left hand ") + o.left_tool + " along `" +
                                   o.left_trajectory->filename().string() + "`)"
                             : std::string())
-      << ", the session recorded to a database thrown away after. Each second of wall time: the "
+      << ", the session recorded to a database thrown away after. Its force evaluations run on "
+      << realtime_engine_threads()
+      << " thread(s): the hardware's threads less one, the core left over being the servo's, the "
+         "frame's and the database writer's (LIVERSIM_THREADS sets it). Each second of wall time: "
+         "the "
          "simulated time it advanced (the real-time factor), the smallest step taken and what "
          "limited it (the mesh with its stiffening, the springs of the tool, or the node-travel "
          "limit), what stiffened the mesh above its rest (the worst stiffening, a factor on ω², "

@@ -97,8 +97,8 @@ std::vector<ServoRun> run_once(const SceneSetup& scene, Condition condition, int
   std::thread publisher;
   if (condition != Condition::alone) {
     auto model = std::make_shared<const SimModel>(build_model(scene.mesh, scene.model_options));
-    simulation =
-        std::make_unique<RealtimeSimulation>(model, make_rest_state(*model, shared_worker_pool()));
+    simulation = std::make_unique<RealtimeSimulation>(
+        model, make_rest_state(*model, realtime_worker_pool()));
     simulation->enable_tools(boundary_surface(*model));
     simulation->set_haptic_servo(servo.get());
     simulation->set_device_tool(Hand::right, DeviceToolSettings{});

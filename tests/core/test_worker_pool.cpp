@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <mutex>
@@ -90,6 +91,24 @@ TEST(WorkerPool, ABadThreadCountInTheEnvironmentIsNamed) {
   EXPECT_EQ(default_engine_threads(), 3);
   ASSERT_EQ(unsetenv("LIVERSIM_THREADS"), 0);
   EXPECT_GE(default_engine_threads(), 1);
+}
+
+TEST(WorkerPool, TheRealTimeLoopLeavesOneCoreToTheServoAndTheFrame) {
+  const char* set = std::getenv("LIVERSIM_THREADS");
+  const std::string kept = set ? set : "";
+  ASSERT_EQ(unsetenv("LIVERSIM_THREADS"), 0);
+  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  EXPECT_EQ(default_engine_threads(), hardware);
+  EXPECT_EQ(realtime_engine_threads(), std::max(1, hardware - 1));
+  // The variable, when set, is the real-time loop's too, and a bad one is named as for the rest.
+  ASSERT_EQ(setenv("LIVERSIM_THREADS", "2", 1), 0);
+  EXPECT_EQ(realtime_engine_threads(), 2);
+  ASSERT_EQ(setenv("LIVERSIM_THREADS", "0", 1), 0);
+  EXPECT_THROW(realtime_engine_threads(), std::invalid_argument);
+  if (set)
+    setenv("LIVERSIM_THREADS", kept.c_str(), 1);
+  else
+    unsetenv("LIVERSIM_THREADS");
 }
 
 TEST(WorkerPool, RefusesAThreadCountOutOfRange) {

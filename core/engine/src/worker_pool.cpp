@@ -1,6 +1,8 @@
 #include "liversim/engine/worker_pool.h"
 
+#include <algorithm>
 #include <cstdlib>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -114,7 +116,10 @@ void WorkerPool::work() {
   }
 }
 
-int default_engine_threads() {
+namespace {
+
+// LIVERSIM_THREADS, or nothing when it is not set; throws naming it when it is not a thread count.
+std::optional<int> threads_from_environment() {
   if (const char* value = std::getenv("LIVERSIM_THREADS")) {
     char* end = nullptr;
     const long threads = std::strtol(value, &end, 10);
@@ -123,8 +128,22 @@ int default_engine_threads() {
                                   "' is invalid: expected a whole number of threads from 1 to 256");
     return static_cast<int>(threads);
   }
+  return std::nullopt;
+}
+
+int hardware_threads() {
   const unsigned hardware = std::thread::hardware_concurrency();
-  return hardware == 0 ? 1 : static_cast<int>(hardware);
+  return hardware == 0 ? 1 : static_cast<int>(std::min(hardware, 256u));
+}
+
+}  // namespace
+
+int default_engine_threads() {
+  return threads_from_environment().value_or(hardware_threads());
+}
+
+int realtime_engine_threads() {
+  return threads_from_environment().value_or(std::max(1, hardware_threads() - 1));
 }
 
 std::shared_ptr<WorkerPool> make_worker_pool(int thread_count) {
@@ -134,6 +153,11 @@ std::shared_ptr<WorkerPool> make_worker_pool(int thread_count) {
 
 std::shared_ptr<WorkerPool> shared_worker_pool() {
   static const std::shared_ptr<WorkerPool> pool = make_worker_pool(default_engine_threads());
+  return pool;
+}
+
+std::shared_ptr<WorkerPool> realtime_worker_pool() {
+  static const std::shared_ptr<WorkerPool> pool = make_worker_pool(realtime_engine_threads());
   return pool;
 }
 

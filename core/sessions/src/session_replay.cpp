@@ -13,7 +13,7 @@ namespace liversim {
 std::unique_ptr<RealtimeSimulation> make_scene_simulation(std::shared_ptr<const SimModel> model,
                                                           const BoundarySurface& surface,
                                                           double loop_step_s) {
-  SimState rest = make_rest_state(*model, shared_worker_pool());
+  SimState rest = make_rest_state(*model, realtime_worker_pool());
   RealtimeSimulation::Options options;
   options.loop_step_s = loop_step_s;
   auto simulation =

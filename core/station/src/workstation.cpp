@@ -1,6 +1,7 @@
 #include "liversim/station/workstation.h"
 
 #include "liversim/engine/model_building.h"
+#include "liversim/engine/worker_pool.h"
 #include "liversim/haptics/openhaptics_device.h"
 #include "liversim/sessions/outcome_metrics.h"
 #include "liversim/sessions/session_replay.h"
@@ -366,8 +367,8 @@ void Workstation::finish_model_change(const ModelChange& change, const ModelChan
   // The same mesh: a session's damage and lift tracking go on in the new simulation.
   std::optional<OutcomeTracking> tracking = simulation_->outcome();
   try {
-    auto replacement =
-        std::make_unique<RealtimeSimulation>(model, carry_state(old, *model, shared_worker_pool()));
+    auto replacement = std::make_unique<RealtimeSimulation>(
+        model, carry_state(old, *model, realtime_worker_pool()));
     simulation_ = std::move(replacement);
     simulation_->publish_time_to(&simulated_clock_s_);
     if (tracking) simulation_->track_outcome(std::move(*tracking));

@@ -78,4 +78,16 @@ std::shared_ptr<WorkerPool> make_worker_pool(int thread_count);
 // The workstation and the command line step with it; tests make their own.
 std::shared_ptr<WorkerPool> shared_worker_pool();
 
+// The threads the real-time loop steps with: LIVERSIM_THREADS when set, else the hardware's
+// threads less one (at least 1). The core left over is the haptic servo's, the station's frame's
+// (metrics, the database writer) and the window's rendering: on 2 cores they otherwise preempt the
+// force loop's worker in the middle of its chunk and the loop waits for it (the bimanual wedge
+// resection fell behind in 25–29 of 32 s on two threads, 11–19 on one: docs/cutting.md).
+// Throws as default_engine_threads does.
+int realtime_engine_threads();
+
+// The process's pool of realtime_engine_threads() threads, made on first use (null: one thread).
+// What the workstation's real-time loop and its replays step with.
+std::shared_ptr<WorkerPool> realtime_worker_pool();
+
 }  // namespace liversim
