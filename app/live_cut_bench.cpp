@@ -219,8 +219,7 @@ int run_live_cut_bench(const LiveCutBenchOptions& o) {
       << realtime_engine_threads()
       << " thread(s): the hardware's threads less one, the core left over being the servo's, the "
          "frame's and the database writer's (LIVERSIM_THREADS sets it). Each second of wall time: "
-         "the "
-         "simulated time it advanced (the real-time factor), the smallest step taken and what "
+         "the simulated time it advanced (the real-time factor), the smallest step taken and what "
          "limited it (the mesh with its stiffening, the springs of the tool, or the node-travel "
          "limit), what stiffened the mesh above its rest (the worst stiffening, a factor on ω², "
          "and of its causes the smallest element volume ratio J, an element compressed or below 0 "

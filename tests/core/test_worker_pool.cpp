@@ -97,7 +97,7 @@ TEST(WorkerPool, TheRealTimeLoopLeavesOneCoreToTheServoAndTheFrame) {
   const char* set = std::getenv("LIVERSIM_THREADS");
   const std::string kept = set ? set : "";
   ASSERT_EQ(unsetenv("LIVERSIM_THREADS"), 0);
-  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int hardware = static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 256u));
   EXPECT_EQ(default_engine_threads(), hardware);
   EXPECT_EQ(realtime_engine_threads(), std::max(1, hardware - 1));
   // The variable, when set, is the real-time loop's too, and a bad one is named as for the rest.

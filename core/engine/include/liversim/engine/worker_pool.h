@@ -75,7 +75,8 @@ std::shared_ptr<WorkerPool> make_worker_pool(int thread_count);
 
 // The process's pool of default_engine_threads() threads, made on first use (null: one thread);
 // throws as default_engine_threads does.
-// The workstation and the command line step with it; tests make their own.
+// The command line and the benchmarks step with it (the real-time loop with realtime_worker_pool);
+// tests make their own.
 std::shared_ptr<WorkerPool> shared_worker_pool();
 
 // The threads the real-time loop steps with: LIVERSIM_THREADS when set, else the hardware's
