@@ -428,6 +428,30 @@ TEST(Cutting, ABladeEdgeIsInTheTissueWhereItPassesThroughAnElementOrComesWithinR
   EXPECT_FALSE(in({0.031, 0.022, 0.06}, {0.031, 0.022, 0.042}, 0.001));
 }
 
+TEST(Cutting, AnEdgeDeepInsideOneLargeElementIsInItThoughNoCornerIsNearIt) {
+  // One element 10 cm across and a 2 mm edge at its centroid: every corner lies far outside the
+  // edge's box, yet the element's box holds it (the walk must not pass over such an element).
+  const SimModel model = build_model(testing::corner_tet_mesh(0.1), ModelOptions{});
+  const Eigen::Vector3d centroid(0.025, 0.025, 0.025);
+  const std::array<Eigen::Vector3d, 2> edge = {centroid - Eigen::Vector3d(0.001, 0, 0),
+                                               centroid + Eigen::Vector3d(0.001, 0, 0)};
+  std::vector<std::uint8_t> scratch;  // as the real-time loop keeps it, a byte per node
+  for (std::vector<std::uint8_t>* kept :
+       {static_cast<std::vector<std::uint8_t>*>(nullptr), &scratch, &scratch}) {
+    const EdgeInTissue in =
+        edge_in_tissue(model, model.rest_position_m, edge, 0.0, kEdgeInTissueMarginM, kept);
+    EXPECT_TRUE(in.within_reach);
+    EXPECT_NEAR(in.length_m, 0.002, 1e-12);
+    EXPECT_NEAR(in.resistance_n, 0.002 * model.regions[0].fracture_toughness_j_per_m2, 1e-12);
+  }
+  // Beside the element, past its slanted face (x + y + z = 0.1) though inside its box: out.
+  const Eigen::Vector3d beyond(0.04, 0.04, 0.04);
+  EXPECT_FALSE(edge_in_tissue(model, model.rest_position_m,
+                              {beyond, beyond + Eigen::Vector3d(0.001, 0, 0)}, 0.0,
+                              kEdgeInTissueMarginM, &scratch)
+                   .within_reach);
+}
+
 TEST(Cutting, CuttingAlongAnExistingCutChangesNothing) {
   const SimModel model = block_model();
   const SimState state = make_rest_state(model);

@@ -333,11 +333,7 @@ TEST_F(LiverFixture, EnergyDecaysAfterAPullIsReleased) {
 }
 
 TEST(Inversion, AnInvertedElementIsPushedBackOut) {
-  TetMesh mesh;
-  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.01, 0, 0),
-                                   Eigen::Vector3d(0, 0.01, 0), Eigen::Vector3d(0, 0, 0.01)})
-    mesh.rest_position_m.push_back(p);
-  mesh.add_tet({0, 1, 2, 3});
+  const TetMesh mesh = testing::corner_tet_mesh(0.01);
   ModelOptions options;
   options.fixed_nodes = {0, 1, 2};
   options.mass_damping_per_s = 50.0;

@@ -1414,7 +1414,7 @@ double blade_edge_in_contact_m(const PartContact& blade, const ToolGeometry& geo
 
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
                             const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m,
-                            double margin_m) {
+                            double margin_m, std::vector<std::uint8_t>* node_scratch) {
   // Each element's stretch of the edge, its faces pushed out by the margin so that an edge lying
   // along faces (its own cut, faces snapped onto it) is in; overlaps counted once.
   struct Stretch {
@@ -1425,11 +1425,27 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
   std::size_t count = 0;
   EdgeInTissue in;
   const Aabb edge_box = Aabb::around(edge_m[0], edge_m[1], std::max(reach_m, margin_m));
+  // Each node's side of the edge's box on each axis (Cohen–Sutherland outcodes: bit 2k below the
+  // box along axis k, bit 2k + 1 above it). An element's box misses the edge's exactly when all
+  // its corners are past the same side: the AND of their codes is not 0. A walk over the nodes'
+  // coordinates and the elements' corner indices instead of gathering every element's corners
+  // (that walk was 8 % of the live loop's time while a blade cut).
+  std::vector<std::uint8_t> own_scratch;
+  std::vector<std::uint8_t>& outcode = node_scratch ? *node_scratch : own_scratch;
+  if (outcode.size() < model.node_count) outcode.resize(model.node_count);
+  const double* coordinate[3] = {position_m.x.data(), position_m.y.data(), position_m.z.data()};
+  for (std::size_t n = 0; n < model.node_count; ++n) {
+    std::uint8_t code = 0;
+    for (int k = 0; k < 3; ++k)
+      code |= static_cast<std::uint8_t>((coordinate[k][n] < edge_box.min_m[k] ? 1 : 0) << (2 * k) |
+                                        (coordinate[k][n] > edge_box.max_m[k] ? 2 : 0) << (2 * k));
+    outcode[n] = code;
+  }
   for (std::size_t e = 0; e < model.tet_count && count < kMostStretches; ++e) {
+    if ((outcode[model.corner[0][e]] & outcode[model.corner[1][e]] & outcode[model.corner[2][e]] &
+         outcode[model.corner[3][e]]) != 0)
+      continue;
     const auto p = corners_at(model, position_m, e);
-    Aabb box;
-    for (const auto& q : p) box.grow(q);
-    if (!box.overlaps(edge_box)) continue;
     if (!in.within_reach) {
       const auto [t_in, t_out] = edge_within_element(p, edge_m, reach_m);
       in.within_reach = t_in <= t_out;

@@ -162,7 +162,8 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   constexpr double kBladeReachM = 0.003;
   const EdgeInTissue in =
       hand.tools->bvh().bounds().overlaps(Aabb::around(edge[0], edge[1], kBladeReachM))
-          ? edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM)
+          ? edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM, kEdgeInTissueMarginM,
+                           &hand.blade_node_scratch)
           : EdgeInTissue{};
   hand.blade_edge_in_tissue_m = in.length_m;
   if (!hand.blade_in_tissue) {

@@ -152,7 +152,9 @@ std::array<Eigen::Vector3d, 2> cutting_edge_m(const Tool& scalpel);
 // length, and the force the crack front along them holds back, each stretch times its element's
 // region's toughness: the work per unit advance of the crack (Mahvash & Hayward 2001); and
 // whether the edge passes through an element or within about `reach_m` of one (its faces pushed
-// out by that much). One walk over the elements; allocates nothing.
+// out by that much). One walk over the nodes and one over the elements' corner indices; allocates
+// nothing once `node_scratch` holds a byte per node (without it, a vector of its own).
+inline constexpr double kEdgeInTissueMarginM = 1e-6;
 struct EdgeInTissue {
   double length_m = 0.0;
   double resistance_n = 0.0;
@@ -160,7 +162,8 @@ struct EdgeInTissue {
 };
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
                             const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m = 0.0,
-                            double margin_m = 1e-6);
+                            double margin_m = kEdgeInTissueMarginM,
+                            std::vector<std::uint8_t>* node_scratch = nullptr);
 // The length of the scalpel's edge in contact that `blade` (its part's contact) reports: the
 // stretch of its axis that touched the tissue and the blade's thickness (a tip's crack is that
 // wide). Times the toughness, the force at which it breaks in.

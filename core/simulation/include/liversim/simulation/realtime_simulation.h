@@ -373,7 +373,8 @@ class RealtimeSimulation {
     // (part_remnants_due), and then the stroke ends.
     bool remnants_due = false;
     Eigen::Vector3d cutting_force_n = Eigen::Vector3d::Zero();  // on the blade, while it cuts
-    double blade_edge_in_tissue_m = 0.0;  // of the scalpel's edge, after the last cycle
+    double blade_edge_in_tissue_m = 0.0;           // of the scalpel's edge, after the last cycle
+    std::vector<std::uint8_t> blade_node_scratch;  // edge_in_tissue's, a byte per node
     Eigen::Vector3d blade_velocity_m_per_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d blade_middle_m = Eigen::Vector3d::Zero();
     double blade_time_s = -1.0;  // when blade_middle_m was; < 0: not yet
