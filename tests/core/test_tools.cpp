@@ -277,6 +277,51 @@ TEST(Tools, ForcepsGraspOnClosingPullAndReleaseOnOpening) {
   EXPECT_FALSE(hand.grasping());
 }
 
+// Two hands over the same surface: the second may query the first's hierarchy, refitted to the
+// tissue as it is now, instead of refitting its own, and meets exactly what its own would give.
+TEST(Tools, AHandQueryingTheOtherHandsRefittedHierarchyMeetsWhatItsOwnGives) {
+  const Block block;
+  const SimModel& model = block.model;
+  SimState state = make_rest_state(model);
+  ToolInteraction pressing(model, block.surface);
+  const double radius = Tool{}.geometry.probe_tip_radius_m;
+  const Tool probe = tool_above_centre(ToolKind::probe, radius - 0.004);
+  for (int interval = 0; interval < 200; ++interval)
+    advance(model, state, {{}, pressing.update(probe, state.position_m)}, 1e-3);
+  // The whole block and the tools 5 cm along x: a hierarchy not refitted to it would meet nothing.
+  const Eigen::Vector3d shift(0.05, 0.0, 0.0);
+  for (std::size_t n = 0; n < model.node_count; ++n)
+    state.position_m.set(n, state.position_m.at(n) + shift);
+  Tool probe_moved = probe;
+  probe_moved.pose.origin_m += shift;
+  pressing.update(probe_moved, state.position_m);  // its hierarchy now fits the moved tissue
+  ASSERT_GT(pressing.contact_count(), 0u);
+
+  Tool forceps = tool_above_centre(ToolKind::forceps, 0.0);
+  forceps.pose.origin_m += shift;
+  forceps.pose.origin_m.x() += 0.01;  // beside the probe, jaws closed on the top face
+  forceps.jaw_opening = 0.0;
+  auto same_springs = [](std::span<const NodeSpring> a, std::span<const NodeSpring> b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (a[i].node != b[i].node || a[i].anchor_m != b[i].anchor_m ||
+          a[i].stiffness_n_per_m != b[i].stiffness_n_per_m ||
+          a[i].damping_n_s_per_m != b[i].damping_n_s_per_m)
+        return false;
+    return true;
+  };
+  for (const Tool& tool : {forceps, probe_moved}) {
+    ToolInteraction own(model, block.surface), sharing(model, block.surface);
+    const auto own_springs = own.update(tool, state.position_m);
+    const std::vector<NodeSpring> by_own(own_springs.begin(), own_springs.end());
+    const auto by_sharing = sharing.update(tool, state.position_m, false, &pressing.bvh());
+    EXPECT_FALSE(by_own.empty());
+    EXPECT_TRUE(same_springs(by_own, by_sharing));
+    EXPECT_EQ(own.grasping(), sharing.grasping());
+    EXPECT_EQ(own.contact_count(), sharing.contact_count());
+  }
+}
+
 TEST(Tools, BadSettingsAreNamed) {
   const Block block;
   ContactSettings contact;

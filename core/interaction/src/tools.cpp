@@ -306,7 +306,8 @@ ToolInteraction::ToolInteraction(const SimModel& model, const BoundarySurface& s
   grasp_weight_.reserve(nodes);
 }
 
-void ToolInteraction::try_grasp(const Tool& tool, const NodeArray& position) {
+void ToolInteraction::try_grasp(const Tool& tool, const NodeArray& position,
+                                const SurfaceBvh& hierarchy) {
   // What the closing jaws take: the surface near them, hinge to tip. Open jaws come down on the
   // tissue and push it aside before they close, so near the grasp point alone may be nothing.
   const Eigen::Vector3d hinge = tool.pose.origin_m;
@@ -315,8 +316,8 @@ void ToolInteraction::try_grasp(const Tool& tool, const NodeArray& position) {
   const double radius = grasp_settings_.radius_m;
   grasp_.clear();
   grasp_weight_.clear();
-  bvh_.for_each_triangle_overlapping(Aabb::around(hinge, tip, radius), [&](std::size_t t) {
-    for (NodeIndex n : bvh_.triangles()[t]) {
+  hierarchy.for_each_triangle_overlapping(Aabb::around(hinge, tip, radius), [&](std::size_t t) {
+    for (NodeIndex n : hierarchy.triangles()[t]) {
       const auto node = static_cast<std::size_t>(n);
       if (node_mark_[node] || model_->inverse_mass_per_kg[node] == 0.0) continue;
       const Eigen::Vector3d p = position.at(n);
@@ -368,12 +369,14 @@ void ToolInteraction::carry_hold(const ForcepsGrasp& held, std::span<const NodeI
 }
 
 std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const NodeArray& position,
-                                                    bool blade_cuts) {
-  bvh_.refit(position);
+                                                    bool blade_cuts, const SurfaceBvh* refitted) {
+  if (!refitted) bvh_.refit(position);
+  const SurfaceBvh& hierarchy = refitted ? *refitted : bvh_;
   springs_.clear();
   if (tool.kind == ToolKind::forceps) {
     if (grasping() && tool.jaw_opening > grasp_settings_.release_above) grasp_.clear();
-    if (!grasping() && tool.jaw_opening < grasp_settings_.close_below) try_grasp(tool, position);
+    if (!grasping() && tool.jaw_opening < grasp_settings_.close_below)
+      try_grasp(tool, position, hierarchy);
   } else {
     grasp_.clear();
   }
@@ -390,7 +393,7 @@ std::span<const NodeSpring> ToolInteraction::update(const Tool& tool, const Node
   // instead (cutting_edge_m).
   if (blade_cuts && tool.kind == ToolKind::scalpel) count = 0;
   contact_count_ = add_contact_springs(
-      *model_, bvh_, position, std::span<const Capsule>(parts.data(), count), contact_,
+      *model_, hierarchy, position, std::span<const Capsule>(parts.data(), count), contact_,
       contact_scratch_, springs_,
       std::span<PartContact>(part_contact_.data(), part_contact_.size()), cut_triangle_);
   return springs_;

@@ -161,7 +161,7 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   // steps), the edge meets nothing: no walk over the elements.
   constexpr double kBladeReachM = 0.003;
   const EdgeInTissue in =
-      hand.tools->bvh().bounds().overlaps(Aabb::around(edge[0], edge[1], kBladeReachM))
+      step_hierarchy().bounds().overlaps(Aabb::around(edge[0], edge[1], kBladeReachM))
           ? edge_in_tissue(*model_, state_.position_m, edge, kBladeReachM, kEdgeInTissueMarginM,
                            &hand.blade_node_scratch)
           : EdgeInTissue{};
@@ -218,6 +218,13 @@ void RealtimeSimulation::cut_with_scalpel(HandInLoop& hand) {
   propagating.refine_edge_m = kBladeRefineEdgeM;
   // Each instant follows the groove it is in as the tissue is now (CuttingSettings).
   swap_in_cut(hand, cut_stroke_so_far(*model_, state_, hand.stroke, propagating), update_start);
+}
+
+const SurfaceBvh& RealtimeSimulation::step_hierarchy() const {
+  // enable_tools and swap_in give every hand the same surface.
+  for (const HandInLoop& hand : hands_)
+    if (hand.acts()) return hand.tools->bvh();
+  throw std::logic_error("step_hierarchy: no hand acts");
 }
 
 void RealtimeSimulation::part_remnants_of(HandInLoop& hand) {
@@ -579,12 +586,16 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   GuardOptions guard;
   guard.check_energy = check_energy;
   // The tools' springs follow the surface: recomputed before every step of the cycle.
+  // The hands hold the same surface: the first that acts refits its hierarchy, the other queries
+  // it (step_hierarchy).
   auto tool_inputs = [&] {
     step_springs_.assign(active_springs_.begin(), active_springs_.end());
+    const SurfaceBvh* refitted = nullptr;
     for (HandInLoop& hand : hands_) {
       if (!hand.acts()) continue;
       const auto tool_springs =
-          hand.tools->update(*hand.active_tool, state_.position_m, hand.blade_in_tissue);
+          hand.tools->update(*hand.active_tool, state_.position_m, hand.blade_in_tissue, refitted);
+      if (!refitted) refitted = &hand.tools->bvh();
       step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
     }
     return StepInputs{{}, step_springs_};

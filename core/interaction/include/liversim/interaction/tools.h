@@ -191,9 +191,11 @@ class ToolInteraction {
   // The springs for the next interval at the tool's pose and the tissue's `position`. A scalpel
   // whose blade is cutting (`blade_cuts`) does not push: it passes into the tissue it separates,
   // its shaft too when deeper than the blade (cutting_edge_m). Allocates nothing (every buffer is
-  // sized for the whole surface at construction).
+  // sized for the whole surface at construction). Given `refitted`, the hierarchy of another
+  // interaction over the same surface already refitted to `position` (the other hand's, this
+  // step), it is queried instead of refitting this one's: the same boxes, half the refits.
   std::span<const NodeSpring> update(const Tool& tool, const NodeArray& position,
-                                     bool blade_cuts = false);
+                                     bool blade_cuts = false, const SurfaceBvh* refitted = nullptr);
   // The springs of the last update.
   std::span<const NodeSpring> springs() const { return springs_; }
 
@@ -224,7 +226,7 @@ class ToolInteraction {
   const SurfaceBvh& bvh() const { return bvh_; }
 
  private:
-  void try_grasp(const Tool& tool, const NodeArray& position);
+  void try_grasp(const Tool& tool, const NodeArray& position, const SurfaceBvh& hierarchy);
 
   const SimModel* model_;
   SurfaceBvh bvh_;

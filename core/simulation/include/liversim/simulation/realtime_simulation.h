@@ -406,6 +406,9 @@ class RealtimeSimulation {
   void cut_with_scalpel(HandInLoop& hand);
   // At the end of the hand's stroke: the holes and strands its cut left are parted (part_remnants).
   void part_remnants_of(HandInLoop& hand);
+  // The surface hierarchy the last step refitted: the first acting hand's (tool_inputs in
+  // advance_cycle); the other hand queries it. Only while a hand acts.
+  const SurfaceBvh& step_hierarchy() const;
   void part_remnants_due();
   // A cut of the hand's scalpel swapped in (when it cut), and traced with the update's time.
   void swap_in_cut(const HandInLoop& hand, CutResult cut,
