@@ -154,12 +154,13 @@ std::array<Eigen::Vector3d, 2> cutting_edge_m(const Tool& scalpel);
 // whether the edge passes through an element or within about `reach_m` of one (its faces pushed
 // out by that much). One walk over the nodes and one over the elements' corner indices; allocates
 // nothing once `node_scratch` holds a byte per node (without it, a vector of its own).
-inline constexpr double kEdgeInTissueMarginM = 1e-6;
 struct EdgeInTissue {
   double length_m = 0.0;
   double resistance_n = 0.0;
   bool within_reach = false;
 };
+// edge_in_tissue's margin unless told (m).
+inline constexpr double kEdgeInTissueMarginM = 1e-6;
 EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
                             const std::array<Eigen::Vector3d, 2>& edge_m, double reach_m = 0.0,
                             double margin_m = kEdgeInTissueMarginM,
