@@ -73,6 +73,38 @@ TEST(Support, UnderASlopeTheBedHasTheSlopesGradient) {
   EXPECT_NEAR(gradient.y(), 0.0, 1e-9);
 }
 
+// The push is the penalty of the distance along the bed's normal, k times it, whatever the slope:
+// on a plane falling at rise over run s, a point p past it (along gravity) lies p/√(1 + s²) from
+// it. So pressed further along the normal a node meets the stiffness k, the contact frequency
+// support_stiffness_per_kg promises: a penalty of the depth along gravity was (1 + s²) times as
+// stiff across a slope (×7.25 at s = 2.5), and on the bed's steep rim it loaded the light nodes
+// there with several times the organ's weight above them.
+TEST(Support, OnASlopeItPushesAlongItsNormalByTheDistanceAlongIt) {
+  constexpr double kSlope = 2.5, kStiffness = 100.0, kPast = 0.002, kFurther = 1e-4;
+  SupportSurface plane;
+  plane.down = {0.0, 0.0, -1.0};
+  plane.axis_u = {1.0, 0.0, 0.0};
+  plane.axis_v = plane.down.cross(plane.axis_u);
+  plane.cell_m = 0.01;
+  plane.cells_u = plane.cells_v = 4;
+  for (int j = 0; j <= 4; ++j)
+    for (int i = 0; i <= 4; ++i) plane.depth_m.push_back(kSlope * i * plane.cell_m);
+  plane.floor_depth_m = 1.0;
+  const Eigen::Vector3d normal = Eigen::Vector3d(kSlope, 0.0, 1.0).normalized();  // out of it
+  const Eigen::Vector3d point(0.02, -0.02, -(kSlope * 0.02 + kPast));
+  const SupportContact pressed = support_contact(plane, point, point, kStiffness, 0.0);
+  const double distance_m = kPast / std::sqrt(1.0 + kSlope * kSlope);
+  ASSERT_TRUE(pressed.touching);
+  EXPECT_NEAR((pressed.force_n - kStiffness * distance_m * normal).norm(), 0.0,
+              1e-12 * kStiffness * distance_m);
+  EXPECT_NEAR(pressed.energy_j, 0.5 * kStiffness * distance_m * distance_m,
+              1e-12 * kStiffness * distance_m * distance_m);
+  const SupportContact deeper =
+      support_contact(plane, point - kFurther * normal, point, kStiffness, 0.0);
+  EXPECT_NEAR((deeper.force_n - pressed.force_n).dot(normal), kStiffness * kFurther,
+              1e-9 * kStiffness * kFurther);
+}
+
 SimModel resting_model(const TetMesh& mesh, double damping_per_s,
                        double contact_damping_ratio = 1.0) {
   ModelOptions options;

@@ -187,11 +187,16 @@ SupportContact support_contact(const SupportSurface& support, const Eigen::Vecto
   if (!(past > 0.0)) return contact;
   contact.touching = true;
   const double k = stiffness_n_per_m;
-  // −∇(½·k·p²), p = x·down − depth(u, v).
-  const Eigen::Vector3d push =
-      -k * past * (support.down - under.slope_u * support.axis_u - under.slope_v * support.axis_v);
+  // ½·k·(p/|∇|)² with ∇ = ∇(x·down − depth(u, v)): the penalty of the distance along the bed's
+  // normal, so a node pressed along it meets k on a slope as on the flat (the depth along gravity
+  // alone was (1 + slope²) times as stiff across the rim's walls). The slope's change within a
+  // cell is left out of the force, as the bilinear bed's creases are.
+  const Eigen::Vector3d gradient =
+      support.down - under.slope_u * support.axis_u - under.slope_v * support.axis_v;
+  const double steepness = gradient.squaredNorm();  // 1 + |∇depth|²
+  const Eigen::Vector3d push = -k * past / steepness * gradient;
   contact.force_n = push;
-  contact.energy_j = 0.5 * k * past * past;
+  contact.energy_j = 0.5 * k * past * past / steepness;
   // The hold: the force −min(k·d, μ·P·(1 − d/R)) along the offset d across gravity, the gradient
   // of its potential for the push P as it is now.
   Eigen::Vector3d offset = position_m - rest_position_m;

@@ -48,7 +48,7 @@ double tissue_energy_j(const SimModel& model, const SimState& state);
 double spring_energy_j(std::span<const NodeSpring> springs, const NodeArray& position);
 // −Σ m·g·(x − X) over the nodes: the work gravity would do bringing the organ back to rest.
 double gravity_potential_energy_j(const SimModel& model, const NodeArray& position);
-// Σ ½·k·p² over the free nodes deeper than the model's support by p (0 without one).
+// Σ ½·k·d² over the free nodes past the model's support by d along its normal (0 without one).
 double support_energy_j(const SimModel& model, const NodeArray& position);
 
 EnergyBalance energy_balance(const SimModel& model, const SimState& state,

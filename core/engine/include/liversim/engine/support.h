@@ -4,9 +4,10 @@
 // organs and the wall it lies on, as a mould of it); around it, a flat tray at the organ's lowest
 // point, where a piece that comes free lands. A height field on a grid across gravity, bilinear
 // between grid points: a point deeper (farther along gravity) than the support is pushed back by a
-// penalty spring, the gradient of ½·k·p² with p the depth past the support and k = m·ω², so that
-// every node meets the same contact frequency ω and a light node pushes no harder than a heavy
-// one. On a slope the push has a sideways part: the bed holds the organ as a bowl would.
+// penalty spring along the support's normal, k times its distance past it along the normal
+// (p/√(1 + slope²), p its depth past it along gravity), k = m·ω², so that every node meets the
+// same contact frequency ω, on a slope as on the flat, and a light node pushes no harder than a
+// heavy one. On a slope the push has a sideways part: the bed holds the organ as a bowl would.
 //
 // The bed also holds the organ where it lay: a node touching it is pulled back across gravity
 // toward its rest place by the same k, up to μ times the push (static friction anchored at the
@@ -63,7 +64,8 @@ inline constexpr double kSupportHoldReleaseM = 0.01;
 struct SupportContact {
   bool touching = false;
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
-  double energy_j = 0.0;  // ½·k·p² of the push and the hold's potential
+  double energy_j = 0.0;  // ½·k·d² of the push (d its distance past the support along the normal)
+                          // and the hold's potential
 };
 SupportContact support_contact(const SupportSurface& support, const Eigen::Vector3d& position_m,
                                const Eigen::Vector3d& rest_position_m, double stiffness_n_per_m,
