@@ -297,6 +297,12 @@ TEST_F(StationTest, ARecordedSessionReplaysItsDeviceInputAndIsNotRecordedAgain) 
   const std::int64_t session = *station_->recording_session();
   ASSERT_TRUE(servoTicks(500));
   ASSERT_FALSE(station_->use_device(DeviceChoice::mouse, WorkspaceMapping{}));
+  // The display has seen the mouse (at the origin), whose loop publishes until the next change:
+  // none of its snapshots may be shown once the replay is chosen.
+  ASSERT_TRUE(frameUntil([&] {
+    const auto sample = snapshot().hand(Hand::right).device_sample;
+    return sample && sample->position_mm.norm() == 0.0;
+  }));
   const std::optional<DeviceRefusal> none =
       station_->use_device(DeviceChoice::replay, WorkspaceMapping{});
   ASSERT_TRUE(none);
@@ -313,6 +319,7 @@ TEST_F(StationTest, ARecordedSessionReplaysItsDeviceInputAndIsNotRecordedAgain) 
   EXPECT_EQ(station_->servo()->mapping().scale, 1.0);
   EXPECT_FALSE(station_->recording_session()) << "a replay was recorded";
   const Eigen::Vector3d along = (end_mm - start_mm).normalized();
+  station_->frame();  // the display's first frame since the choice
   ASSERT_TRUE(frameUntil([&] {
     const auto sample = snapshot().hand(Hand::right).device_sample;
     if (!sample) return false;

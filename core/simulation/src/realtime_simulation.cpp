@@ -427,6 +427,9 @@ void RealtimeSimulation::set_haptic_servo(ServoLoop* servo) {
   if (running()) throw std::logic_error("set_haptic_servo: stop the simulation first");
   haptic_servo_ = servo;
   for (HandInLoop& hand : hands_) hand.device_sample.reset();
+  // The display's next snapshot holds no sample of the device gone (a replay's first frame
+  // showed the mouse's when the old loop's last snapshot was still the newest).
+  publish_cycle(Publish::snapshot_only);
 }
 
 void RealtimeSimulation::set_device_tool(Hand which,
@@ -742,7 +745,7 @@ void RealtimeSimulation::publish_time_to(std::atomic<double>* clock_s) {
   if (published_clock_s_) published_clock_s_->store(state_.time_s, std::memory_order_relaxed);
 }
 
-void RealtimeSimulation::publish_cycle() {
+void RealtimeSimulation::publish_cycle(Publish what) {
   SimulationSnapshot& out = snapshots_.back();
   // Same size: copies without allocating (a cut's new size allocates once).
   out.position_m.x = state_.position_m.x;
@@ -763,7 +766,7 @@ void RealtimeSimulation::publish_cycle() {
       seen.grasping = seen.blade_cutting = false;
       seen.contacts = 0;
       seen.blade_edge_in_tissue_m = 0.0;
-      if (haptic_servo_) haptic_servo_->publish(which, LocalForceModel{});
+      if (haptic_servo_ && what == Publish::cycle) haptic_servo_->publish(which, LocalForceModel{});
       continue;
     }
     // The local model of the force on the tool: its F0 is the snapshot's tool force.
@@ -779,9 +782,9 @@ void RealtimeSimulation::publish_cycle() {
     seen.blade_edge_in_tissue_m =
         cutting_ && held.active_tool->kind == ToolKind::scalpel ? held.blade_edge_in_tissue_m : 0.0;
     seen.tool = held.active_tool;
-    if (haptic_servo_) haptic_servo_->publish(which, force_model);
+    if (haptic_servo_ && what == Publish::cycle) haptic_servo_->publish(which, force_model);
   }
-  observe_outcome();
+  if (what == Publish::cycle) observe_outcome();
   out.model = model_;
   out.topology_version = topology_version_;
   out.resected_volume_m3 = resected_volume_m3_;

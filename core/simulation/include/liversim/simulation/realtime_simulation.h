@@ -425,8 +425,11 @@ class RealtimeSimulation {
   void take_tool(Hand hand, const std::optional<Tool>& tool);
   // A cycle's steps, guarded, and the cut of a scalpel in the tissue after them.
   GuardedReport advance_cycle(int steps, bool check_energy);
-  // The snapshot of the cycle just taken (and the force model to the servo, if any).
-  void publish_cycle();
+  // A cycle's publication: the snapshot, each hand's force model to the servo, the outcome's
+  // observation. Outside the loop only the snapshot, so that the servo and the outcome see the
+  // same cycles a replay does.
+  enum class Publish { cycle, snapshot_only };
+  void publish_cycle(Publish what = Publish::cycle);
   void log_input(SimulationInput input);  // simulation thread, when logging_inputs_
   std::atomic<bool> logging_inputs_{false};
   std::mutex input_log_mutex_;              // UI ↔ simulation only
