@@ -1668,6 +1668,10 @@ The scene that was running goes on.</source>
         <translation>隐式步未收敛</translation>
     </message>
     <message>
+        <source>the step fell below a thousandth of its value at rest (tissue drawn or crushed past what the step can follow)</source>
+        <translation>步长降至静止时的千分之一以下（组织被拉伸或挤压到步长无法跟随的程度）</translation>
+    </message>
+    <message>
         <source>unknown problem</source>
         <translation>未知问题</translation>
     </message>

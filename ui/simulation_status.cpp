@@ -92,6 +92,11 @@ QString healthProblemText(HealthProblem problem) {
     case HealthProblem::solver_failed:
       return QCoreApplication::translate("liversim::MainWindow",
                                          "an implicit step did not converge");
+    case HealthProblem::step_collapsed:
+      return QCoreApplication::translate(
+          "liversim::MainWindow",
+          "the step fell below a thousandth of its value at rest (tissue drawn or crushed past "
+          "what the step can follow)");
   }
   return QCoreApplication::translate("liversim::MainWindow", "unknown problem");
 }

@@ -220,6 +220,38 @@ TEST(Guard, UnconvergedImplicitStepsAreRolledBack) {
   EXPECT_EQ(state.time_s, 0.0);
 }
 
+// A step that has collapsed (here the travel limit of a node thrown so fast that it allows only a
+// two-thousandth of the rest step) ends the advance at once rather than holding it
+// for a thousand evaluations and more, and the guard takes it as a problem: it retries, then gives
+// up on the checkpoint. A cycle stuck so had frozen the liver for minutes with nothing said.
+TEST(Guard, AStepFallenBelowAThousandthOfItsRestValueEndsTheAdvanceAndIsAProblem) {
+  const TetMesh mesh = testing::block_mesh(4, 1, 1, {0.04, 0.01, 0.01});
+  const SimModel model = build_model(mesh, ModelOptions{});
+  ASSERT_GT(model.stable_time_step_s, 0.0);
+  const double collapsing_speed_m_per_s =
+      0.1 * model.min_element_height_m / (0.5 * kCollapsedStepFraction * model.stable_time_step_s);
+  SimState state = make_rest_state(model);
+  state.velocity_m_per_s.x[0] = state.max_speed_m_per_s = collapsing_speed_m_per_s;
+  const StepReport steps = advance(model, state, {}, 10.0 * model.stable_time_step_s);
+  EXPECT_TRUE(steps.step_collapsed);
+  EXPECT_EQ(steps.substeps, 0);
+  EXPECT_EQ(steps.force_evaluations, 1);
+
+  SimState thrown = make_rest_state(model);
+  thrown.velocity_m_per_s.x[0] = thrown.max_speed_m_per_s = collapsing_speed_m_per_s;
+  StateCheckpoint checkpoint = make_checkpoint(model);
+  GuardOptions guard;
+  guard.kinetic_energy_slack = 1e12;  // the energy check and the speed backstop would flag the
+  guard.speed_limit_m_per_s = 1e12;   // throw itself
+  const GuardedReport report =
+      guarded_advance(model, thrown, {}, 10.0 * model.stable_time_step_s, checkpoint, guard);
+  EXPECT_EQ(report.problem, HealthProblem::step_collapsed);
+  EXPECT_TRUE(report.gave_up);
+  EXPECT_EQ(report.rollbacks, guard.max_retries + 1);
+  EXPECT_EQ(thrown.time_s, 0.0);
+  EXPECT_NE(health_problem_text(HealthProblem::step_collapsed), "unknown");
+}
+
 INSTANTIATE_TEST_SUITE_P(Integrators, GuardFixture, ::testing::ValuesIn(kAllIntegrators),
                          [](const auto& info) {
                            std::string name(integrator_name(info.param));

@@ -25,6 +25,9 @@ std::string_view health_problem_text(HealthProblem problem) {
       return "a node held more kinetic energy than was ever supplied";
     case HealthProblem::solver_failed:
       return "an implicit step did not converge";
+    case HealthProblem::step_collapsed:
+      return "the explicit step fell below a thousandth of the mesh's at rest (tissue drawn or "
+             "crushed past what the step can follow)";
   }
   return "unknown";
 }
@@ -132,6 +135,7 @@ GuardedReport guarded_advance(const SimModel& model, SimState& state, const Step
         advance(model, state, effective, interval_s, options.whole_step_s, options.give_up);
     // An unconverged implicit step is not a solution, however finite it looks.
     const HealthProblem problem = steps.unconverged_steps > 0 ? HealthProblem::solver_failed
+                                  : steps.step_collapsed      ? HealthProblem::step_collapsed
                                                               : check_health(model, state, options);
     if (problem == HealthProblem::none) {
       // Newest good. After a rollback always: a caller saving seldom (the real-time loop, every 5

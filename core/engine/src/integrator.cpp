@@ -152,6 +152,7 @@ double stability_interval(IntegratorKind kind) {
 
 void accumulate(StepReport& total, const StepReport& part) {
   total.gave_up_early |= part.gave_up_early;
+  total.step_collapsed |= part.step_collapsed;
   if (part.substeps == 0) return;
   if (total.substeps == 0) {
     total.smallest_substep_s = part.smallest_substep_s;
@@ -477,6 +478,10 @@ double advance_central_difference(const SimModel& model, SimState& state, const 
       const double travel_limit = 0.1 * model.min_element_height_m / state.max_speed_m_per_s;
       report.smallest_travel_limit_s = std::min(report.smallest_travel_limit_s, travel_limit);
       limit = std::min(limit, travel_limit);
+    }
+    if (limit < kCollapsedStepFraction * model.stable_time_step_s) {
+      report.step_collapsed = true;
+      return advanced_s;
     }
     double step = limit;
     if (requested_s > 0.0) {

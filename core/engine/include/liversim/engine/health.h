@@ -22,6 +22,7 @@ enum class HealthProblem : std::uint8_t {
   runaway_speed,        // a node moved faster than the speed limit (a backstop)
   runaway_energy,       // a node held more kinetic energy than was ever supplied
   solver_failed,        // an implicit step's Newton iteration did not converge
+  step_collapsed,       // the explicit step fell below kCollapsedStepFraction of its rest value
 };
 std::string_view health_problem_text(HealthProblem problem);
 

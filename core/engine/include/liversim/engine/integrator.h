@@ -60,7 +60,10 @@ struct StepReport {
   int rejected_steps = 0;      // dopri5: steps redone because the error was too large
   int force_evaluations = 0;   // internal-force evaluations of the whole mesh
   bool gave_up_early = false;  // advance's give_up ended the interval before its end
-  int newton_iterations = 0;   // implicit schemes
+  // Central difference: the interval ended early because the step it could take had fallen below
+  // kCollapsedStepFraction of the model's stable step at rest (see there).
+  bool step_collapsed = false;
+  int newton_iterations = 0;  // implicit schemes
   int linear_solves = 0;
   int factorizations = 0;
   int unconverged_steps = 0;  // implicit steps whose Newton iteration hit its limit
@@ -86,6 +89,14 @@ double max_frequency_rad_per_s(const SimModel& model, const StepInputs& inputs,
 // Stiffening relative to rest of what a force evaluation saw (compression, stretched fibres).
 double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& seen);
 
+// Below this fraction of the model's stable step at rest (a stiffening of a million, or a node
+// fast enough to cross a tenth of the smallest element within it), central difference ends the
+// interval where it is (StepReport::step_collapsed) rather than go on: a real-time cycle's 0.43 ms
+// would take a thousand force evaluations or more, and nothing else bounds an interval's work (a
+// paced run lifting a specimen under gravity stood still for ten minutes, issue 42). The guard
+// takes it as a problem (health.h).
+inline constexpr double kCollapsedStepFraction = 1e-3;
+
 // Advances the state by exactly `interval_s` with the model's integrator, in steps of
 // model.integrator.step_s (0: the stable step of explicit schemes), shortened where an explicit
 // scheme's stability limit requires it, and equalised so that the interval ends exactly. Allocates
@@ -100,7 +111,8 @@ double stiffening_since_rest(const SimModel& model, const ElasticEvaluation& see
 //
 // `give_up` set (central difference): the interval ends early, where the step under way ends, once
 // it reads true (StepReport::gave_up_early): a loop asked to stop is not held for the rest of an
-// interval whose steps have fallen to microseconds.
+// interval whose steps have fallen to microseconds. It also ends early, with step_collapsed, where
+// its step falls below kCollapsedStepFraction of model.stable_time_step_s.
 StepReport advance(const SimModel& model, SimState& state, const StepInputs& inputs,
                    double interval_s, double whole_step_s = 0.0,
                    const std::atomic<bool>* give_up = nullptr);
