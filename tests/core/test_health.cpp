@@ -221,9 +221,9 @@ TEST(Guard, UnconvergedImplicitStepsAreRolledBack) {
 }
 
 // A step that has collapsed (here the travel limit of a node thrown so fast that it allows only a
-// two-thousandth of the rest step) ends the advance at once rather than holding it
-// for a thousand evaluations and more, and the guard takes it as a problem: it retries, then gives
-// up on the checkpoint. A cycle stuck so had frozen the liver for minutes with nothing said.
+// two-thousandth of the rest step) ends the advance at once rather than holding it for a thousand
+// evaluations and more, and the guard takes it as a problem: it retries, then gives up on the
+// checkpoint, and says why.
 TEST(Guard, AStepFallenBelowAThousandthOfItsRestValueEndsTheAdvanceAndIsAProblem) {
   const TetMesh mesh = testing::block_mesh(4, 1, 1, {0.04, 0.01, 0.01});
   const SimModel model = build_model(mesh, ModelOptions{});
@@ -249,7 +249,7 @@ TEST(Guard, AStepFallenBelowAThousandthOfItsRestValueEndsTheAdvanceAndIsAProblem
   EXPECT_TRUE(report.gave_up);
   EXPECT_EQ(report.rollbacks, guard.max_retries + 1);
   EXPECT_EQ(thrown.time_s, 0.0);
-  EXPECT_NE(health_problem_text(HealthProblem::step_collapsed), "unknown");
+  EXPECT_NE(health_problem_text(report.problem).find("step fell below"), std::string_view::npos);
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, GuardFixture, ::testing::ValuesIn(kAllIntegrators),
