@@ -101,6 +101,9 @@ RealtimeSimulation::RealtimeSimulation(std::shared_ptr<const SimModel> model,
   field_m_.min().array() -= kFieldMarginM;
   field_m_.max().array() += kFieldMarginM;
   free_bodies_ = free_bodies(*model_);
+  if (!free_bodies_.empty())
+    body_contact_ = BodyContact(*model_, boundary_surface(*model_), free_bodies_);
+  step_springs_.reserve(options_.spring_capacity + body_contact_.max_springs());
 }
 
 RealtimeSimulation::~RealtimeSimulation() {
@@ -137,11 +140,13 @@ void RealtimeSimulation::enable_tools(const BoundarySurface& surface, ContactSet
                                       GraspSettings grasp) {
   if (running()) throw std::logic_error("enable_tools: stop the simulation first");
   for (HandInLoop& hand : hands_) hand.tools.emplace(*model_, surface, contact, grasp);
+  tools_hold_model_boundary_ = false;  // the caller's surface (the scene's drawn one)
   contact_settings_ = contact;
   grasp_settings_ = grasp;
   // The set springs and at most two per surface node from each hand's tool (hold and contact):
   // no reallocation in a step.
-  step_springs_.reserve(options_.spring_capacity + 2 * hands_.size() * surface.nodes.size());
+  step_springs_.reserve(options_.spring_capacity + 2 * hands_.size() * surface.nodes.size() +
+                        body_contact_.max_springs());
 }
 
 void RealtimeSimulation::enable_cutting(CuttingSettings settings) {
@@ -284,9 +289,13 @@ void RealtimeSimulation::swap_in(CutResult change, std::span<const TetIndex> bod
     ForcepsGrasp held;
     if (hand.tools && hand.tools->grasp()) held = *hand.tools->grasp();
     hand.tools.emplace(*model_, surface, contact_settings_, grasp_settings_);
+    tools_hold_model_boundary_ = true;
     hand.tools->carry_hold(held, change.node_origin);
   }
-  step_springs_.reserve(options_.spring_capacity + 2 * hands_.size() * surface.nodes.size());
+  free_bodies_ = free_bodies(*model_);
+  body_contact_ = BodyContact(*model_, surface, free_bodies_);
+  step_springs_.reserve(options_.spring_capacity + 2 * hands_.size() * surface.nodes.size() +
+                        body_contact_.max_springs());
   {
     std::lock_guard lock(springs_mutex_);
     pending_springs_.clear();
@@ -294,7 +303,6 @@ void RealtimeSimulation::swap_in(CutResult change, std::span<const TetIndex> bod
   }
   active_springs_.clear();
   ++topology_version_;
-  free_bodies_ = free_bodies(*model_);
 }
 
 bool RealtimeSimulation::take_out_free_bodies(bool all) {
@@ -582,7 +590,10 @@ void merge_guarded(GuardedReport& total, const GuardedReport& one) {
 
 GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   const SimModel& model = *model_;  // a cut may replace it between cycles
-  const bool tool_acts =
+  // Tools and bodies in contact push with springs that follow the surface: made before every
+  // step.
+  const bool springs_follow_surface =
+      body_contact_.active() ||
       std::any_of(hands_.begin(), hands_.end(), [](const HandInLoop& h) { return h.acts(); });
   // Guarded: a bad step goes back to the last good state and is retried with shorter steps; a
   // bad input (a NaN from a device) is refused.
@@ -591,7 +602,7 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   // The tools' springs follow the surface: recomputed before every step of the cycle.
   // The hands hold the same surface: the first that acts refits its hierarchy, the other queries
   // it (step_hierarchy).
-  auto tool_inputs = [&] {
+  auto step_inputs = [&] {
     step_springs_.assign(active_springs_.begin(), active_springs_.end());
     const SurfaceBvh* refitted = nullptr;
     for (HandInLoop& hand : hands_) {
@@ -601,6 +612,10 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
       if (!refitted) refitted = &hand.tools->bvh();
       step_springs_.insert(step_springs_.end(), tool_springs.begin(), tool_springs.end());
     }
+    // On the same surface as the hands' (after a cut, swap_in), their hierarchy refitted this
+    // step serves.
+    body_contact_.add_springs(model, state_.position_m, step_springs_,
+                              tools_hold_model_boundary_ ? refitted : nullptr);
     return StepInputs{{}, step_springs_};
   };
   // Whole steps as long as the limits allow, up to the loop's step: the state may end a little
@@ -628,7 +643,7 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
     return one;
   };
   GuardedReport guarded;
-  if (tool_acts) {
+  if (springs_follow_surface) {
     bool first = true;
     for (int s = 0; s < steps && !give_up_cycle_.load(std::memory_order_relaxed); ++s) {
       const double interval_s = step_s_ - loop_lead_s_;
@@ -643,7 +658,7 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
       step_guard.check_energy = guard.check_energy && first;
       step_guard.checkpoint_on_entry = checkpoint_due && first;
       first = false;
-      const GuardedReport one = advance_by(interval_s, tool_inputs(), step_guard);
+      const GuardedReport one = advance_by(interval_s, step_inputs(), step_guard);
       merge_guarded(guarded, one);
       if (one.gave_up) break;
     }

@@ -15,6 +15,7 @@
 #include "liversim/haptics/servo_loop.h"
 #include "liversim/haptics/spsc_ring.h"
 #include "liversim/haptics/triple_buffer.h"
+#include "liversim/interaction/body_contact.h"
 #include "liversim/interaction/cutting.h"
 #include "liversim/interaction/simulation_input.h"
 #include "liversim/interaction/tools.h"
@@ -383,7 +384,8 @@ class RealtimeSimulation {
   };
   std::array<HandInLoop, kHands.size()> hands_;
   HandInLoop& hand(Hand which) { return hands_[hand_index(which)]; }
-  std::vector<NodeSpring> step_springs_;  // a step's springs: the set ones and the tools'
+  // A step's springs: the set ones, the tools' and the bodies' contacts'.
+  std::vector<NodeSpring> step_springs_;
   ContactSettings contact_settings_;
   GraspSettings grasp_settings_;
   std::optional<CuttingSettings> cutting_;
@@ -393,6 +395,10 @@ class RealtimeSimulation {
   // the model changes) and those taken out.
   Eigen::AlignedBox3d field_m_;
   std::vector<FreeBody> free_bodies_;
+  BodyContact body_contact_;  // between the organ and the free bodies (none: inactive)
+  // The hands' tools hold boundary_surface(*model_), the one body_contact_ is built on (a cut's
+  // swap_in builds both from it), not a surface enable_tools was given.
+  bool tools_hold_model_boundary_ = false;
   int specimens_taken_out_ = 0;
   double specimens_taken_out_m3_ = 0.0;
   std::atomic<bool> take_out_requested_{false};
