@@ -36,16 +36,7 @@ BodyContact::BodyContact(const SimModel& model, const BoundarySurface& surface,
     lightest_kg = std::min(lightest_kg, model.lumped_mass_kg[static_cast<std::size_t>(n)]);
   const double omega = model.support_frequency_fraction * model.max_frequency_rad_per_s;
   stiffness_n_per_m_ = omega * omega * lightest_kg;
-  stiffness_sum_.assign(model.node_count, 0.0);
-  weighted_anchor_sum_.assign(model.node_count, Eigen::Vector3d::Zero());
-  touched_.reserve(surface_nodes_.size());
-}
-
-void BodyContact::push(NodeIndex node, const Eigen::Vector3d& anchor_m, double stiffness_n_per_m) {
-  const auto n = static_cast<std::size_t>(node);
-  if (stiffness_sum_[n] == 0.0) touched_.push_back(node);
-  stiffness_sum_[n] += stiffness_n_per_m;
-  weighted_anchor_sum_[n] += stiffness_n_per_m * anchor_m;
+  scratch_.resize(model.node_count);
 }
 
 void BodyContact::add_springs(const SimModel& model, const NodeArray& position,
@@ -98,22 +89,13 @@ void BodyContact::add_springs(const SimModel& model, const NodeArray& position,
     if (face < 0) continue;
     ++contacts_;
     const auto& corner = triangles[static_cast<std::size_t>(face)];
-    const double stiffness = stiffness_n_per_m_;
-    push(node, x + depth_m * normal, stiffness);
+    const Eigen::Vector3d push_n = stiffness_n_per_m_ * depth_m * normal;
+    scratch_.add(node, push_n, stiffness_n_per_m_);
     for (int i = 0; i < 3; ++i)
       if (weights[i] > 0.0)
-        push(corner[i], position.at(corner[i]) - depth_m * normal, weights[i] * stiffness);
+        scratch_.add(corner[i], -weights[i] * push_n, weights[i] * weights[i] * stiffness_n_per_m_);
   }
-  for (const NodeIndex node : touched_) {
-    const auto n = static_cast<std::size_t>(node);
-    const double k = stiffness_sum_[n];
-    springs.push_back(NodeSpring{
-        node, weighted_anchor_sum_[n] / k, k,
-        model.support_damping_ratio * critical_damping_n_s_per_m(k, model.lumped_mass_kg[n])});
-    stiffness_sum_[n] = 0.0;
-    weighted_anchor_sum_[n].setZero();
-  }
-  touched_.clear();
+  scratch_.add_springs(model, position, springs, model.support_damping_ratio);
 }
 
 }  // namespace liversim

@@ -244,9 +244,8 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
             const auto node = static_cast<std::size_t>(triangle[i]);
             if (model.inverse_mass_per_kg[node] == 0.0 || closest.weight[i] == 0.0) continue;
             free_weight += closest.weight[i];
-            if (scratch.stiffness_n_per_m[node] == 0.0) scratch.touched.push_back(triangle[i]);
-            scratch.stiffness_n_per_m[node] += closest.weight[i] * closest.weight[i] * stiffness;
-            scratch.force_n[node] += closest.weight[i] * stiffness * push;
+            scratch.add(triangle[i], closest.weight[i] * stiffness * push,
+                        closest.weight[i] * closest.weight[i] * stiffness);
           }
           if (per_part.empty() || free_weight == 0.0) return;
           PartContact& met = per_part[p];
@@ -266,17 +265,21 @@ std::size_t add_contact_springs(const SimModel& model, const SurfaceBvh& bvh,
           met.touched_cut_face |= t < cut_triangle.size() && cut_triangle[t] != 0;
         });
   }
-  // One spring per node, giving its summed force at `position` with its summed stiffness.
-  for (NodeIndex n : scratch.touched) {
+  return scratch.add_springs(model, position, springs);
+}
+
+std::size_t ContactScratch::add_springs(const SimModel& model, const NodeArray& position,
+                                        std::vector<NodeSpring>& springs, double damping_ratio) {
+  for (NodeIndex n : touched) {
     const auto node = static_cast<std::size_t>(n);
-    const double k = scratch.stiffness_n_per_m[node];
-    springs.push_back({n, position.at(n) + scratch.force_n[node] / k, k,
-                       critical_damping_n_s_per_m(k, model.lumped_mass_kg[node])});
-    scratch.stiffness_n_per_m[node] = 0.0;
-    scratch.force_n[node].setZero();
+    const double k = stiffness_n_per_m[node];
+    springs.push_back({n, position.at(n) + force_n[node] / k, k,
+                       damping_ratio * critical_damping_n_s_per_m(k, model.lumped_mass_kg[node])});
+    stiffness_n_per_m[node] = 0.0;
+    force_n[node].setZero();
   }
-  const std::size_t added = scratch.touched.size();
-  scratch.touched.clear();
+  const std::size_t added = touched.size();
+  touched.clear();
   return added;
 }
 

@@ -289,9 +289,9 @@ void RealtimeSimulation::swap_in(CutResult change, std::span<const TetIndex> bod
     ForcepsGrasp held;
     if (hand.tools && hand.tools->grasp()) held = *hand.tools->grasp();
     hand.tools.emplace(*model_, surface, contact_settings_, grasp_settings_);
-    tools_hold_model_boundary_ = true;
     hand.tools->carry_hold(held, change.node_origin);
   }
+  tools_hold_model_boundary_ = true;
   free_bodies_ = free_bodies(*model_);
   body_contact_ = BodyContact(*model_, surface, free_bodies_);
   step_springs_.reserve(options_.spring_capacity + 2 * hands_.size() * surface.nodes.size() +
@@ -599,7 +599,6 @@ GuardedReport RealtimeSimulation::advance_cycle(int steps, bool check_energy) {
   // bad input (a NaN from a device) is refused.
   GuardOptions guard;
   guard.check_energy = check_energy;
-  // The tools' springs follow the surface: recomputed before every step of the cycle.
   // The hands hold the same surface: the first that acts refits its hierarchy, the other queries
   // it (step_hierarchy).
   auto step_inputs = [&] {

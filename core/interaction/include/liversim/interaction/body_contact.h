@@ -6,20 +6,21 @@
 // on the face (node-to-surface penalty contact, as SOFA's and most surgical simulators' is). The
 // springs are made before every step from the positions then (as the tools' are), so that the
 // integrators, the step's limit and the energy books take them like any tool's spring: a freed
-// specimen rests on the organ instead of falling through it, and forceps pressing it into the
-// organ meet the organ.
+// specimen rests on the organ instead of falling through it.
 //
 // The penalty's frequency is the support's (SimModel::support_frequency_fraction of the mesh's
 // highest): k = ω_c²·m with m the lightest surface node's mass, the same for every contact, so
-// that the push is the gradient of ½·k·d² and no spring of one contact is faster than ω_c; a node
-// in several contacts takes one spring with their sum. Each spring is critically damped (as the
-// support is). Frictionless.
+// that the push is the gradient of ½·k·d² and no spring of one contact is faster than ω_c. A
+// corner of weight w takes w·k·d and stiffness w²·k (as a tool's contact shares its push); a node
+// in several contacts takes one spring with their sums (ContactScratch), damped as the support
+// is. Frictionless.
 
 #include "liversim/engine/forces.h"
 #include "liversim/engine/model.h"
 #include "liversim/engine/surface.h"
 #include "liversim/engine/surface_bvh.h"
 #include "liversim/interaction/cutting.h"
+#include "liversim/interaction/tools.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -42,7 +43,7 @@ class BodyContact {
 
   bool active() const { return !hierarchy_.empty(); }
   // The most springs add_springs appends (for a caller that reserves so as not to allocate).
-  std::size_t max_springs() const { return touched_.capacity(); }
+  std::size_t max_springs() const { return surface_nodes_.size(); }
 
   // Appends the springs of every contact at `position` to `springs`. `refitted`: a hierarchy of
   // the same surface already refitted to `position` (a tool's, this step), queried instead of
@@ -53,19 +54,13 @@ class BodyContact {
   std::size_t contacts() const { return contacts_; }
 
  private:
-  // A spring's share before the springs on one node are summed into one.
-  void push(NodeIndex node, const Eigen::Vector3d& anchor_m, double stiffness_n_per_m);
-
   SurfaceBvh hierarchy_;
   std::vector<std::int32_t> body_of_triangle_;  // 0: the organ, 1 + i: free body i
   std::vector<NodeIndex> surface_nodes_;
   std::vector<std::int32_t> body_of_surface_node_;
   std::vector<Aabb> body_box_;      // per body, for one add_springs
   double stiffness_n_per_m_ = 0.0;  // ω_c²·(the lightest surface node's mass)
-  // Per mesh node, for one add_springs: the summed stiffness and stiffness-weighted anchor.
-  std::vector<double> stiffness_sum_;
-  std::vector<Eigen::Vector3d> weighted_anchor_sum_;
-  std::vector<NodeIndex> touched_;
+  ContactScratch scratch_;          // per mesh node, for one add_springs
   std::size_t contacts_ = 0;
 };
 

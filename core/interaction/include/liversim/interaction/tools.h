@@ -129,6 +129,17 @@ struct ContactScratch {
     touched.clear();
     touched.reserve(nodes);
   }
+  // Adds a share to the node's sums: its force at the positions evaluated and its stiffness.
+  void add(NodeIndex node, const Eigen::Vector3d& share_force_n, double share_stiffness_n_per_m) {
+    const auto n = static_cast<std::size_t>(node);
+    if (stiffness_n_per_m[n] == 0.0) touched.push_back(node);
+    stiffness_n_per_m[n] += share_stiffness_n_per_m;
+    force_n[n] += share_force_n;
+  }
+  // Appends one spring per touched node, giving its summed force at `position` with its summed
+  // stiffness, damped at `damping_ratio` of critical; zeroes the sums. Returns how many.
+  std::size_t add_springs(const SimModel& model, const NodeArray& position,
+                          std::vector<NodeSpring>& springs, double damping_ratio = 1.0);
 };
 
 // What one tool part met in a contact evaluation: the tissue's force on it (the springs' elastic
