@@ -971,6 +971,18 @@
         <source>How hard the lesion is to cut: the scalpel is held back by this times the length of its edge in the lesion. </source>
         <translation>病灶的切割难度：手术刀受到的阻力为此值乘以刀刃在病灶内的长度。</translation>
     </message>
+    <message>
+        <source>Blade friction</source>
+        <translation>刀片摩擦</translation>
+    </message>
+    <message>
+        <source>Change the lesion&apos;s blade friction</source>
+        <translation>更改病灶的刀片摩擦</translation>
+    </message>
+    <message>
+        <source>The friction on the scalpel&apos;s sides in the lesion, per length of its edge in it. </source>
+        <translation>病灶内手术刀两侧的摩擦，按其刃在病灶内的每单位长度计。</translation>
+    </message>
 </context>
 <context>
     <name>liversim::EditorOrganPanel</name>
@@ -1409,6 +1421,18 @@
     <message>
         <source>Change the fracture toughness</source>
         <translation>更改断裂韧性</translation>
+    </message>
+    <message>
+        <source>The friction on the scalpel&apos;s sides: it is held back by this times the length of its edge in the tissue, whichever way it moves while it cuts (assumed: 70 N/m). </source>
+        <translation>手术刀两侧的摩擦：切割时无论朝哪个方向移动，它所受的阻力为此值乘以刃在组织内的长度（假定值：70 N/m）。</translation>
+    </message>
+    <message>
+        <source>Blade friction</source>
+        <translation>刀片摩擦</translation>
+    </message>
+    <message>
+        <source>Change the blade friction</source>
+        <translation>更改刀片摩擦</translation>
     </message>
 </context>
 <context>
@@ -2115,6 +2139,18 @@ The scene that was running goes on.</source>
     <message>
         <source>. What holds the scalpel back as it cuts.</source>
         <translation>。切割时阻碍手术刀的正是它。</translation>
+    </message>
+    <message>
+        <source> N/m</source>
+        <translation> N/m</translation>
+    </message>
+    <message>
+        <source>Blade friction</source>
+        <translation>刀片摩擦</translation>
+    </message>
+    <message>
+        <source>. The friction on the scalpel&apos;s sides as it cuts.</source>
+        <translation>。切割时手术刀两侧的摩擦。</translation>
     </message>
 </context>
 <context>

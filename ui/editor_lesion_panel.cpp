@@ -118,6 +118,13 @@ EditorLesionPanel::EditorLesionPanel(ScenarioDocument& scenarioDocument, QWidget
       tr("How hard the lesion is to cut: the scalpel is held back by this times the length of "
          "its edge in the lesion. ") +
       lesionFractureToughness_->toolTip());
+  lesionBladeFriction_ =
+      optionalLesionValue(form, parameter::blade_friction, " N/m", "lesionBladeFriction",
+                          tr("Blade friction"), tr("Change the lesion's blade friction"),
+                          kLesionBladeFriction, &LesionSpec::blade_friction_n_per_m);
+  lesionBladeFriction_->setToolTip(
+      tr("The friction on the scalpel's sides in the lesion, per length of its edge in it. ") +
+      lesionBladeFriction_->toolTip());
   lesionHidden_ = new QCheckBox(tr("Hidden from the trainee"));
   lesionHidden_->setObjectName("lesionHidden");
   lesionHidden_->setToolTip(tr("Not drawn in the workstation (palpation tasks)"));
@@ -151,6 +158,8 @@ void EditorLesionPanel::refresh(int selected) {
       lesionViscosity_->setValue(l.viscosity_pa_s.value_or(lesionViscosity_->minimum()));
       lesionFractureToughness_->setValue(
           l.fracture_toughness_j_per_m2.value_or(lesionFractureToughness_->minimum()));
+      lesionBladeFriction_->setValue(
+          l.blade_friction_n_per_m.value_or(lesionBladeFriction_->minimum()));
       lesionHidden_->setChecked(l.hidden);
     }
     lesionYieldLimit_->setEnabled(s.effects.viscoplastic);

@@ -1,8 +1,8 @@
 #pragma once
 // The scenario editor's Lesions panel: the scenario's lesions, and the one selected in the editor
-// with its name, centre, semi-axes, stiffness, its own yield limit, viscosity and fracture
-// toughness (or the parenchyma's) and whether the trainee sees it. Lesions are added and removed
-// here; which one is selected is the editor's (the view shows it too).
+// with its name, centre, semi-axes, stiffness, its own yield limit, viscosity, fracture
+// toughness and blade friction (or the parenchyma's) and whether the trainee sees it. Lesions are
+// added and removed here; which one is selected is the editor's (the view shows it too).
 
 #include "editor_panel.h"
 
@@ -52,6 +52,7 @@ class EditorLesionPanel : public EditorPanel {
   QDoubleSpinBox* lesionYieldLimit_ = nullptr;         // Pa; its minimum: the parenchyma's
   QDoubleSpinBox* lesionViscosity_ = nullptr;          // Pa·s; its minimum: the parenchyma's
   QDoubleSpinBox* lesionFractureToughness_ = nullptr;  // J/m²; its minimum: the parenchyma's
+  QDoubleSpinBox* lesionBladeFriction_ = nullptr;      // N/m; its minimum: the parenchyma's
   QCheckBox* lesionHidden_ = nullptr;
   QPushButton* removeLesion_ = nullptr;
   QWidget* lesionFields_ = nullptr;

@@ -57,6 +57,8 @@ class EditorPanel : public QWidget {
     kGravityStrength,
     kFractureToughness,
     kLesionFractureToughness,
+    kBladeFriction,
+    kLesionBladeFriction,
   };
 
  protected:

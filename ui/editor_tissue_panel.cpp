@@ -66,16 +66,30 @@ EditorTissuePanel::EditorTissuePanel(
   form->addRow(tr("Poisson's ratio ν"), poissonRatio_);
   bindSpinBox(poissonRatio_, tr("Change Poisson's ratio"), kPoissonRatio,
               [](Scenario& s, double v) { s.parenchyma.elastic.poisson_ratio = v; });
-  // Not an effect: it is what holds the scalpel back, in any scene that offers it.
-  fractureToughness_ = rangeSpinBox(parameter::fracture_toughness, 1.0, " J/m²", 0);
-  fractureToughness_->setObjectName("parenchymaFractureToughness");
-  fractureToughness_->setToolTip(
+  // Not effects: what holds the scalpel back, in any scene that offers it.
+  const auto cuttingValue = [&](std::string_view range, const char* suffix, const char* name,
+                                const QString& label, const QString& what, const QString& editText,
+                                int mergeKey, void (*set)(Scenario&, double)) {
+    QDoubleSpinBox* box = rangeSpinBox(range, 1.0, suffix, 0);
+    box->setObjectName(name);
+    box->setToolTip(what + box->toolTip());
+    form->addRow(label, box);
+    bindSpinBox(box, editText, mergeKey, set);
+    return box;
+  };
+  fractureToughness_ = cuttingValue(
+      parameter::fracture_toughness, " J/m²", "parenchymaFractureToughness",
+      tr("Fracture toughness J"),
       tr("The energy to cut new surface: the scalpel is held back by it times the length of its "
-         "edge in the tissue, and breaks in when pressed that hard. ") +
-      fractureToughness_->toolTip());
-  form->addRow(tr("Fracture toughness J"), fractureToughness_);
-  bindSpinBox(fractureToughness_, tr("Change the fracture toughness"), kFractureToughness,
-              [](Scenario& s, double v) { s.parenchyma.fracture_toughness_j_per_m2 = v; });
+         "edge in the tissue, and breaks in when pressed that hard. "),
+      tr("Change the fracture toughness"), kFractureToughness,
+      [](Scenario& s, double v) { s.parenchyma.fracture_toughness_j_per_m2 = v; });
+  bladeFriction_ = cuttingValue(
+      parameter::blade_friction, " N/m", "parenchymaBladeFriction", tr("Blade friction"),
+      tr("The friction on the scalpel's sides: it is held back by this times the length of its "
+         "edge in the tissue, whichever way it moves while it cuts (assumed: 70 N/m). "),
+      tr("Change the blade friction"), kBladeFriction,
+      [](Scenario& s, double v) { s.parenchyma.blade_friction_n_per_m = v; });
   layout->addLayout(form);
 
   auto* effects = new QGroupBox(tr("Effects simulated (an effect off costs nothing)"));
@@ -270,6 +284,7 @@ void EditorTissuePanel::refresh() {
     youngsModulus_->setValue(s.parenchyma.elastic.youngs_modulus_pa / 1e3);
     poissonRatio_->setValue(s.parenchyma.elastic.poisson_ratio);
     fractureToughness_->setValue(s.parenchyma.fracture_toughness_j_per_m2);
+    bladeFriction_->setValue(s.parenchyma.blade_friction_n_per_m);
     const bool on[4] = {s.effects.near_incompressibility, s.effects.viscoelastic,
                         s.effects.viscoplastic, s.effects.fibres};
     for (int i = 0; i < 4; ++i) effects_[i]->setChecked(on[i]);

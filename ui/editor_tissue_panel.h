@@ -1,6 +1,6 @@
 #pragma once
 // The scenario editor's Tissue and effects panel: the parenchyma's stiffness, Poisson's ratio and
-// fracture toughness,
+// fracture toughness and blade friction,
 // the effects simulated with what they cost (measured by the editor), gravity's direction and
 // strength, the laws of the effects that are on, the fibres' direction, and the fixed regions: the
 // brush that paints them on the organ, what is painted, and the built-in liver's ligament.
@@ -42,6 +42,7 @@ class EditorTissuePanel : public EditorPanel {
   QDoubleSpinBox* youngsModulus_ = nullptr;
   QDoubleSpinBox* poissonRatio_ = nullptr;
   QDoubleSpinBox* fractureToughness_ = nullptr;  // J/m²
+  QDoubleSpinBox* bladeFriction_ = nullptr;      // N/m
   QCheckBox* effects_[4] = {};  // near-incompressibility, viscoelastic, viscoplastic, fibres
   QDoubleSpinBox* viscoelasticE1_ = nullptr;
   QDoubleSpinBox* viscoelasticEta1_ = nullptr;

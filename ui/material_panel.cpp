@@ -38,6 +38,10 @@ MaterialPanel::MaterialPanel(QWidget* parent) : QWidget(parent) {
       "materialFractureToughness", tr("Fracture toughness J"));
   fractureToughness_->setToolTip(fractureToughness_->toolTip() +
                                  tr(". What holds the scalpel back as it cuts."));
+  add(bladeFriction_, parameter::blade_friction, 1.0, tr(" N/m"), 0, "materialBladeFriction",
+      tr("Blade friction"));
+  bladeFriction_->setToolTip(bladeFriction_->toolTip() +
+                             tr(". The friction on the scalpel's sides as it cuts."));
   add(e1_, parameter::e1, 1.0, tr(" Pa"), 0, "materialE1", tr("Maxwell arm E1"));
   e1_->setToolTip(e1_->toolTip() + tr(". E2 = E − E1 follows."));
   add(eta1_, parameter::eta1, 1.0, tr(" Pa·s"), 0, "materialEta1", tr("Maxwell arm η1"));
@@ -97,6 +101,7 @@ void MaterialPanel::showTissue(const TissueSpec& tissue, const EffectsSpec& effe
   poissonRatio_->setValue(tissue.elastic.poisson_ratio);
   density_->setValue(tissue.elastic.density_kg_per_m3);
   fractureToughness_->setValue(tissue.fracture_toughness_j_per_m2);
+  bladeFriction_->setValue(tissue.blade_friction_n_per_m);
   const bool viscoelastic = effects.viscoelastic && tissue.viscoelastic;
   const bool viscoplastic = effects.viscoplastic && tissue.viscoplastic;
   const bool fibres = effects.fibres && tissue.fibres;
@@ -145,6 +150,7 @@ TissueSpec MaterialPanel::requestedTissue() const {
   tissue.elastic.poisson_ratio = poissonRatio_->value();
   tissue.elastic.density_kg_per_m3 = density_->value();
   tissue.fracture_toughness_j_per_m2 = fractureToughness_->value();
+  tissue.blade_friction_n_per_m = bladeFriction_->value();
   if (effects_.viscoelastic && tissue.viscoelastic) {
     tissue.viscoelastic =
         with_maxwell_arm(*tissue.viscoelastic, e1_->value(), tissue.elastic.youngs_modulus_pa);

@@ -58,6 +58,7 @@ class MaterialPanel : public QWidget {
   QDoubleSpinBox* poissonRatio_ = nullptr;
   QDoubleSpinBox* density_ = nullptr;
   QDoubleSpinBox* fractureToughness_ = nullptr;  // J/m²
+  QDoubleSpinBox* bladeFriction_ = nullptr;      // N/m
   QDoubleSpinBox* e1_ = nullptr;
   QDoubleSpinBox* eta1_ = nullptr;
   QDoubleSpinBox* yieldLimit_ = nullptr;

@@ -443,6 +443,7 @@ TEST(Cutting, AnEdgeDeepInsideOneLargeElementIsInItThoughNoCornerIsNearIt) {
     EXPECT_TRUE(in.within_reach);
     EXPECT_NEAR(in.length_m, 0.002, 1e-12);
     EXPECT_NEAR(in.resistance_n, 0.002 * model.regions[0].fracture_toughness_j_per_m2, 1e-12);
+    EXPECT_NEAR(in.friction_n, 0.002 * model.regions[0].blade_friction_n_per_m, 1e-12);
   }
   // Beside the element, past its slanted face (x + y + z = 0.1) though inside its box: out.
   const Eigen::Vector3d beyond(0.04, 0.04, 0.04);

@@ -320,17 +320,20 @@ TEST(LoopStep, ACuttingScalpelTakesOneForceEvaluationPerLoopStep) {
   EXPECT_LE(evaluations, loop_steps + loop_steps / 20);
 }
 
-// A block (its mesh's regions, each of the toughness given, J/m²) held at its base, in the
-// real-time loop with its tools and cutting on.
+// A block (its mesh's regions, each of the toughness given, J/m², and the blade friction given,
+// N/m; none: liver's) held at its base, in the real-time loop with its tools and cutting on.
 struct BlockInTheLoop {
   std::shared_ptr<const SimModel> model;
   std::unique_ptr<RealtimeSimulation> simulation;
 };
-BlockInTheLoop block_in_the_loop(const TetMesh& mesh, const std::vector<double>& toughness) {
+BlockInTheLoop block_in_the_loop(const TetMesh& mesh, const std::vector<double>& toughness,
+                                 const std::vector<double>& friction = {}) {
   ModelOptions options;
   options.regions.assign(toughness.size(), RegionMaterial{});
-  for (std::size_t r = 0; r < toughness.size(); ++r)
+  for (std::size_t r = 0; r < toughness.size(); ++r) {
     options.regions[r].fracture_toughness_j_per_m2 = toughness[r];
+    if (r < friction.size()) options.regions[r].blade_friction_n_per_m = friction[r];
+  }
   options.mass_damping_per_s = 30.0;
   for (std::size_t n = 0; n < mesh.node_count(); ++n)
     if (mesh.rest_position_m.z[n] < 1e-9) options.fixed_nodes.push_back(static_cast<NodeIndex>(n));
@@ -344,16 +347,23 @@ BlockInTheLoop block_in_the_loop(const TetMesh& mesh, const std::vector<double>&
 }
 
 // A blade you feel (issue 42, item 4): drawn straight through a block, a cutting blade is held back
-// by the toughness times its edge in the tissue, against its motion. The block (6 × 5 × 4 cm,
-// fixed at its base) is two layers: the top centimetre of toughness 400 J/m², the rest 200 J/m²
-// (RegionMaterial::fracture_toughness_j_per_m2). The upright blade, its tip 15 mm under
-// the top, is drawn 3 cm along x at 1 cm/s; once it is under way the force on it is
-// 400·0.010 + 200·0.005 = 5 N along −x. What may differ: the elements' faces are pushed out by a
-// 1 µm margin (so an edge along faces is in), which the edge crosses at a slant and may count a
-// few times over at the top and where the layers meet (10 µm allowed), and the top may sag or
-// rise (measured below).
-TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheEdgeInIt) {
+// by the toughness times its edge in the tissue, against its motion across the edge, and by the
+// friction on its sides times the same edge, against its motion; drawn out along its edge, by the
+// friction alone. The block (6 × 5 × 4 cm, fixed at its base) is two layers: the top centimetre
+// of toughness 400 J/m² and friction 140 N/m, the rest 200 J/m² and 70 N/m
+// (RegionMaterial::fracture_toughness_j_per_m2, blade_friction_n_per_m). The upright blade, its
+// tip 15 mm under the top, is drawn 3 cm along x at 1 cm/s; once it is under way the force on it
+// is (400 + 140)·0.010 + (200 + 70)·0.005 = 6.75 N along −x. Then it is drawn straight up along
+// its edge at 1 cm/s: with L of its edge in the tissue, the force is 140·min(L, 0.01) + 70·(L −
+// 0.01)⁺ along −z, nothing across. What may differ: the elements' faces are pushed out by a 1 µm
+// margin (so an edge along faces is in), which the edge crosses at a slant and may count a few
+// times over at the top and where the layers meet (10 µm allowed), the top may sag or rise
+// (measured below), and, drawn up, the blade's velocity is smoothed over 10 ms (the stroke's
+// motion along x has faded to e⁻¹⁰ after the 100 ms left out).
+TEST(BladeResistance,
+     AStraightStrokeThroughABlockIsHeldBackByToughnessAndFrictionTimesTheEdgeInIt) {
   constexpr double kTopM = 0.04, kLayerM = 0.03, kDepthM = 0.015;
+  constexpr double kToughness[] = {200.0, 400.0}, kFriction[] = {70.0, 140.0};
   // Not jittered: the layers meet at z = 3 cm exactly (the mesh's layers are 1 cm apart).
   TetMesh mesh = testing::block_mesh(6, 5, 4, {0.06, 0.05, kTopM});
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
@@ -361,7 +371,8 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
     for (NodeIndex n : mesh.tet(e)) z += 0.25 * mesh.rest_position_m.z[n];
     mesh.region[e] = z > kLayerM ? 1 : 0;
   }
-  BlockInTheLoop block = block_in_the_loop(mesh, {200.0, 400.0});
+  BlockInTheLoop block =
+      block_in_the_loop(mesh, {kToughness[0], kToughness[1]}, {kFriction[0], kFriction[1]});
   const std::shared_ptr<const SimModel>& model = block.model;
   RealtimeSimulation& simulation = *block.simulation;
 
@@ -372,23 +383,41 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
   constexpr double kSpeedMPerS = 0.01, kTravelM = 0.03;
   const int steps = std::max(1, static_cast<int>(std::lround(kCycleS / realtime_step_s(*model))));
   std::vector<SimulationInput> inputs;
-  for (int c = 0; c * kCycleS * kSpeedMPerS <= kTravelM; ++c) {
+  int across_cycles = 0;
+  for (int c = 0; c * kCycleS * kSpeedMPerS <= kTravelM; ++c, ++across_cycles) {
     scalpel.pose.origin_m = start + Eigen::Vector3d(c * kCycleS * kSpeedMPerS, 0.0, 0.0);
+    add_cycle(inputs, scalpel, steps);
+  }
+  const Eigen::Vector3d end_m = scalpel.pose.origin_m;
+  for (int c = 1; c * kCycleS * kSpeedMPerS <= kDepthM; ++c) {
+    scalpel.pose.origin_m = end_m + Eigen::Vector3d(0.0, 0.0, c * kCycleS * kSpeedMPerS);
     add_cycle(inputs, scalpel, steps);
   }
   std::vector<Eigen::Vector3d> steady;  // the force on the blade from 1 cm of travel on
   std::vector<double> depths_m;         // and how much of its edge is in the tissue
-  double top_shift_m = 0.0;             // how far the top near the blade moved, up or down
+  struct Withdrawal {
+    Eigen::Vector3d force_n;
+    double edge_in_tissue_m;
+  };
+  std::vector<Withdrawal> withdrawal;  // drawn up, from 100 ms on while 2 mm or more is in
+  double top_shift_m = 0.0;            // how far the top near the blade moved, up or down
   int cycle = 0;
   simulation.replay(inputs, [&](const StepReport&, bool) {
     simulation.update_snapshot();
     const SimulationSnapshot& seen = simulation.snapshot();
-    if (cycle++ * kCycleS * kSpeedMPerS < 0.01) return;
-    ASSERT_TRUE(seen.hand(Hand::right).blade_cutting)
-        << "the blade is not cutting at cycle " << cycle;
-    steady.push_back(seen.hand(Hand::right).cutting_force_n);
-    depths_m.push_back(seen.hand(Hand::right).blade_edge_in_tissue_m);
-    const Eigen::Vector3d edge_heel = seen.hand(Hand::right).tool->pose.origin_m;
+    const int c = cycle++;
+    const HandSnapshot& hand = seen.hand(Hand::right);
+    if (c < across_cycles) {
+      if (c * kCycleS * kSpeedMPerS < 0.01) return;
+      ASSERT_TRUE(hand.blade_cutting) << "the blade is not cutting at cycle " << c;
+      steady.push_back(hand.cutting_force_n);
+      depths_m.push_back(hand.blade_edge_in_tissue_m);
+    } else {
+      if ((c - across_cycles) * kCycleS < 0.1 || hand.blade_edge_in_tissue_m < 0.002) return;
+      ASSERT_TRUE(hand.blade_cutting) << "drawn up, the blade stopped cutting at cycle " << c;
+      withdrawal.push_back({hand.cutting_force_n, hand.blade_edge_in_tissue_m});
+    }
+    const Eigen::Vector3d edge_heel = hand.tool->pose.origin_m;
     const SimModel& now = *seen.model;
     for (std::size_t n = 0; n < now.node_count; ++n) {
       const Eigen::Vector3d rest = now.rest_position_m.at(n);
@@ -397,8 +426,11 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
     }
   });
   ASSERT_FALSE(steady.empty());
-  const double expected_n = 400.0 * (kTopM - kLayerM) + 200.0 * (kLayerM - (kTopM - kDepthM));
-  const double below_n = 400.0 * top_shift_m, above_n = 400.0 * (1e-5 + top_shift_m);
+  const double top_per_m = kToughness[1] + kFriction[1],
+               bottom_per_m = kToughness[0] + kFriction[0];
+  const double expected_n =
+      top_per_m * (kTopM - kLayerM) + bottom_per_m * (kLayerM - (kTopM - kDepthM));
+  const double below_n = top_per_m * top_shift_m, above_n = top_per_m * (1e-5 + top_shift_m);
   std::cout << "resistance of a blade 15 mm deep: expected " << expected_n << " N (top moved "
             << top_shift_m * 1e3 << " mm); got " << steady.front().transpose() << " … "
             << steady.back().transpose() << " N\n";
@@ -413,6 +445,23 @@ TEST(BladeResistance, AStraightStrokeThroughABlockIsHeldBackByToughnessTimesTheE
     EXPECT_GE(depth_m, kDepthM - top_shift_m);
     EXPECT_LE(depth_m, kDepthM + 1e-5 + top_shift_m);
   }
+  // Drawn out along its edge: the sides' friction over the edge in each layer, against the motion.
+  ASSERT_GT(withdrawal.size(), 50u) << "the blade left the tissue too soon";
+  const double top_layer_m = kTopM - kLayerM;
+  for (const Withdrawal& drawn : withdrawal) {
+    const double in_m = drawn.edge_in_tissue_m;
+    const double friction_n = kFriction[1] * std::min(in_m, top_layer_m) +
+                              kFriction[0] * std::max(0.0, in_m - top_layer_m);
+    EXPECT_LT(drawn.force_n.z(), 0.0) << "not against the motion";
+    EXPECT_LT(drawn.force_n.head<2>().norm(), 1e-3 * drawn.force_n.norm())
+        << "across the edge, drawn along it";
+    EXPECT_NEAR(drawn.force_n.norm(), friction_n, kFriction[1] * (1e-5 + top_shift_m))
+        << "with " << in_m * 1e3 << " mm of the edge in the tissue";
+  }
+  std::cout << "drawn out along its edge: " << withdrawal.front().force_n.transpose() << " N with "
+            << withdrawal.front().edge_in_tissue_m * 1e3 << " mm in … "
+            << withdrawal.back().force_n.transpose() << " N with "
+            << withdrawal.back().edge_in_tissue_m * 1e3 << " mm in\n";
 }
 
 // A blade put back into its own cut is in it at once (issue 42, item 3: a cut deepened stroke

@@ -35,6 +35,7 @@ Scenario every_field_set() {
   s.parenchyma.viscoplastic = ViscoplasticParameters{60.0, 5000.0, 0.6};
   s.parenchyma.fibres = FibreSpec{1200.0, 3.0, {0.0, 0.6, 0.8}};
   s.parenchyma.fracture_toughness_j_per_m2 = 180.0;
+  s.parenchyma.blade_friction_n_per_m = 55.0;
   LesionSpec lesion;
   lesion.name = "tumour";
   lesion.centre_mm = {-45.0, 5.0, 30.0};
@@ -43,6 +44,7 @@ Scenario every_field_set() {
   lesion.yield_limit_pa = 400.0;
   lesion.viscosity_pa_s = 9000.0;
   lesion.fracture_toughness_j_per_m2 = 450.0;
+  lesion.blade_friction_n_per_m = 160.0;
   lesion.hidden = true;
   s.lesions = {lesion};
   s.effects = {false, true, true, true};
@@ -103,6 +105,8 @@ TEST(ScenarioFile, EveryFieldSurvivesASaveAndALoad) {
       {"parenchyma.fibres.k1", [](Scenario& s) { s.parenchyma.fibres->k1_pa = 800.0; }},
       {"parenchyma.fracture_toughness_j_per_m2",
        [](Scenario& s) { s.parenchyma.fracture_toughness_j_per_m2 = 225.0; }},
+      {"parenchyma.blade_friction_n_per_m",
+       [](Scenario& s) { s.parenchyma.blade_friction_n_per_m = 70.0; }},
       {"parenchyma.fibres.k2", [](Scenario& s) { s.parenchyma.fibres->k2 = 0.7; }},
       {"parenchyma.fibres.direction",
        [](Scenario& s) {
@@ -116,6 +120,8 @@ TEST(ScenarioFile, EveryFieldSurvivesASaveAndALoad) {
       {"lesions[0].viscosity_pa_s", [](Scenario& s) { s.lesions[0].viscosity_pa_s.reset(); }},
       {"lesions[0].fracture_toughness_j_per_m2",
        [](Scenario& s) { s.lesions[0].fracture_toughness_j_per_m2.reset(); }},
+      {"lesions[0].blade_friction_n_per_m",
+       [](Scenario& s) { s.lesions[0].blade_friction_n_per_m.reset(); }},
       {"lesions[0].hidden", [](Scenario& s) { s.lesions[0].hidden = false; }},
       {"effects.near_incompressibility",
        [](Scenario& s) { s.effects.near_incompressibility = true; }},
@@ -401,6 +407,54 @@ TEST(ScenarioFile, AVersionTwoFileReadsWithTheLiversFractureToughness) {
   EXPECT_FALSE(refused.scenario);
   ASSERT_EQ(refused.errors.size(), 1u);
   EXPECT_EQ(refused.errors[0].path, "parenchyma.fracture_toughness_j_per_m2");
+}
+
+// Version 4 added the blade friction; a version-3 file reads with the default (70 N/m) for the
+// parenchyma, each lesion takes the parenchyma's, and the scene's regions have them.
+TEST(ScenarioFile, AVersionThreeFileReadsWithTheDefaultBladeFriction) {
+  std::string text = older_palpation_scenario(
+      3, R"({"near_incompressibility": true, "viscoelastic": false, "viscoplastic": false,
+              "fibres": false, "gravity": false, "gravity_direction": [0, 0, -1],
+              "gravity_m_per_s2": 9.81})");
+  const ScenarioReading reading = read_scenario(text);
+  ASSERT_TRUE(reading.scenario) << (reading.errors.empty() ? "" : reading.errors[0].text());
+  EXPECT_EQ(reading.file_version, 3);
+  const Scenario& s = *reading.scenario;
+  EXPECT_EQ(s.parenchyma.blade_friction_n_per_m, 70.0);
+  EXPECT_FALSE(s.lesions[0].blade_friction_n_per_m);
+  const auto regions = region_materials(s);
+  ASSERT_EQ(regions.size(), 2u);
+  EXPECT_EQ(regions[0].blade_friction_n_per_m, 70.0);
+  EXPECT_EQ(regions[1].blade_friction_n_per_m, 70.0) << "a lesion takes the parenchyma's";
+
+  // Set, each region has its own, into the model; saved, the parenchyma's is written out.
+  Scenario rough = s;
+  rough.parenchyma.blade_friction_n_per_m = 0.0;
+  rough.lesions[0].blade_friction_n_per_m = 250.0;
+  const SceneSetup scene = build_scene(rough, ".");
+  const SimModel model = build_model(scene.mesh, scene.model_options);
+  EXPECT_EQ(model.regions[0].blade_friction_n_per_m, 0.0);
+  EXPECT_EQ(model.regions[1].blade_friction_n_per_m, 250.0);
+  const std::string saved = write_scenario(rough);
+  EXPECT_NE(saved.find("\"blade_friction_n_per_m\": 0"), std::string::npos) << saved;
+  EXPECT_NE(saved.find("\"blade_friction_n_per_m\": 250"), std::string::npos) << saved;
+  EXPECT_EQ(round_trip(rough), rough);
+
+  // Out of the documented range, or not a number, it is refused, naming the field and the range.
+  rough.lesions[0].blade_friction_n_per_m = -1.0;
+  rough.parenchyma.blade_friction_n_per_m = std::nan("");
+  const auto errors = validate(rough);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].path, "parenchyma.blade_friction_n_per_m");
+  EXPECT_EQ(errors[1].path, "lesions[0].blade_friction_n_per_m");
+  EXPECT_NE(errors[1].message.find("expected blade friction, 0 to 2000 N/m"), std::string::npos)
+      << errors[1].message;
+  text.replace(text.find("\"density_kg_per_m3\": 1060"), 25,
+               "\"density_kg_per_m3\": 1060, \"blade_friction_n_per_m\": 5000");
+  const ScenarioReading refused = read_scenario(text);
+  EXPECT_FALSE(refused.scenario);
+  ASSERT_EQ(refused.errors.size(), 1u);
+  EXPECT_EQ(refused.errors[0].path, "parenchyma.blade_friction_n_per_m");
 }
 
 // Gravity in the scene: its acceleration is g times the normalised direction when on, and the

@@ -37,7 +37,7 @@ for path in usr/bin/liversim usr/bin/liversim-cli \
   usr/share/icons/hicolor/scalable/apps/org.liversim.LiverSim.svg \
   usr/share/metainfo/org.liversim.LiverSim.metainfo.xml \
   usr/share/liversim/scenarios/palpation-hidden-lesion.json \
-  usr/share/liversim/scenarios/schema/liversim-scenario-3.schema.json \
+  usr/share/liversim/scenarios/schema/liversim-scenario-4.schema.json \
   usr/share/liversim/resources/icons/liversim.svg usr/share/doc/liversim/copyright; do
   grep -q "\./$path\$" <<<"$contents" || fail "the package lacks /$path"
 done

@@ -315,6 +315,19 @@ TEST_F(ScenarioEditorTest, TheRubricTheLawsTheIntegratorAndTheGraspPointAreEdite
   trigger("redoAction");
   EXPECT_EQ(scenario().lesions[0].fracture_toughness_j_per_m2, 600.0);
   EXPECT_EQ(lesionToughness->value(), 600.0);
+  // And what rubs on the blade's sides: the parenchyma's friction (0 allowed: a frictionless
+  // blade), and the lesion's own or the parenchyma's.
+  auto* friction = field<QDoubleSpinBox>("parenchymaBladeFriction");
+  EXPECT_EQ(friction->value(), 70.0);
+  friction->setValue(0.0);
+  EXPECT_EQ(scenario().parenchyma.blade_friction_n_per_m, 0.0);
+  auto* lesionFriction = field<QDoubleSpinBox>("lesionBladeFriction");
+  EXPECT_EQ(lesionFriction->text(), "the parenchyma's");
+  lesionFriction->setValue(150.0);
+  EXPECT_EQ(scenario().lesions[0].blade_friction_n_per_m, 150.0);
+  trigger("undoAction");
+  EXPECT_FALSE(scenario().lesions[0].blade_friction_n_per_m);
+  EXPECT_EQ(lesionFriction->text(), "the parenchyma's");
 
   // The integrator, through the same panel as the workstation's.
   auto* accuracy = field<QWidget>("accuracyPanel");

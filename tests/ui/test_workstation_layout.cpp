@@ -214,16 +214,24 @@ TEST(Workstation, TheMaterialPanelChangesTheRunningLiversTissue) {
   EXPECT_EQ(window->simulation().model().regions[0].tissue.density_kg_per_m3, 1000.0);
   EXPECT_FALSE(window->changingTissue());
 
-  // The fracture toughness, entered in the panel: what the scalpel will be held back by.
-  finished.clear();
-  auto* toughness = window->findChild<QDoubleSpinBox*>("materialFractureToughness");
-  ASSERT_NE(toughness, nullptr);
-  EXPECT_EQ(toughness->value(), 200.0);
-  toughness->setValue(450.0);
-  ASSERT_TRUE(finished.wait(kTimeoutMs));
-  ASSERT_TRUE(finished.first().first().toBool());
+  // What the scalpel will be held back by, entered in the panel: the fracture toughness and the
+  // friction on the blade's sides, each from its default into the running liver's model.
+  const auto enter = [&](const char* name, double shown, double entered) {
+    finished.clear();
+    auto* box = window->findChild<QDoubleSpinBox*>(name);
+    ASSERT_NE(box, nullptr) << name;
+    EXPECT_EQ(box->value(), shown) << name;
+    box->setValue(entered);
+    ASSERT_TRUE(finished.wait(kTimeoutMs)) << name;
+    ASSERT_TRUE(finished.first().first().toBool()) << name;
+  };
+  enter("materialFractureToughness", 200.0, 450.0);
   EXPECT_EQ(window->simulation().model().regions[0].fracture_toughness_j_per_m2, 450.0);
   EXPECT_EQ(window->materialPanel()->tissueInUse().fracture_toughness_j_per_m2, 450.0);
+  enter("materialBladeFriction", 70.0, 120.0);
+  EXPECT_EQ(window->simulation().model().regions[0].blade_friction_n_per_m, 120.0);
+  EXPECT_EQ(window->materialPanel()->tissueInUse().blade_friction_n_per_m, 120.0);
+  EXPECT_EQ(window->simulation().model().regions[0].fracture_toughness_j_per_m2, 450.0);
 }
 
 // Gravity is free practice's to choose, for a trainee too: switched on, the liver carries its

@@ -32,6 +32,10 @@ void validate_regions(const std::vector<RegionMaterial>& regions) {
       throw std::invalid_argument(
           region_name(r) + ": " +
           out_of_range_message("fracture toughness (J/m²)", j, "a finite value >= 0"));
+    if (const double f = regions[r].blade_friction_n_per_m; !std::isfinite(f) || f < 0.0)
+      throw std::invalid_argument(
+          region_name(r) + ": " +
+          out_of_range_message("blade friction (N/m)", f, "a finite value >= 0"));
     if (regions[r].viscoplastic && !regions[r].viscoelastic)
       throw std::invalid_argument(region_name(r) +
                                   ": viscoplasticity needs the viscoelastic parameters (E1, E2, "

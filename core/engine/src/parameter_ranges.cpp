@@ -63,6 +63,12 @@ constexpr std::array kRanges{
                    "published for liver tumours or cirrhosis: up to fibrous tissue (muscle "
                    "550-8000), down to a tenth of liver",
                    false},
+    ParameterRange{p::blade_friction, "blade friction", "N/m", 0.0, 2000.0, false,
+                   "assumed, none is published for a scalpel in liver: a third of the toughness "
+                   "(friction 21 % and tearing 61 % of a needle's insertion force in porcine "
+                   "tissue, Barnett, Lee & Moore 2015), 70 N/m for liver's 200 J/m²; 0 is a "
+                   "frictionless blade",
+                   false},
 };
 
 }  // namespace

@@ -1418,7 +1418,7 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
   // Each element's stretch of the edge, its faces pushed out by the margin so that an edge lying
   // along faces (its own cut, faces snapped onto it) is in; overlaps counted once.
   struct Stretch {
-    double from, to, toughness;
+    double from, to, toughness, friction;
   };
   constexpr std::size_t kMostStretches = 128;  // elements along one edge: a few dozen at most
   std::array<Stretch, kMostStretches> stretches;
@@ -1451,10 +1451,11 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
       in.within_reach = t_in <= t_out;
     }
     const auto [t_in, t_out] = edge_within_element(p, edge_m, margin_m);
-    if (t_in < t_out)
-      stretches[count++] = {
-          t_in, t_out,
-          model.regions[static_cast<std::size_t>(model.region[e])].fracture_toughness_j_per_m2};
+    if (t_in < t_out) {
+      const RegionMaterial& region = model.regions[static_cast<std::size_t>(model.region[e])];
+      stretches[count++] = {t_in, t_out, region.fracture_toughness_j_per_m2,
+                            region.blade_friction_n_per_m};
+    }
   }
   std::sort(stretches.begin(), stretches.begin() + static_cast<std::ptrdiff_t>(count),
             [](const Stretch& a, const Stretch& b) { return a.from < b.from; });
@@ -1465,6 +1466,7 @@ EdgeInTissue edge_in_tissue(const SimModel& model, const NodeArray& position_m,
         std::max(0.0, stretches[i].to - std::max(stretches[i].from, covered_to)) * edge_length_m;
     in.length_m += new_m;
     in.resistance_n += stretches[i].toughness * new_m;
+    in.friction_n += stretches[i].friction * new_m;
     covered_to = std::max(covered_to, stretches[i].to);
   }
   return in;

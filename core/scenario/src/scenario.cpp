@@ -378,7 +378,8 @@ TissueSpec read_tissue(const Json& value, std::vector<ScenarioError>& errors) {
   TissueSpec tissue;
   Fields f(value, "parenchyma", errors,
            {"youngs_modulus_pa", "poisson_ratio", "density_kg_per_m3", "mooney_rivlin_fraction",
-            "fracture_toughness_j_per_m2", "viscoelastic", "viscoplastic", "fibres"});
+            "fracture_toughness_j_per_m2", "blade_friction_n_per_m", "viscoelastic", "viscoplastic",
+            "fibres"});
   if (!f.is_object()) return tissue;
   TissueMaterial& m = tissue.elastic;
   m.youngs_modulus_pa = f.parameter("youngs_modulus_pa", p::youngs_modulus, true).value_or(0.0);
@@ -389,6 +390,8 @@ TissueSpec read_tissue(const Json& value, std::vector<ScenarioError>& errors) {
   tissue.fracture_toughness_j_per_m2 =
       f.parameter("fracture_toughness_j_per_m2", p::fracture_toughness, false)
           .value_or(tissue.fracture_toughness_j_per_m2);
+  tissue.blade_friction_n_per_m = f.parameter("blade_friction_n_per_m", p::blade_friction, false)
+                                      .value_or(tissue.blade_friction_n_per_m);
   if (const Json* v = f.get("viscoelastic")) {
     Fields g(*v, f.at("viscoelastic"), errors, {"e1_pa", "e2_pa", "eta1_pa_s"});
     if (g.is_object())
@@ -442,7 +445,7 @@ std::vector<LesionSpec> read_lesions(const Json& value, std::vector<ScenarioErro
   return read_object_list<LesionSpec>(
       value, "lesions", "lesions",
       {"name", "centre_mm", "radii_mm", "youngs_modulus_pa", "yield_limit_pa", "viscosity_pa_s",
-       "fracture_toughness_j_per_m2", "hidden"},
+       "fracture_toughness_j_per_m2", "blade_friction_n_per_m", "hidden"},
       errors, [](Fields& f) {
         LesionSpec lesion;
         lesion.name = f.text("name", true, true).value_or("");
@@ -456,6 +459,8 @@ std::vector<LesionSpec> read_lesions(const Json& value, std::vector<ScenarioErro
         lesion.viscosity_pa_s = f.parameter("viscosity_pa_s", p::eta1, false);
         lesion.fracture_toughness_j_per_m2 =
             f.parameter("fracture_toughness_j_per_m2", p::fracture_toughness, false);
+        lesion.blade_friction_n_per_m =
+            f.parameter("blade_friction_n_per_m", p::blade_friction, false);
         lesion.hidden = f.boolean("hidden", false).value_or(false);
         return lesion;
       });
@@ -596,7 +601,9 @@ std::vector<RubricCriterion> read_rubric(const Json& value, std::vector<Scenario
 // Older format versions, step by step up to the current one. Version 2 added effects.gravity and
 // its direction and strength; a version-1 file has none, which reads as gravity off. Version 3
 // added the fracture toughness of the parenchyma and of each lesion; an older file has none,
-// which reads as the default (liver's) toughness. So there is nothing to rewrite. A later version
+// which reads as the default (liver's) toughness. Version 4 added the blade friction of the
+// parenchyma and of each lesion; an older file has none, which reads as the default (70 N/m) for
+// every region. So there is nothing to rewrite. A later version
 // adds its step here (and a test with a file of the one before).
 void migrate(Json& /*document*/, int /*from_version*/) {}
 
@@ -654,7 +661,8 @@ bool TissueSpec::operator==(const TissueSpec& o) const {
   };
   return same_elastic(elastic, o.elastic) && same_viscoelastic(viscoelastic, o.viscoelastic) &&
          same_viscoplastic(viscoplastic, o.viscoplastic) && fibres == o.fibres &&
-         fracture_toughness_j_per_m2 == o.fracture_toughness_j_per_m2;
+         fracture_toughness_j_per_m2 == o.fracture_toughness_j_per_m2 &&
+         blade_friction_n_per_m == o.blade_friction_n_per_m;
 }
 
 bool Scenario::operator==(const Scenario& o) const {
@@ -681,6 +689,14 @@ std::vector<ScenarioError> validate(const Scenario& s) {
                      format_number(toughness.max) + " J/m²");
   };
   check_toughness("parenchyma.fracture_toughness_j_per_m2", t.fracture_toughness_j_per_m2);
+  const ParameterRange& friction = parameter_range(p::blade_friction);
+  auto check_friction = [&](const std::string& path, double value) {
+    if (!friction.contains(value))
+      fail(path, format_number(value) + " N/m is invalid: expected " + std::string(friction.label) +
+                     ", " + format_number(friction.min) + " to " + format_number(friction.max) +
+                     " N/m");
+  };
+  check_friction("parenchyma.blade_friction_n_per_m", t.blade_friction_n_per_m);
 
   // Each effect that is on needs its law; viscoplasticity sits in series with viscoelasticity.
   if (s.effects.viscoelastic && !t.viscoelastic)
@@ -766,6 +782,8 @@ std::vector<ScenarioError> validate(const Scenario& s) {
                std::string(ratio.why) + ")");
     if (lesion.fracture_toughness_j_per_m2)
       check_toughness(at + ".fracture_toughness_j_per_m2", *lesion.fracture_toughness_j_per_m2);
+    if (lesion.blade_friction_n_per_m)
+      check_friction(at + ".blade_friction_n_per_m", *lesion.blade_friction_n_per_m);
     if (built_in && !(liver.value(to_metres(lesion.centre_mm)) < 0.0))
       fail(at + ".centre_mm", "(" + format_number(lesion.centre_mm[0]) + ", " +
                                   format_number(lesion.centre_mm[1]) + ", " +
@@ -949,6 +967,7 @@ std::string write_scenario(const Scenario& s) {
   if (t.elastic.mooney_rivlin_fraction != 0.0)
     tissue["mooney_rivlin_fraction"] = t.elastic.mooney_rivlin_fraction;
   tissue["fracture_toughness_j_per_m2"] = t.fracture_toughness_j_per_m2;
+  tissue["blade_friction_n_per_m"] = t.blade_friction_n_per_m;
   if (t.viscoelastic)
     tissue["viscoelastic"] = {{"e1_pa", t.viscoelastic->e1_pa},
                               {"e2_pa", t.viscoelastic->e2_pa},
@@ -974,6 +993,7 @@ std::string write_scenario(const Scenario& s) {
     if (l.viscosity_pa_s) lesion["viscosity_pa_s"] = *l.viscosity_pa_s;
     if (l.fracture_toughness_j_per_m2)
       lesion["fracture_toughness_j_per_m2"] = *l.fracture_toughness_j_per_m2;
+    if (l.blade_friction_n_per_m) lesion["blade_friction_n_per_m"] = *l.blade_friction_n_per_m;
     lesion["hidden"] = l.hidden;
     lesions.push_back(lesion);
   }
@@ -1062,6 +1082,7 @@ std::vector<RegionMaterial> region_materials(const Scenario& s) {
   RegionMaterial parenchyma;
   parenchyma.tissue = t.elastic;
   parenchyma.fracture_toughness_j_per_m2 = t.fracture_toughness_j_per_m2;
+  parenchyma.blade_friction_n_per_m = t.blade_friction_n_per_m;
   if (s.effects.viscoelastic) parenchyma.viscoelastic = t.viscoelastic;
   if (s.effects.viscoplastic) parenchyma.viscoplastic = t.viscoplastic;
   if (s.effects.fibres) parenchyma.fibres = FibreParameters{t.fibres->k1_pa, t.fibres->k2};
@@ -1074,6 +1095,8 @@ std::vector<RegionMaterial> region_materials(const Scenario& s) {
     material.tissue.youngs_modulus_pa = lesion.youngs_modulus_pa;
     material.fracture_toughness_j_per_m2 =
         lesion.fracture_toughness_j_per_m2.value_or(t.fracture_toughness_j_per_m2);
+    material.blade_friction_n_per_m =
+        lesion.blade_friction_n_per_m.value_or(t.blade_friction_n_per_m);
     const double ratio = lesion.youngs_modulus_pa / t.elastic.youngs_modulus_pa;
     if (parenchyma.viscoelastic) {
       ViscoelasticParameters law = *parenchyma.viscoelastic;

@@ -400,16 +400,17 @@ void RealtimeSimulation::resist_cutting(HandInLoop& hand,
   hand.blade_middle_m = middle;
   hand.blade_time_s = state_.time_s;
   const Eigen::Vector3d axis = (edge[1] - edge[0]).normalized();
-  const Eigen::Vector3d across =
-      hand.blade_velocity_m_per_s - hand.blade_velocity_m_per_s.dot(axis) * axis;
-  const double speed = across.norm();
-  if (!(speed > 0.0)) {
-    hand.cutting_force_n.setZero();
-    return;
-  }
-  hand.cutting_force_n = -in.resistance_n *
-                         std::min(1.0, speed / cutting_->full_resistance_speed_m_per_s) * across /
-                         speed;
+  const Eigen::Vector3d& velocity = hand.blade_velocity_m_per_s;
+  const Eigen::Vector3d across = velocity - velocity.dot(axis) * axis;
+  const double full_speed = cutting_->full_resistance_speed_m_per_s;
+  // Each force against a motion, growing with its speed up to full_speed, then constant.
+  const auto against = [full_speed](const Eigen::Vector3d& motion, double force_n) {
+    const double speed = motion.norm();
+    return speed > 0.0
+               ? Eigen::Vector3d(-force_n * std::min(1.0, speed / full_speed) / speed * motion)
+               : Eigen::Vector3d::Zero();
+  };
+  hand.cutting_force_n = against(across, in.resistance_n) + against(velocity, in.friction_n);
 }
 
 void RealtimeSimulation::HandInLoop::end_stroke() {

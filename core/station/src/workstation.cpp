@@ -59,7 +59,8 @@ std::string describe_tissue(const TissueSpec& tissue, const EffectsSpec& effects
   std::ostringstream text;
   text << "E " << tissue.elastic.youngs_modulus_pa << " Pa, nu " << tissue.elastic.poisson_ratio
        << ", density " << tissue.elastic.density_kg_per_m3 << " kg/m3, fracture toughness "
-       << tissue.fracture_toughness_j_per_m2 << " J/m2";
+       << tissue.fracture_toughness_j_per_m2 << " J/m2, blade friction "
+       << tissue.blade_friction_n_per_m << " N/m";
   if (effects.viscoelastic && tissue.viscoelastic)
     text << ", E1 " << tissue.viscoelastic->e1_pa << " Pa, eta1 " << tissue.viscoelastic->eta1_pa_s
          << " Pa s";
@@ -144,6 +145,7 @@ Scenario Workstation::described_scenario() const {
   s.parenchyma.viscoelastic = parenchyma.viscoelastic;
   s.parenchyma.viscoplastic = parenchyma.viscoplastic;
   s.parenchyma.fracture_toughness_j_per_m2 = parenchyma.fracture_toughness_j_per_m2;
+  s.parenchyma.blade_friction_n_per_m = parenchyma.blade_friction_n_per_m;
   if (parenchyma.fibres && !options.fibre_field.first_family.empty()) {
     const Eigen::Vector3d& d = options.fibre_field.first_family.front();
     s.parenchyma.fibres =

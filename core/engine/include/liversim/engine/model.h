@@ -32,6 +32,11 @@ struct RegionMaterial {
   // metre of it in the region, and what breaks a blade in (interaction/cutting.h). Porcine liver
   // cut by a scalpel: 187–225 J/m² (Chanthasopeephan, Desai & Lau 2006).
   double fracture_toughness_j_per_m2 = 200.0;
+  // The friction on a blade's sides per metre of its edge in the region (N/m, ≥ 0), against the
+  // blade's motion in any direction, while it cuts (interaction/cutting.h). Assumed, not measured
+  // for liver: a third of the toughness's force, as friction was 21 % and tearing 61 % of a
+  // needle's insertion force in porcine tissue (Barnett, Lee & Moore 2015).
+  double blade_friction_n_per_m = 70.0;
 };
 
 // Reference fibre directions (normalised when the model is built): empty for no family, one vector
@@ -78,8 +83,8 @@ struct IntegratorSettings {
 };
 
 // The default SimModel::plastic_flow_interval_s: two haptic servo periods. At 1 ms the scalar flow
-// update was still about a fifth of a stroke's time on the wedge scenario (perf); a flow taken every
-// 2 ms lags that of every step by at most (σ − σs)/η2·(2 ms)ⁿ (docs/viscous-tissue.md).
+// update was still about a fifth of a stroke's time on the wedge scenario (perf); a flow taken
+// every 2 ms lags that of every step by at most (σ − σs)/η2·(2 ms)ⁿ (docs/viscous-tissue.md).
 inline constexpr double kPlasticFlowIntervalS = 0.002;
 
 struct ModelOptions {

@@ -54,6 +54,7 @@ inline constexpr std::string_view fibre_k2 = "k2";
 inline constexpr std::string_view mass_damping = "mass_damping_per_s";
 inline constexpr std::string_view lesion_stiffness_ratio = "lesion_stiffness_ratio";
 inline constexpr std::string_view fracture_toughness = "fracture_toughness_j_per_m2";
+inline constexpr std::string_view blade_friction = "blade_friction_n_per_m";
 }  // namespace parameter
 
 // Every range, in the order above.

@@ -51,8 +51,11 @@ struct CuttingSettings {
   // crack that long (Mahvash & Hayward 2001, haptic rendering of cutting).
   //
   // A cutting blade is held back by the toughness times its edge in the tissue, against its
-  // motion across the edge; below this speed the resistance grows from zero with the speed (a
-  // still blade is not pushed back, and the force does not flip with the hand's tremor).
+  // motion across the edge, and by the friction on its sides (RegionMaterial::
+  // blade_friction_n_per_m) times the same edge, against its motion in any direction (drawn along
+  // its edge or out of its cut, it still rubs); below this speed each grows from zero with the
+  // speed it acts against (a still blade is not pushed back, and the force does not flip with the
+  // hand's tremor).
   double full_resistance_speed_m_per_s = 0.005;
   // A node is moved onto the cut when the cut crosses one of its edges within this fraction of
   // the edge's length from it, and when every element it belongs to keeps at least
@@ -150,13 +153,15 @@ std::array<Eigen::Vector3d, 2> cutting_edge_m(const Tool& scalpel);
 // The blade's edge in the tissue: each stretch of the edge within an element (its faces pushed
 // out by `margin_m`, so that an edge along faces, as in its own cut, is in; overlaps once), their
 // length, and the force the crack front along them holds back, each stretch times its element's
-// region's toughness: the work per unit advance of the crack (Mahvash & Hayward 2001); and
+// region's toughness: the work per unit advance of the crack (Mahvash & Hayward 2001); the
+// friction on the blade's sides, each stretch times its region's blade friction; and
 // whether the edge passes through an element or within about `reach_m` of one (its faces pushed
 // out by that much). One walk over the nodes and one over the elements' corner indices; allocates
 // nothing once `node_scratch` holds a byte per node (without it, a vector of its own).
 struct EdgeInTissue {
   double length_m = 0.0;
-  double resistance_n = 0.0;
+  double resistance_n = 0.0;  // the crack front's: against the blade's motion across its edge
+  double friction_n = 0.0;    // the sides': against the blade's motion in any direction
   bool within_reach = false;
 };
 // edge_in_tissue's margin unless told (m).

@@ -20,7 +20,7 @@
 namespace liversim {
 
 // The version this build writes and the newest it reads; older files are migrated on reading.
-inline constexpr int kScenarioFormatVersion = 3;
+inline constexpr int kScenarioFormatVersion = 4;
 inline constexpr std::string_view kScenarioFormatName = "liversim-scenario";
 
 using Millimetres3 =
@@ -74,6 +74,9 @@ struct TissueSpec {
   // The energy to make new cut surface (J/m²): what holds a scalpel back as it cuts and what it
   // takes to break in (RegionMaterial; docs/cutting.md). Porcine liver: 187–225 J/m².
   double fracture_toughness_j_per_m2 = RegionMaterial{}.fracture_toughness_j_per_m2;
+  // The friction on a cutting blade's sides per metre of its edge in the tissue (N/m): assumed,
+  // 70 N/m (RegionMaterial; docs/cutting.md).
+  double blade_friction_n_per_m = RegionMaterial{}.blade_friction_n_per_m;
   bool operator==(const TissueSpec&) const;
 };
 
@@ -86,6 +89,7 @@ struct LesionSpec {
   std::optional<double> yield_limit_pa;  // with viscoplasticity (default: the parenchyma's)
   std::optional<double> viscosity_pa_s;  // η1 with viscoelasticity (default: the parenchyma's)
   std::optional<double> fracture_toughness_j_per_m2;  // J/m² (default: the parenchyma's)
+  std::optional<double> blade_friction_n_per_m;       // N/m (default: the parenchyma's)
   bool hidden = false;                                // not drawn for the trainee (palpation tasks)
   bool operator==(const LesionSpec&) const = default;
 };

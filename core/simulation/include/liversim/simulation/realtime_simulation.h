@@ -50,7 +50,8 @@ struct HandSnapshot {
   std::size_t contacts = 0;
   bool blade_cutting = false;  // the scalpel has broken into the tissue
   // Of force_n, the tissue's resistance to the cutting blade (CuttingSettings): its toughness
-  // times the edge in the tissue, against the blade's motion across its edge.
+  // times the edge in the tissue, against the blade's motion across its edge, and the friction on
+  // its sides times the same edge, against its motion.
   Eigen::Vector3d cutting_force_n = Eigen::Vector3d::Zero();
   // How much of the scalpel's edge is inside the tissue (m; with cutting enabled), cutting or not:
   // how deep the blade is, along its edge.
